@@ -1,0 +1,175 @@
+//! The driver traits. Both are pull-based: the interpreter sleeps on the (possibly
+//! virtual) tokio clock in short ticks and drains every sample that became available,
+//! so a simulated station costs no timer per sample.
+
+use async_trait::async_trait;
+
+/// Which table axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum TableAxisId {
+    /// Outer axis.
+    Outer,
+    /// Inner axis.
+    Inner,
+}
+
+/// A command to the table. Angles in degrees, rates in deg/s.
+#[derive(Debug, Clone, PartialEq)]
+pub enum TableCommand {
+    /// Position both axes (acceleration- and rate-limited move), then hold.
+    MoveTo {
+        /// Outer angle, deg.
+        outer_deg: f64,
+        /// Inner angle, deg.
+        inner_deg: f64,
+    },
+    /// Ramp an axis to a constant rate.
+    Rate {
+        /// Axis.
+        axis: TableAxisId,
+        /// Rate, deg/s.
+        rate_dps: f64,
+    },
+    /// Decelerate an axis to rest and hold where it stops.
+    Stop {
+        /// Axis.
+        axis: TableAxisId,
+    },
+    /// Sway an axis: `center + amplitude sin(2 pi (t - t0) / period)`.
+    Oscillate {
+        /// Axis.
+        axis: TableAxisId,
+        /// Centre, deg.
+        center_deg: f64,
+        /// Amplitude, deg.
+        amplitude_deg: f64,
+        /// Period, s.
+        period_s: f64,
+    },
+    /// Safe state: decelerate both axes within the table's limits and stop.
+    SafeStop,
+}
+
+/// One table feedback sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TableSample {
+    /// Time since the station's start, s.
+    pub t: f64,
+    /// Measured outer angle, deg.
+    pub outer_deg: f64,
+    /// Measured inner angle, deg.
+    pub inner_deg: f64,
+    /// Measured outer rate, deg/s.
+    pub outer_rate_dps: f64,
+    /// Measured inner rate, deg/s.
+    pub inner_rate_dps: f64,
+    /// Lab air temperature, degC, if the station measures it.
+    pub ambient_c: Option<f64>,
+}
+
+/// One IMU sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImuSample {
+    /// Time stamp since the station's start, s.
+    pub t: f64,
+    /// Accelerometer outputs, m/s^2.
+    pub accel: [f64; 3],
+    /// Gyro outputs, deg/s.
+    pub gyro: [f64; 3],
+    /// Internal temperature, degC.
+    pub temp_c: Option<f64>,
+}
+
+/// Static facts about a table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TableInfo {
+    /// Model name.
+    pub model: String,
+    /// Maximum rate per axis, deg/s.
+    pub max_rate_dps: f64,
+    /// Maximum angular acceleration per axis, deg/s^2.
+    pub max_accel_dps2: f64,
+    /// Feedback rate, Hz.
+    pub feedback_hz: f64,
+    /// Whether the table is simulated.
+    pub simulated: bool,
+}
+
+/// Static facts about an IMU.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImuInfo {
+    /// Model name.
+    pub model: String,
+    /// Serial number.
+    pub serial: String,
+    /// Grade (`tactical`, `navigation`, `consumer`...).
+    pub grade: String,
+    /// Sample rate, Hz.
+    pub sample_hz: f64,
+    /// Accelerometer range, m/s^2.
+    pub accel_range_mps2: f64,
+    /// Gyro range, deg/s.
+    pub gyro_range_dps: f64,
+    /// Whether the IMU is simulated.
+    pub simulated: bool,
+}
+
+/// What went wrong, for the engine to branch on (never on message text).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DriverErrorKind {
+    /// No answer in time.
+    Timeout,
+    /// The link failed (socket closed, serial error).
+    Transport,
+    /// The instrument itself reported a fault.
+    Instrument,
+    /// The command is outside what the device can do.
+    InvalidCommand,
+}
+
+/// A driver error.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{message}")]
+pub struct DriverError {
+    /// Kind.
+    pub kind: DriverErrorKind,
+    /// Message for people.
+    pub message: String,
+}
+
+impl DriverError {
+    /// Builds an error.
+    pub fn new(kind: DriverErrorKind, message: impl Into<String>) -> Self {
+        DriverError { kind, message: message.into() }
+    }
+
+    /// Kind of the error.
+    pub fn kind(&self) -> DriverErrorKind {
+        self.kind
+    }
+}
+
+/// A rate table.
+#[async_trait]
+pub trait TableDriver: Send {
+    /// Static facts.
+    fn info(&self) -> TableInfo;
+    /// Sends a command; returns once the table accepted it (not once the motion ended).
+    async fn command(&mut self, cmd: TableCommand) -> Result<(), DriverError>;
+    /// Appends every feedback sample that became available since the last call.
+    async fn read(&mut self, out: &mut Vec<TableSample>) -> Result<(), DriverError>;
+}
+
+/// An IMU.
+#[async_trait]
+pub trait ImuDriver: Send {
+    /// Static facts.
+    fn info(&self) -> ImuInfo;
+    /// Appends every sample that became available since the last call.
+    async fn read(&mut self, out: &mut Vec<ImuSample>) -> Result<(), DriverError>;
+    /// The operator remounted the IMU with a new `C_PB` (row-major); a simulator changes its
+    /// physics, hardware ignores it.
+    async fn remount(&mut self, _rotation: [[f64; 3]; 3]) -> Result<(), DriverError> {
+        Ok(())
+    }
+}

@@ -1,0 +1,7 @@
+//! ratecal's stages, each a function from one data type to the next:
+//! `check` (AST -> Plan), `run` (Plan + drivers -> Recording), `fit` (Recording ->
+//! Results), `render` (Results -> report), `audit` (Plan vs Plan, run folders).
+//! Only `run` awaits; the engine does IO only through what it is handed.
+
+pub mod plan;
+pub mod recording;

@@ -1,0 +1,225 @@
+//! The recording folder of `spec/recording-format.md`: the contract between measuring and
+//! analysing. `run` writes one (`write`), `fit` reads any (`read`), whoever wrote it.
+
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// `manifest.yaml`. Unknown keys are ignored on reading.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    /// `ratecal-recording/1`.
+    pub format: String,
+    /// Station geometry and site.
+    pub station: ManifestStation,
+    /// Free-form IMU description (model, serial, grade...).
+    #[serde(default)]
+    pub imu: BTreeMap<String, String>,
+    /// The procedure that ran (always written by ratecal; optional from other systems).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub procedure: Option<ProcedureRef>,
+    /// Acquisition windows in time order.
+    #[serde(default)]
+    pub segments: Vec<Segment>,
+    /// Lab conditions measured once.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub environment: Option<EnvironmentRecord>,
+    /// What ratecal adds about the run itself (absent from other systems' recordings).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub run: Option<RunInfo>,
+}
+
+/// `station:` block of the manifest.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ManifestStation {
+    /// Site.
+    pub site: ratecal_physics::Site,
+    /// Table axes.
+    pub table: TableAxes,
+    /// IMU mount (identity if absent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mount: Option<Mount>,
+}
+
+/// Outer and inner axis unit vectors (lab frame, ENU).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TableAxes {
+    /// `a_o`.
+    pub outer_axis: [f64; 3],
+    /// `a_i` at outer angle 0.
+    pub inner_axis: [f64; 3],
+}
+
+/// `mount: { rotation: [[...],[...],[...]] }`: `C_PB` row-major.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Mount {
+    /// `C_PB`, row-major.
+    pub rotation: [[f64; 3]; 3],
+}
+
+/// `procedure:` block.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ProcedureRef {
+    /// Name.
+    pub name: String,
+    /// Version.
+    pub version: String,
+    /// Lowercase hex SHA-256 of the canonical text, unabridged.
+    pub sha256: String,
+}
+
+/// Kind of a segment.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SegmentKind {
+    /// Table at rest.
+    Static,
+    /// One axis at a constant rate.
+    Rate,
+    /// One axis swaying sinusoidally.
+    Oscillation,
+}
+
+/// One acquisition window.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Segment {
+    /// Free-form id.
+    pub id: String,
+    /// Kind.
+    pub kind: SegmentKind,
+    /// Start, s (stream clock).
+    pub t_start: f64,
+    /// End, s.
+    pub t_end: f64,
+    /// `outer` / `inner` for rate and oscillation segments.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axis: Option<String>,
+    /// Nominal rate of a rate segment, deg/s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rate_dps: Option<f64>,
+    /// Oscillation amplitude, deg.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub amplitude_deg: Option<f64>,
+    /// Oscillation period, s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub period_s: Option<f64>,
+    /// Oscillation centre, deg.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub center_deg: Option<f64>,
+    /// Nominal attitude (informative; references come from the feedback).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pitch_deg: Option<f64>,
+    /// Nominal attitude (informative).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub roll_deg: Option<f64>,
+    /// Remount before this segment; holds until another segment says otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mount: Option<Mount>,
+}
+
+/// `environment:` block.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct EnvironmentRecord {
+    /// Lab temperature, degC.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub temperature_c: Option<f64>,
+    /// Relative humidity, %.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub humidity_pct: Option<f64>,
+    /// Pressure, kPa.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pressure_kpa: Option<f64>,
+    /// Vibration, g.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vibration_g: Option<f64>,
+}
+
+/// What ratecal records about its own run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunInfo {
+    /// Run id.
+    pub id: String,
+    /// ratecal version.
+    pub ratecal_version: String,
+    /// Whether the station was simulated.
+    pub dry_run: bool,
+    /// Start, RFC 3339 (wall clock).
+    pub started: String,
+    /// End, RFC 3339, once ended.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ended: Option<String>,
+    /// `running`, `completed`, `aborted`.
+    pub status: String,
+    /// Why it aborted.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub abort: Option<AbortRecord>,
+    /// Operator.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub operator: Option<String>,
+    /// Seed of a simulated run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
+    /// SHA-256 of the station file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub station_sha256: Option<String>,
+    /// SHA-256 of each data file once the run ended (`imu.csv`, `table.csv`, ...).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub files_sha256: BTreeMap<String, String>,
+}
+
+/// Why and when a run aborted.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AbortRecord {
+    /// Rule text (or `ctrl-c`, `settle timeout in step X`, `driver error: ...`).
+    pub rule: String,
+    /// Stream time when it fired, s.
+    pub t: f64,
+    /// Step it fired in.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step: Option<String>,
+    /// The values that fired it.
+    pub values: String,
+}
+
+/// The IMU stream, columnar.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ImuStream {
+    /// Time stamps, s.
+    pub t: Vec<f64>,
+    /// Accelerometer outputs, m/s^2.
+    pub accel: Vec<[f64; 3]>,
+    /// Gyro outputs, deg/s.
+    pub gyro: Vec<[f64; 3]>,
+    /// IMU internal temperature, degC (optional column).
+    pub temp: Option<Vec<f64>>,
+}
+
+/// The table feedback stream, columnar.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TableStream {
+    /// Time stamps, s.
+    pub t: Vec<f64>,
+    /// Outer angle, deg (may run past 360).
+    pub outer: Vec<f64>,
+    /// Inner angle, deg.
+    pub inner: Vec<f64>,
+    /// Outer rate, deg/s.
+    pub outer_rate: Vec<f64>,
+    /// Inner rate, deg/s.
+    pub inner_rate: Vec<f64>,
+    /// Lab air temperature, degC (optional column).
+    pub ambient: Option<Vec<f64>>,
+}
+
+/// A whole recording in memory.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Recording {
+    /// Manifest.
+    pub manifest: Manifest,
+    /// IMU stream.
+    pub imu: ImuStream,
+    /// Table stream.
+    pub table: TableStream,
+}
+
+/// The format tag this version writes and reads.
+pub const FORMAT: &str = "ratecal-recording/1";
