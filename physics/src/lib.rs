@@ -8,6 +8,7 @@
 mod effects;
 mod kinematics;
 mod model;
+pub mod units;
 
 pub use effects::{EFFECTS, EffectId, EffectInfo, effect};
 pub use kinematics::{

@@ -10,33 +10,7 @@
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
-/// Physical dimension of a quantity.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Dim {
-    /// deg, rad, arcmin, arcsec (internal: deg).
-    Angle,
-    /// deg/s, rad/s, deg/h (internal: deg/s).
-    Rate,
-    /// g, mg, ug, m/s^2 (internal: m/s^2 with g = 9.80665 standard gravity as a unit).
-    Accel,
-    /// ms, s, min, h (internal: s).
-    Time,
-    /// Hz (internal: Hz).
-    Frequency,
-    /// degC, K (internal: degC).
-    Temperature,
-    /// degC/h (internal: degC/h).
-    TemperatureRate,
-    /// mm, m (internal: m).
-    Length,
-    /// %, ppm (internal: plain ratio, 1 % = 0.01).
-    Ratio,
-    /// Pa-family: kPa, Pa, hPa (internal: kPa).
-    Pressure,
-    /// A bare number.
-    Number,
-}
+pub use ratecal_physics::units::Dim;
 
 /// A value with its unit as written, and its value in the internal unit of its dimension.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
