@@ -49,8 +49,11 @@ impl World {
         let servo = Servo {
             wn: 2.0 * std::f64::consts::PI * t.settling.natural_frequency.0,
             zeta: t.settling.damping,
+            feedforward: t.settling.feedforward,
         };
-        let axis = || AxisProfile::at_rest(0.0, servo, t.max_rate.0, t.max_accel_dps2);
+        // Plan so that the servo's overshoot stays within the table's acceleration limit.
+        let plan_accel = t.max_accel_dps2 / servo.accel_derating();
+        let axis = || AxisProfile::at_rest(0.0, servo, t.max_rate.0, plan_accel);
         let mut faults: Vec<PendingFault> = station
             .faults
             .iter()

@@ -65,10 +65,11 @@ impl Cmd {
         }
     }
 
-    /// The forcing of the error equation (`-cmd''` for constant acceleration, 0 with feed-forward).
-    fn forcing(&self) -> f64 {
+    /// The forcing of the error equation: the part of `-cmd''` that the acceleration
+    /// feed-forward leaves over (an oscillation is fully fed forward).
+    fn forcing(&self, feedforward: f64) -> f64 {
         match *self {
-            Cmd::Poly { alpha, .. } => -alpha,
+            Cmd::Poly { alpha, .. } => -alpha * (1.0 - feedforward),
             Cmd::Osc { .. } => 0.0,
         }
     }
@@ -81,6 +82,9 @@ pub struct Servo {
     pub wn: f64,
     /// Damping ratio.
     pub zeta: f64,
+    /// Fraction of the commanded acceleration fed forward (0..1): the rest drives the
+    /// tracking error.
+    pub feedforward: f64,
 }
 
 impl Servo {
@@ -109,6 +113,23 @@ impl Servo {
             let (e1, e2) = ((r1 * s).exp(), (r2 * s).exp());
             (c1 * e1 + c2 * e2, r1 * c1 * e1 + r2 * c2 * e2)
         }
+    }
+
+    /// How much lower than the table's limit to plan the commanded acceleration so that
+    /// the true acceleration stays within it: after a step `D` in the commanded
+    /// acceleration the true one peaks at `D (1 + overshoot)` (the loop's zero), and the
+    /// worst step is a reversal from `+a` to `-a`.
+    pub fn accel_derating(&self) -> f64 {
+        let w2 = self.wn * self.wn;
+        let horizon = 20.0 / self.decay();
+        let peak = (0..=4000)
+            .map(|k| {
+                let (x, v) = self.free(1.0 / w2, 0.0, horizon * k as f64 / 4000.0);
+                1.0 - w2 * x - 2.0 * self.zeta * self.wn * v
+            })
+            .fold(1.0, f64::max);
+        let overshoot = (1.0 - self.feedforward) * (peak - 1.0);
+        1.0 + 2.0 * overshoot
     }
 
     /// Slowest decay rate, 1/s (halved when critically damped, for its `s e^{-wn s}` term).
@@ -241,7 +262,7 @@ impl AxisProfile {
     fn push(&mut self, t0: f64, cmd: Cmd) {
         let (_, e, de) = self.state(t0);
         let w2 = self.servo.wn * self.servo.wn;
-        let e_p = cmd.forcing() / w2;
+        let e_p = cmd.forcing(self.servo.feedforward) / w2;
         let (x0, v0) = (e - e_p, de);
         let size =
             x0.abs() + (v0.abs() + self.servo.decay() * x0.abs()) / self.servo.decay().max(1e-9);

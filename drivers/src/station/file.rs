@@ -4,7 +4,7 @@
 
 use super::quantity::{
     Accel, AccelDensity, Angle, Freq, Pressure, Rate, RateDensity, RateWalk, Ratio, Rotation, Temp,
-    TempDelta, TempRate, Time, UnitVec, positive,
+    TempDelta, TempRate, Time, UnitVec, fraction, positive,
 };
 use serde::{Deserialize, Serialize};
 
@@ -93,6 +93,14 @@ pub struct SettlingSpec {
     /// Damping ratio (0 < damping; below 1 overshoots).
     #[serde(deserialize_with = "positive")]
     pub damping: f64,
+    /// Fraction of the commanded acceleration fed forward, 0 to 1: the rest makes the
+    /// tracking lag while accelerating and the overshoot after a move.
+    #[serde(default = "default_feedforward", deserialize_with = "fraction")]
+    pub feedforward: f64,
+}
+
+fn default_feedforward() -> f64 {
+    0.8
 }
 
 impl Default for SettlingSpec {
@@ -100,6 +108,7 @@ impl Default for SettlingSpec {
         SettlingSpec {
             natural_frequency: Freq(5.0),
             damping: 0.6,
+            feedforward: default_feedforward(),
         }
     }
 }

@@ -109,6 +109,18 @@ pub fn positive<'de, D: Deserializer<'de>, T: Deserialize<'de> + Value>(
     }
 }
 
+/// `deserialize_with` helper: a plain number from 0 to 1.
+pub fn fraction<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    let v = f64::deserialize(d)?;
+    if (0.0..=1.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err(de::Error::custom(format!(
+            "must be between 0 and 1, found {v}"
+        )))
+    }
+}
+
 /// A unit vector written `[x, y, z]` (checked to 1e-6; then normalised exactly).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct UnitVec(pub [f64; 3]);

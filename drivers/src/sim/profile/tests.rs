@@ -3,6 +3,7 @@ use super::*;
 const SERVO: Servo = Servo {
     wn: 2.0 * std::f64::consts::PI * 5.0,
     zeta: 0.6,
+    feedforward: 0.0,
 };
 
 fn scan(p: &AxisProfile, t0: f64, t1: f64, dt: f64) -> Vec<(f64, AxisKinematics)> {
