@@ -111,9 +111,9 @@ mod tests {
             ne.add(&[*x, 1.0], y);
         }
         let s = ne.solve(&[0, 1]).unwrap();
-        // closed form: slope = Sxy/Sxx with Sxx = 10, Sxy = 19.3
-        assert!((s.x[0] - 1.93).abs() < 1e-12);
-        assert!((s.x[1] - (5.02 - 1.93 * 2.0)).abs() < 1e-12);
+        // closed form: slope = Sxy/Sxx with Sxx = 10, Sxy = 19.6
+        assert!((s.x[0] - 1.96).abs() < 1e-12);
+        assert!((s.x[1] - (5.02 - 1.96 * 2.0)).abs() < 1e-12);
         let rss: f64 = xs
             .iter()
             .zip(ys)
