@@ -5,3 +5,5 @@
 
 pub mod plan;
 pub mod recording;
+pub mod fit;
+pub mod results;
