@@ -9,7 +9,10 @@ use std::time::{Duration, Instant};
 async fn standard_procedure_motion_at_1khz() {
     let text =
         ratecal_drivers::DEFAULT_STATION_YAML.replace("sample_rate: 100 Hz", "sample_rate: 1 kHz");
-    let s = Station::from_yaml(&text, "fast.yaml").unwrap();
+    let mut s = Station::from_yaml(&text, "fast.yaml").unwrap();
+    if std::env::var_os("RATECAL_NOISELESS").is_some() {
+        s = s.noiseless();
+    }
     let (mut table, mut imu) = build(&s, 1).unwrap();
     let wall = Instant::now();
     let (mut a, mut b) = (Vec::with_capacity(20_000), Vec::new());
@@ -64,5 +67,32 @@ async fn standard_procedure_motion_at_1khz() {
         "{n} IMU samples, {virt} s simulated in {el:.3} s: {:.0}x real time, {:.0} ns/sample",
         virt / el,
         el / n as f64 * 1e9
+    );
+}
+
+#[test]
+#[ignore = "timing; run in release"]
+fn physics_cost_per_call() {
+    use ratecal_physics::{AxisMotion, ImuErrors, TableState, ideal_outputs};
+    let s = Station::default_sim();
+    let (geo, site, e) = (s.geometry(), s.site(), ImuErrors::default());
+    let wall = Instant::now();
+    let mut acc = 0.0;
+    let n = 1_000_000;
+    for k in 0..n {
+        let st = TableState {
+            outer: AxisMotion {
+                angle: k as f64 * 1e-4,
+                rate: 1.0,
+                accel: 0.0,
+            },
+            inner: AxisMotion::default(),
+        };
+        let out = ideal_outputs(&st, &geo, &site, &e.lever_m);
+        acc += e.apply(&out, 20.0).0.x;
+    }
+    println!(
+        "{:.0} ns per ideal_outputs + apply ({acc})",
+        wall.elapsed().as_secs_f64() / n as f64 * 1e9
     );
 }
