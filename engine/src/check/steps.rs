@@ -377,7 +377,19 @@ impl Ck<'_> {
                 }
             }
             Stmt::Remount { axis, message } => {
-                let k = match axis.node.as_str() {
+                // The axis may be a loop variable (`for axis in [z, x, y] { remount axis up }`).
+                let bound = self
+                    .scopes
+                    .iter()
+                    .rev()
+                    .flat_map(|s| s.iter())
+                    .find(|(n, _)| *n == axis.node)
+                    .map(|(_, v)| v.v.clone());
+                let name = match bound {
+                    Some(Val::Sym(s)) | Some(Val::Str(s)) => s,
+                    _ => axis.node.clone(),
+                };
+                let k = match name.as_str() {
                     "x" => 0,
                     "y" => 1,
                     "z" => 2,
@@ -405,7 +417,7 @@ impl Ck<'_> {
                     || {
                         format!(
                             "Remount the IMU with its {} axis up",
-                            axis.node.to_uppercase()
+                            name.to_uppercase()
                         )
                     },
                     |m| m.node.clone(),
