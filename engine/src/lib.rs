@@ -5,4 +5,6 @@
 
 pub mod plan;
 pub mod recording;
+pub mod fit;
+pub mod results;
 pub mod run;
