@@ -3,6 +3,7 @@
 
 mod common;
 
+use common::plans::*;
 use common::*;
 use ratecal_engine::plan::*;
 use ratecal_engine::recording::{Columns, Manifest, RecordingWriter, SegmentKind, sha256_hex};
@@ -10,77 +11,6 @@ use ratecal_engine::run::{NoProgress, RunOptions, RunOutcome, RunStatus, execute
 use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
-
-fn plan(aborts: Vec<AbortRule>, steps: Vec<Step>) -> Plan {
-    Plan {
-        name: "test".into(),
-        version: "1.0.0".into(),
-        title: "t".into(),
-        references: vec![],
-        imu_class: None,
-        meta: Default::default(),
-        requirements: vec![],
-        environment: vec![],
-        aborts,
-        steps,
-        fits: vec![],
-        accepts: vec![],
-        verifications: vec![],
-        estimated_duration_s: 0.0,
-    }
-}
-
-fn step(name: &str, body: Vec<Node>) -> Step {
-    Step {
-        name: name.into(),
-        title: None,
-        aborts: vec![],
-        body,
-        estimated_duration_s: 0.0,
-    }
-}
-
-fn mv(outer: f64, inner: f64) -> Node {
-    Node::Do(Action::MoveTo {
-        outer_deg: outer,
-        inner_deg: inner,
-    })
-}
-
-fn settle(
-    min: f64,
-    att: Option<f64>,
-    rate: Option<f64>,
-    timeout: f64,
-    on_timeout: OnTimeout,
-) -> Node {
-    Node::Do(Action::Settle(Settle {
-        min_time_s: min,
-        stable: vec![],
-        attitude_error_deg: att,
-        rate_error_dps: rate,
-        timeout_s: Some(timeout),
-        on_timeout,
-    }))
-}
-
-fn acquire(id: &str, dur: f64) -> Node {
-    Node::Do(Action::Acquire(Acquire {
-        segment: id.into(),
-        channels: vec!["accel".into()],
-        duration_s: dur,
-        rate_hz: 100.0,
-    }))
-}
-
-fn rule(text: &str, condition: AbortCondition, persistence_s: f64) -> AbortRule {
-    AbortRule {
-        text: text.into(),
-        condition,
-        persistence_s,
-        action: AbortAction::Abort,
-    }
-}
 
 async fn run_on(dir: &Path, plan: &Plan, faults: Faults, opts: RunOptions) -> (RunOutcome, Shared) {
     let (mut table, mut imu, shared) = station(faults);

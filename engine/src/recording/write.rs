@@ -115,8 +115,9 @@ impl Stream {
 }
 
 /// Writes a recording folder incrementally. Sample times handed in are already on the
-/// recording's clock (0 at the start of the run); samples whose time does not strictly
-/// increase are dropped (the format requires increasing time), and counted.
+/// recording's clock (0 at the start of the run). Samples the format cannot hold are
+/// dropped and counted: a time that does not strictly increase, or a non-finite value (a
+/// faulty IMU's NaN output; the format refuses non-numeric cells).
 pub struct RecordingWriter {
     dir: PathBuf,
     imu: Stream,
@@ -218,7 +219,9 @@ impl RecordingWriter {
     /// Appends IMU samples (times on the recording clock).
     pub fn write_imu(&mut self, samples: &[ImuSample]) -> io::Result<()> {
         for s in samples {
-            if self.imu.last_t.is_some_and(|l| s.t <= l) || !s.t.is_finite() {
+            let temp_ok = !self.columns.imu_temp || s.temp_c.is_some_and(f64::is_finite);
+            let finite = s.accel.iter().chain(&s.gyro).all(|v| v.is_finite()) && temp_ok;
+            if self.imu.last_t.is_some_and(|l| s.t <= l) || !s.t.is_finite() || !finite {
                 self.dropped += 1;
                 continue;
             }
@@ -245,7 +248,15 @@ impl RecordingWriter {
     /// Appends table feedback samples (times on the recording clock).
     pub fn write_table(&mut self, samples: &[TableSample]) -> io::Result<()> {
         for s in samples {
-            if self.table.last_t.is_some_and(|l| s.t <= l) || !s.t.is_finite() {
+            let ambient_ok = !self.columns.ambient || s.ambient_c.is_some_and(f64::is_finite);
+            let finite = [s.outer_deg, s.inner_deg, s.outer_rate_dps, s.inner_rate_dps]
+                .iter()
+                .all(|v| v.is_finite());
+            if self.table.last_t.is_some_and(|l| s.t <= l)
+                || !s.t.is_finite()
+                || !finite
+                || !ambient_ok
+            {
                 self.dropped += 1;
                 continue;
             }

@@ -72,6 +72,7 @@ pub async fn execute(
         stall_s: opts.stall_timeout_s.max(3.0 / info.sample_hz.max(1e-3)),
         imu_hz: info.sample_hz,
         timeouts_since: None,
+        warned_nonfinite: false,
     };
     ex.journal(JournalEvent::Start {
         procedure: plan.name.clone(),
@@ -190,6 +191,7 @@ struct Exec<'a> {
     stall_s: f64,
     imu_hz: f64,
     timeouts_since: Option<f64>,
+    warned_nonfinite: bool,
 }
 
 impl Exec<'_> {
@@ -593,6 +595,20 @@ impl Exec<'_> {
             .and_then(|()| self.sink.table(&self.table_buf))
         {
             return Err(self.abort("recording error".into(), e.to_string()));
+        }
+        let nonfinite = self
+            .imu_buf
+            .iter()
+            .filter(|s| !s.accel.iter().chain(&s.gyro).all(|v| v.is_finite()))
+            .count();
+        if nonfinite > 0 && !self.warned_nonfinite {
+            self.warned_nonfinite = true;
+            let values =
+                "the IMU delivers non-finite outputs; those samples are not recorded".to_string();
+            self.journal(JournalEvent::Warning {
+                rule: "imu output".into(),
+                values,
+            });
         }
         for s in &self.imu_buf {
             let row = ImuRow {

@@ -130,9 +130,9 @@ pub struct RunOutcome {
     pub segments: usize,
     /// Steps completed (including those completed before a resume).
     pub steps_completed: usize,
-    /// IMU samples recorded.
+    /// IMU samples received (the recording holds those with finite values).
     pub imu_samples: u64,
-    /// Table samples recorded.
+    /// Table samples received.
     pub table_samples: u64,
     /// Warnings raised (rules with `warn`, settle timeouts with `warn`).
     pub warnings: Vec<String>,

@@ -4,6 +4,8 @@
 
 #![allow(dead_code)]
 
+pub mod plans;
+
 use async_trait::async_trait;
 use ratecal_drivers::{
     DriverError, DriverErrorKind, ImuDriver, ImuInfo, ImuSample, TableAxisId, TableCommand,
