@@ -4,7 +4,8 @@
 //! Only `run` awaits; the engine does IO only through what it is handed.
 
 pub mod check;
+pub mod fit;
 pub mod plan;
 pub mod recording;
-pub mod fit;
 pub mod results;
+pub mod run;

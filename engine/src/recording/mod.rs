@@ -11,6 +11,10 @@ pub use error::RecordingError;
 pub use read::{parse_manifest, read};
 use std::collections::BTreeMap;
 
+mod write;
+
+pub use write::{Columns, RecordingWriter, manifest_yaml, push_fixed, rfc3339, sha256_hex};
+
 /// `manifest.yaml`. Unknown keys are ignored on reading.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Manifest {
