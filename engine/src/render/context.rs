@@ -93,6 +93,7 @@ pub fn build(input: &ReportInput) -> Value {
         "verification": verification,
         "repeatability": repeatability,
         "residuals": list(results, "residuals"),
+        "residual_table": residual_table(results),
         "allan": results.get("allan").cloned().unwrap_or(Value::Null),
         "warnings": list(results, "warnings"),
         "findings": list(results, "findings"),
@@ -248,6 +249,47 @@ fn summary(acceptance: &Value, verification: &Value, repeat: &Value, params: &Va
         "not_evaluated": not_evaluated,
         "unobservable": unobservable,
     })
+}
+
+/// Residual rows grouped by segment, in the order segments first appear:
+/// `[{segment, channels: {ax: row, ...}}]`. Accepts a list of rows
+/// (`{segment, channel, mean, std, ...}`) or an object `{segment: {channel: {...}}}`.
+fn residual_table(results: &Value) -> Value {
+    let mut out: Vec<(String, Map<String, Value>)> = vec![];
+    let mut add = |seg: &str, ch: &str, row: &Value| {
+        let i = match out.iter().position(|(s, _)| s == seg) {
+            Some(i) => i,
+            None => {
+                out.push((seg.to_string(), Map::new()));
+                out.len() - 1
+            }
+        };
+        out[i].1.insert(ch.to_string(), row.clone());
+    };
+    match results.get("residuals") {
+        Some(Value::Array(rows)) => {
+            for row in rows {
+                let s = row.get("segment").and_then(Value::as_str);
+                let c = row.get("channel").and_then(Value::as_str);
+                if let (Some(s), Some(c)) = (s, c) {
+                    add(s, c, row);
+                }
+            }
+        }
+        Some(Value::Object(segs)) => {
+            for (s, chans) in segs {
+                for (c, row) in chans.as_object().into_iter().flatten() {
+                    add(s, c, row);
+                }
+            }
+        }
+        _ => {}
+    }
+    Value::Array(
+        out.into_iter()
+            .map(|(s, c)| json!({ "segment": s, "channels": c }))
+            .collect(),
+    )
 }
 
 /// Min, max, mean and span of a time series' values, or null when empty.

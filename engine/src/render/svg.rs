@@ -6,11 +6,16 @@
 use std::fmt::Write;
 
 const W: f64 = 720.0;
-const H: f64 = 300.0;
 const LEFT: f64 = 78.0;
 const RIGHT: f64 = 160.0;
 const TOP: f64 = 30.0;
+/// Plot area height; the bottom margin grows with the category labels.
+const PH: f64 = 224.0;
 const BOTTOM: f64 = 46.0;
+/// Category labels: font size, rotation, and a generous average glyph width.
+const CAT_FONT: f64 = 9.0;
+const CAT_ANGLE_DEG: f64 = 50.0;
+const GLYPH: f64 = 5.4;
 
 /// Colours for series, in order (colour-blind safe, Okabe-Ito).
 pub const PALETTE: [&str; 8] = [
@@ -198,7 +203,19 @@ impl Chart {
             self.y_log,
         )?;
         let pw = W - LEFT - RIGHT;
-        let ph = H - TOP - BOTTOM;
+        let ph = PH;
+        let longest = self
+            .x_categories
+            .iter()
+            .map(|c| c.chars().count())
+            .max()
+            .unwrap_or(0);
+        let bottom = if longest == 0 {
+            BOTTOM
+        } else {
+            16.0 + longest as f64 * GLYPH * CAT_ANGLE_DEG.to_radians().sin()
+        };
+        let height = (TOP + ph + bottom).round();
         let px = |v: f64| LEFT + xa.t(v) * pw;
         let py = |v: f64| TOP + (1.0 - ya.t(v)) * ph;
         let ok = |p: &(f64, f64)| {
@@ -211,7 +228,7 @@ impl Chart {
         let mut s = String::new();
         let _ = write!(
             s,
-            r#"<svg xmlns="http://www.w3.org/2000/svg" class="plot" viewBox="0 0 {W} {H}" width="{W}" height="{H}" role="img" aria-label="{t}" font-family="sans-serif" font-size="11">"#,
+            r#"<svg xmlns="http://www.w3.org/2000/svg" class="plot" viewBox="0 0 {W} {height}" width="{W}" height="{height}" role="img" aria-label="{t}" font-family="sans-serif" font-size="11">"#,
             t = esc(&self.title)
         );
         let _ = write!(s, r#"<title>{}</title>"#, esc(&self.title));
@@ -253,7 +270,7 @@ impl Chart {
                 let x = px(i as f64);
                 let _ = write!(
                     s,
-                    r##"<text x="{x:.1}" y="{:.1}" text-anchor="end" font-size="8" transform="rotate(-35 {x:.1} {:.1})">{}</text>"##,
+                    r##"<text x="{x:.1}" y="{:.1}" text-anchor="end" font-size="{CAT_FONT}" transform="rotate(-{CAT_ANGLE_DEG} {x:.1} {:.1})">{}</text>"##,
                     TOP + ph + 10.0,
                     TOP + ph + 10.0,
                     esc(label)
@@ -274,7 +291,7 @@ impl Chart {
                 s,
                 r#"<text x="{:.1}" y="{:.1}" text-anchor="middle">{}</text>"#,
                 LEFT + pw / 2.0,
-                H - 8.0,
+                height - 8.0,
                 esc(&self.x_label)
             );
         }
@@ -326,13 +343,22 @@ impl Chart {
                     );
                 }
             }
-            // Legend entry.
+            // Legend entry: a line for line styles, a dot for markers.
             let ly = TOP + 12.0 + 16.0 * k as f64;
             let lx = LEFT + pw + 12.0;
+            let symbol = match ser.style {
+                Style::Markers => format!(
+                    r#"<circle cx="{}" cy="{ly}" r="3.5" fill="{c}"/>"#,
+                    lx + 9.0
+                ),
+                _ => format!(
+                    r#"<line x1="{lx}" y1="{ly}" x2="{}" y2="{ly}" stroke="{c}" stroke-width="2.5"/>"#,
+                    lx + 18.0
+                ),
+            };
             let _ = write!(
                 s,
-                r#"<line x1="{lx}" y1="{ly}" x2="{}" y2="{ly}" stroke="{c}" stroke-width="2.5"/><text x="{}" y="{:.1}">{}</text></g>"#,
-                lx + 18.0,
+                r#"{symbol}<text x="{}" y="{:.1}">{}</text></g>"#,
                 lx + 24.0,
                 ly + 4.0,
                 esc(&ser.name)
