@@ -2,6 +2,13 @@
 //! analysing. `run` writes one (`write`), `fit` reads any (`read`), whoever wrote it.
 
 use serde::{Deserialize, Serialize};
+
+mod csvread;
+mod error;
+mod read;
+
+pub use error::RecordingError;
+pub use read::{parse_manifest, read};
 use std::collections::BTreeMap;
 
 /// `manifest.yaml`. Unknown keys are ignored on reading.

@@ -1,0 +1,341 @@
+//! Accuracy verification at segments no fit used, and evaluation of the procedure's
+//! thresholds: value, limit, margin, expanded uncertainty (k = 2), decision rule.
+
+use super::Out;
+use super::prep::SegData;
+use super::select::Selection;
+use super::stats::{Inflation, mean, std};
+use crate::plan::{Accept, Cmp, DecisionRule, Plan, Quantity, VerifyPoint};
+use crate::recording::Recording;
+use crate::recording::SegmentKind;
+use crate::results::{Acceptance, Results, Verdict, VerificationPoint};
+use ratecal_physics::{Mat3, Vec3};
+use std::collections::{BTreeMap, HashMap};
+
+/// Where a verification segment was: mean feedback angles (deg) or axis and nominal rate.
+#[derive(Debug, Clone)]
+pub(crate) enum Where {
+    /// Static, at (outer, inner) deg.
+    Attitude(f64, f64),
+    /// Rate segment: axis name and nominal rate, deg/s.
+    Rate(String, f64),
+}
+
+/// Compensated output against the reference at every segment no fit used.
+pub(crate) fn verify(
+    sel: &Selection,
+    data: &HashMap<usize, SegData>,
+    out: &Out,
+    rec: &Recording,
+) -> (Vec<VerificationPoint>, HashMap<String, Where>) {
+    let mut pts = Vec::new();
+    let mut wh = HashMap::new();
+    for i in &sel.unused {
+        let Some(s) = data.get(i) else { continue };
+        let seg = &rec.manifest.segments[*i];
+        let w = match (s.kind, &seg.axis, seg.rate_dps) {
+            (SegmentKind::Rate, Some(ax), Some(r)) => Where::Rate(ax.clone(), r),
+            _ => Where::Attitude(s.mean_angles_deg.0, s.mean_angles_deg.1),
+        };
+        wh.insert(s.id.clone(), w);
+        if s.kind == SegmentKind::Static
+            && let Some(m) = &out.accel_model
+        {
+            pts.push(point(s, "accel", m, &s.accel, &s.f_ref, &s.keep_a, "m/s^2"));
+        }
+        if let Some(m) = &out.gyro_model {
+            pts.push(point(s, "gyro", m, &s.gyro, &s.w_ref, &s.keep_g, "deg/s"));
+        }
+    }
+    (pts, wh)
+}
+
+fn point(
+    s: &SegData,
+    sensor: &str,
+    model: &(Mat3, Vec3),
+    o: &[Vec<f64>; 3],
+    r: &[Vec<f64>; 3],
+    keep: &[bool],
+    unit: &str,
+) -> VerificationPoint {
+    let (k, b) = model;
+    let om = Vec3::from_fn(|i, _| mean(&o[i], keep));
+    let rm = Vec3::from_fn(|i, _| mean(&r[i], keep));
+    let comp = k.try_inverse().unwrap_or(Mat3::identity()) * (om - b);
+    let err = comp - rm;
+    let n = keep.iter().filter(|k| **k).count().max(1) as f64;
+    let u = Vec3::from_fn(|i, _| {
+        let d: Vec<f64> = (0..s.t.len()).map(|j| o[i][j] - r[i][j]).collect();
+        let mut infl = Inflation::default();
+        infl.add(&d, keep);
+        std(&d, keep) * (infl.factor() / n).sqrt()
+    });
+    let imax = (0..3)
+        .max_by(|&a, &b| err[a].abs().total_cmp(&err[b].abs()))
+        .unwrap_or(0);
+    VerificationPoint {
+        segment: s.id.clone(),
+        sensor: sensor.into(),
+        max_error: err[imax].abs(),
+        error: [err[0], err[1], err[2]],
+        u: u[imax],
+        unit: unit.into(),
+    }
+}
+
+/// Evaluates every threshold of the procedure (procedure level, steps, verification points,
+/// environment).
+pub(crate) fn evaluate(
+    plan: Option<&Plan>,
+    res: &Results,
+    q: &BTreeMap<String, (f64, f64)>,
+    wh: &HashMap<String, Where>,
+    warnings: &mut Vec<String>,
+) -> Vec<Acceptance> {
+    let Some(plan) = plan else { return Vec::new() };
+    let mut out = Vec::new();
+    for a in &plan.accepts {
+        let measured = lookup(&a.quantity, res, q);
+        out.push(match measured {
+            Ok((v, u)) => judge(a, v, u, None),
+            Err(why) => not_evaluated(a, &why),
+        });
+    }
+    for v in &plan.verifications {
+        for lim in &v.limits {
+            let sensor = lim.quantity.split('.').next().unwrap_or("");
+            let found = res
+                .verification
+                .iter()
+                .filter(|p| p.sensor == sensor)
+                .find(|p| {
+                    wh.get(&p.segment)
+                        .is_some_and(|w| matches_point(&v.point, w))
+                });
+            let where_ = match v.point {
+                VerifyPoint::Attitude {
+                    outer_deg,
+                    inner_deg,
+                } => format!("at outer {outer_deg} deg, inner {inner_deg} deg"),
+                VerifyPoint::Rate { axis, rate_dps } => {
+                    format!("at {rate_dps} deg/s about the {axis:?} axis")
+                }
+            };
+            out.push(match found {
+                Some(p) => judge(
+                    lim,
+                    p.max_error,
+                    p.u,
+                    Some(format!(
+                        "{} ({where_}, segment {})",
+                        lim_name(lim),
+                        p.segment
+                    )),
+                ),
+                None => {
+                    let mut a = not_evaluated(
+                        lim,
+                        &format!("no segment of the recording {where_} outside the fits"),
+                    );
+                    a.name = format!("{} ({where_})", lim_name(lim));
+                    a
+                }
+            });
+        }
+    }
+    for c in &plan.environment {
+        let value = env_value(&c.name, res);
+        for (q, op) in [(&c.min, Cmp::Ge), (&c.max, Cmp::Le)] {
+            let Some(q) = q else { continue };
+            let a = Accept {
+                step: None,
+                quantity: format!("environment.{}", c.name),
+                op,
+                limit: q.clone(),
+                over_runs: None,
+                rule: DecisionRule::Simple,
+            };
+            out.push(match value {
+                Some(v) => judge(&a, v, 0.0, None),
+                None => not_evaluated(&a, "the recording holds no lab conditions (no environment block, no ambient column)"),
+            });
+        }
+    }
+    if out.iter().any(|a| a.verdict == Verdict::NotEvaluated) {
+        warnings.push("some acceptance checks could not be evaluated (see their reasons)".into());
+    }
+    out
+}
+
+/// Whether a segment is at a verification point: within 0.5 deg of the attitude
+/// (angles modulo 360), or about the same axis at the same nominal rate.
+fn matches_point(p: &VerifyPoint, w: &Where) -> bool {
+    let close = |a: f64, b: f64| ((a - b + 180.0).rem_euclid(360.0) - 180.0).abs() <= 0.5;
+    match (p, w) {
+        (
+            VerifyPoint::Attitude {
+                outer_deg,
+                inner_deg,
+            },
+            Where::Attitude(o, i),
+        ) => close(*outer_deg, *o) && close(*inner_deg, *i),
+        (VerifyPoint::Rate { axis, rate_dps }, Where::Rate(a, r)) => {
+            let name = serde_json::to_value(axis)
+                .ok()
+                .and_then(|v| v.as_str().map(String::from))
+                .unwrap_or_default();
+            name == *a && (rate_dps - r).abs() <= 1e-6 * rate_dps.abs().max(1.0)
+        }
+        _ => false,
+    }
+}
+
+fn env_value(name: &str, res: &Results) -> Option<f64> {
+    let rec = res.environment.recorded.as_ref();
+    let amb = res.environment.ambient.as_ref();
+    match name {
+        "temperature" => rec.and_then(|r| r.temperature_c).or(amb.map(|a| a.mean_c)),
+        "temperature_drift" | "drift" => amb.map(|a| a.drift_c_per_h.abs()),
+        "humidity" => rec.and_then(|r| r.humidity_pct).map(|v| v / 100.0),
+        "pressure" => rec.and_then(|r| r.pressure_kpa),
+        "vibration" => rec
+            .and_then(|r| r.vibration_g)
+            .map(|v| v * ratecal_physics::STANDARD_GRAVITY),
+        _ => None,
+    }
+}
+
+/// Value and standard uncertainty of a checked quantity, internal units.
+fn lookup(
+    name: &str,
+    res: &Results,
+    q: &BTreeMap<String, (f64, f64)>,
+) -> Result<(f64, f64), String> {
+    if let Some(v) = q.get(name) {
+        return Ok(*v);
+    }
+    if let Some(p) = res.parameters.get(name) {
+        return match p.value_u() {
+            Some((v, u)) => Ok((v.abs(), u)),
+            None => Err(format!("{name} is not observable in this recording")),
+        };
+    }
+    match name {
+        "repeatability.cv" => Err("repeatability needs several complete runs (`ratecal analyze RUN1 RUN2 RUN3`); one was given".into()),
+        "accel.error" | "gyro.error" => {
+            let sensor = &name[..name.find('.').unwrap_or(0)];
+            res.verification
+                .iter()
+                .filter(|p| p.sensor == sensor)
+                .max_by(|a, b| a.max_error.total_cmp(&b.max_error))
+                .map(|p| (p.max_error, p.u))
+                .ok_or_else(|| "no segment outside the fits to verify at".into())
+        }
+        "sync.error" => Ok((res.sync.max_sync_error_s, 0.0)),
+        _ => Err(format!("`{name}` is not a quantity the analysis computes")),
+    }
+}
+
+fn lim_name(a: &Accept) -> String {
+    format!(
+        "{} {} {} {}",
+        a.quantity,
+        op_str(a.op),
+        fmt_num(a.limit.written),
+        a.limit.unit
+    )
+    .trim_end()
+    .to_string()
+}
+
+fn op_str(op: Cmp) -> &'static str {
+    match op {
+        Cmp::Le => "<=",
+        Cmp::Lt => "<",
+        Cmp::Ge => ">=",
+        Cmp::Gt => ">",
+    }
+}
+
+fn fmt_num(v: f64) -> String {
+    format!("{v}")
+}
+
+/// Internal units per written unit of the limit.
+fn factor(q: &Quantity) -> f64 {
+    if q.written != 0.0 && q.value != 0.0 {
+        q.value / q.written
+    } else {
+        ratecal_physics::units::unit(&q.unit).map_or(1.0, |u| u.1)
+    }
+}
+
+/// Applies the decision rule to a value (internal units) with standard uncertainty `u`.
+pub(crate) fn judge(a: &Accept, v: f64, u: f64, name: Option<String>) -> Acceptance {
+    let f = factor(&a.limit);
+    let (value, limit, big_u) = (v / f, a.limit.written, 2.0 * u / f);
+    let upper = matches!(a.op, Cmp::Le | Cmp::Lt);
+    let margin = if upper { limit - value } else { value - limit };
+    let meets = |m: f64| match a.op {
+        Cmp::Le | Cmp::Ge => m >= 0.0,
+        Cmp::Lt | Cmp::Gt => m > 0.0,
+    };
+    let verdict = match a.rule {
+        DecisionRule::Simple => {
+            if meets(margin) {
+                Verdict::Pass
+            } else {
+                Verdict::Fail
+            }
+        }
+        DecisionRule::GuardBanded => {
+            if meets(margin - big_u) {
+                Verdict::Pass
+            } else if !meets(margin + big_u) {
+                Verdict::Fail
+            } else {
+                Verdict::Indeterminate
+            }
+        }
+    };
+    Acceptance {
+        name: name.unwrap_or_else(|| lim_name(a)),
+        quantity: a.quantity.clone(),
+        step: a.step.clone(),
+        value: Some(value),
+        op: op_str(a.op).into(),
+        limit,
+        unit: a.limit.unit.clone(),
+        margin: Some(margin),
+        expanded_u: Some(big_u),
+        rule: rule_str(a.rule).into(),
+        verdict,
+        reason: None,
+    }
+}
+
+fn rule_str(r: DecisionRule) -> &'static str {
+    match r {
+        DecisionRule::Simple => "simple",
+        DecisionRule::GuardBanded => "guard_banded",
+    }
+}
+
+/// A threshold that could not be evaluated, with why.
+pub(crate) fn not_evaluated(a: &Accept, why: &str) -> Acceptance {
+    Acceptance {
+        name: lim_name(a),
+        quantity: a.quantity.clone(),
+        step: a.step.clone(),
+        value: None,
+        op: op_str(a.op).into(),
+        limit: a.limit.written,
+        unit: a.limit.unit.clone(),
+        margin: None,
+        expanded_u: None,
+        rule: rule_str(a.rule).into(),
+        verdict: Verdict::NotEvaluated,
+        reason: Some(why.into()),
+    }
+}

@@ -1,0 +1,348 @@
+//! Preprocessing of one segment: synchronisation of the table feedback onto the IMU
+//! stamps (linear interpolation), references through the physics kinematics, outlier
+//! removal within the segment, zero-phase Butterworth low-pass.
+
+use crate::plan::Outliers;
+use crate::recording::{Recording, Segment, SegmentKind};
+use crate::results::SyncReport;
+use ratecal_physics::{AxisMotion, DEG, Geometry, Mat3, Site, TableState, Vec3};
+
+/// One segment's IMU samples with their references, ready for the fits.
+#[derive(Debug, Clone)]
+pub(crate) struct SegData {
+    /// Segment id.
+    pub id: String,
+    /// Kind.
+    pub kind: SegmentKind,
+    /// IMU stamps.
+    pub t: Vec<f64>,
+    /// Accelerometer outputs per axis, m/s^2 (filtered if asked).
+    pub accel: [Vec<f64>; 3],
+    /// Gyro outputs per axis, deg/s (filtered if asked).
+    pub gyro: [Vec<f64>; 3],
+    /// IMU temperature, degC.
+    pub temp: Option<Vec<f64>>,
+    /// Specific-force reference at the IMU reference point, body axes, m/s^2.
+    pub f_ref: [Vec<f64>; 3],
+    /// Inertial-rate reference (table motion and Earth rate), body axes, deg/s.
+    pub w_ref: [Vec<f64>; 3],
+    /// Accelerometer samples kept after outlier removal.
+    pub keep_a: Vec<bool>,
+    /// Gyro samples kept.
+    pub keep_g: Vec<bool>,
+    /// Mean feedback angles (outer, inner), deg.
+    pub mean_angles_deg: (f64, f64),
+}
+
+impl SegData {
+    /// Samples removed from either sensor.
+    pub(crate) fn outliers(&self) -> usize {
+        self.keep_a
+            .iter()
+            .zip(&self.keep_g)
+            .filter(|(a, g)| !**a || !**g)
+            .count()
+    }
+}
+
+/// How to preprocess.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct PrepOptions {
+    /// Outlier rule.
+    pub outliers: Option<Outliers>,
+    /// Butterworth (order, cutoff Hz).
+    pub lowpass: Option<(u32, f64)>,
+}
+
+/// The station geometry in force for each segment (station mount, then per-segment remounts).
+pub(crate) fn geometries(rec: &Recording) -> Vec<Geometry> {
+    let st = &rec.manifest.station;
+    let v = |a: [f64; 3]| Vec3::new(a[0], a[1], a[2]);
+    let m = |r: &[[f64; 3]; 3]| Mat3::from_fn(|i, j| r[i][j]);
+    let mut c_pb = st
+        .mount
+        .as_ref()
+        .map_or(Mat3::identity(), |mt| m(&mt.rotation));
+    rec.manifest
+        .segments
+        .iter()
+        .map(|s| {
+            if let Some(mt) = &s.mount {
+                c_pb = m(&mt.rotation);
+            }
+            Geometry {
+                outer_axis: v(st.table.outer_axis),
+                inner_axis: v(st.table.inner_axis),
+                c_pb,
+            }
+        })
+        .collect()
+}
+
+/// Builds a segment's data; `warnings` collects what could not be done as asked.
+pub(crate) fn prepare(
+    rec: &Recording,
+    seg: &Segment,
+    geo: &Geometry,
+    opts: PrepOptions,
+    sync: &mut SyncReport,
+    warnings: &mut Vec<String>,
+) -> SegData {
+    let imu = &rec.imu;
+    let a = imu.t.partition_point(|&t| t < seg.t_start);
+    let b = imu.t.partition_point(|&t| t <= seg.t_end);
+    let t = imu.t[a..b].to_vec();
+    let n = t.len();
+    let accel: [Vec<f64>; 3] =
+        std::array::from_fn(|k| imu.accel[a..b].iter().map(|v| v[k]).collect());
+    let gyro: [Vec<f64>; 3] =
+        std::array::from_fn(|k| imu.gyro[a..b].iter().map(|v| v[k]).collect());
+    let temp = imu.temp.as_ref().map(|tc| tc[a..b].to_vec());
+    let site: Site = rec.manifest.station.site;
+    let mut f_ref: [Vec<f64>; 3] = std::array::from_fn(|_| Vec::with_capacity(n));
+    let mut w_ref: [Vec<f64>; 3] = std::array::from_fn(|_| Vec::with_capacity(n));
+    let (mut so, mut si) = (0.0, 0.0);
+    let tab = &rec.table;
+    let mut j = tab.t.partition_point(|&x| x <= t[0]).saturating_sub(1);
+    for &ti in &t {
+        while j + 2 < tab.t.len() && tab.t[j + 1] <= ti {
+            j += 1;
+        }
+        let (t0, t1) = (tab.t[j], tab.t[j + 1]);
+        let w = ((ti - t0) / (t1 - t0)).clamp(0.0, 1.0);
+        let gap = t1 - t0;
+        sync.max_gap_s = sync.max_gap_s.max(gap);
+        sync.max_sync_error_s = sync
+            .max_sync_error_s
+            .max((ti - t0).abs().min((t1 - ti).abs()));
+        let lerp = |x: &[f64]| x[j] + w * (x[j + 1] - x[j]);
+        let lerp_angle = |x: &[f64]| x[j] + w * unwrap(x[j + 1] - x[j]);
+        let acc_o = rate_derivative(&tab.t, &tab.outer_rate, j);
+        let acc_i = rate_derivative(&tab.t, &tab.inner_rate, j);
+        let max_acc = acc_o.abs().max(acc_i.abs());
+        sync.max_angle_error_deg = sync.max_angle_error_deg.max(gap * gap / 8.0 * max_acc);
+        let state = TableState {
+            outer: AxisMotion {
+                angle: lerp_angle(&tab.outer) * DEG,
+                rate: lerp(&tab.outer_rate) * DEG,
+                accel: acc_o * DEG,
+            },
+            inner: AxisMotion {
+                angle: lerp_angle(&tab.inner) * DEG,
+                rate: lerp(&tab.inner_rate) * DEG,
+                accel: acc_i * DEG,
+            },
+        };
+        so += state.outer.angle / DEG;
+        si += state.inner.angle / DEG;
+        let f = state.f_b(geo, &site, &Vec3::zeros());
+        let wi = state.w_ib(geo, &site) / DEG;
+        for k in 0..3 {
+            f_ref[k].push(f[k]);
+            w_ref[k].push(wi[k]);
+        }
+    }
+    let mut d = SegData {
+        id: seg.id.clone(),
+        kind: seg.kind,
+        t,
+        accel,
+        gyro,
+        temp,
+        f_ref,
+        w_ref,
+        keep_a: vec![true; n],
+        keep_g: vec![true; n],
+        mean_angles_deg: (so / n as f64, si / n as f64),
+    };
+    if let Some(rule) = opts.outliers {
+        for k in 0..3 {
+            let ra: Vec<f64> = (0..n).map(|i| d.accel[k][i] - d.f_ref[k][i]).collect();
+            flag_outliers(&ra, rule, &mut d.keep_a);
+            let rg: Vec<f64> = (0..n).map(|i| d.gyro[k][i] - d.w_ref[k][i]).collect();
+            flag_outliers(&rg, rule, &mut d.keep_g);
+        }
+    }
+    if let Some((order, cutoff)) = opts.lowpass {
+        let fs = 1.0 / super::stats::median_step(&d.t);
+        if cutoff >= fs / 2.0 {
+            warnings.push(format!(
+                "segment {}: low-pass cutoff {cutoff} Hz is at or above the Nyquist frequency ({:.1} Hz); not filtered",
+                d.id,
+                fs / 2.0
+            ));
+        } else if let Some(sos) = butter(order, cutoff, fs) {
+            for k in 0..3 {
+                // Outliers are replaced by interpolation before filtering, and stay excluded.
+                fill_removed(&mut d.accel[k], &d.keep_a);
+                fill_removed(&mut d.gyro[k], &d.keep_g);
+                d.accel[k] = filtfilt(&sos, &d.accel[k]);
+                d.gyro[k] = filtfilt(&sos, &d.gyro[k]);
+            }
+        } else {
+            warnings.push(format!("segment {}: Butterworth order {order} at {cutoff} Hz could not be designed; not filtered", d.id));
+        }
+    }
+    d
+}
+
+/// Shortest signed angle step, deg (feedback may wrap at 360).
+fn unwrap(d: f64) -> f64 {
+    d - 360.0 * (d / 360.0).round()
+}
+
+/// Angular acceleration (deg/s^2) at table sample `j` by a central difference over about
+/// 0.1 s of feedback rates: the table reports rates, not accelerations.
+fn rate_derivative(t: &[f64], r: &[f64], j: usize) -> f64 {
+    let h = 5;
+    let lo = j.saturating_sub(h);
+    let hi = (j + 1 + h).min(t.len() - 1);
+    if t[hi] > t[lo] {
+        (r[hi] - r[lo]) / (t[hi] - t[lo])
+    } else {
+        0.0
+    }
+}
+
+/// Flags outliers of one residual series (clears `keep`), within the segment.
+pub(crate) fn flag_outliers(r: &[f64], rule: Outliers, keep: &mut [bool]) {
+    match rule {
+        Outliers::Sigma(k) => {
+            for _ in 0..5 {
+                let m = super::stats::mean(r, keep);
+                let s = super::stats::std(r, keep);
+                let mut changed = false;
+                for i in 0..r.len() {
+                    if keep[i] && (r[i] - m).abs() > k * s {
+                        keep[i] = false;
+                        changed = true;
+                    }
+                }
+                if !changed {
+                    break;
+                }
+            }
+        }
+        Outliers::Grubbs(alpha) => {
+            use statrs::distribution::{ContinuousCDF, StudentsT};
+            for _ in 0..1000 {
+                let n = keep.iter().filter(|k| **k).count();
+                if n < 7 {
+                    break;
+                }
+                let m = super::stats::mean(r, keep);
+                let s = super::stats::std(r, keep);
+                let Some((imax, dev)) = (0..r.len())
+                    .filter(|&i| keep[i])
+                    .map(|i| (i, (r[i] - m).abs()))
+                    .max_by(|a, b| a.1.total_cmp(&b.1))
+                else {
+                    break;
+                };
+                let nf = n as f64;
+                let Ok(dist) = StudentsT::new(0.0, 1.0, nf - 2.0) else {
+                    break;
+                };
+                let tq = dist.inverse_cdf(1.0 - alpha / (2.0 * nf));
+                let g_crit = (nf - 1.0) / nf.sqrt() * (tq * tq / (nf - 2.0 + tq * tq)).sqrt();
+                if s > 0.0 && dev / s > g_crit {
+                    keep[imax] = false;
+                } else {
+                    break;
+                }
+            }
+        }
+    }
+}
+
+fn fill_removed(x: &mut [f64], keep: &[bool]) {
+    let n = x.len();
+    let mut i = 0;
+    while i < n {
+        if keep[i] {
+            i += 1;
+            continue;
+        }
+        let start = i;
+        while i < n && !keep[i] {
+            i += 1;
+        }
+        let left = start.checked_sub(1).map(|l| x[l]);
+        let right = (i < n).then(|| x[i]);
+        for (k, v) in x[start..i].iter_mut().enumerate() {
+            *v = match (left, right) {
+                (Some(l), Some(r)) => l + (r - l) * (k + 1) as f64 / (i - start + 1) as f64,
+                (Some(l), None) => l,
+                (None, Some(r)) => r,
+                (None, None) => *v,
+            };
+        }
+    }
+}
+
+fn butter(order: u32, cutoff: f64, fs: f64) -> Option<iir_filters::sos::Sos> {
+    use iir_filters::filter_design::{FilterType, butter};
+    let zpk = butter(order, FilterType::LowPass(cutoff), fs).ok()?;
+    iir_filters::sos::zpk2sos(&zpk, None).ok()
+}
+
+/// Zero-phase filtering: forward then backward, each pass started in the steady state of
+/// its first sample (subtracting it is exact for a unity-DC-gain low-pass), so the edges
+/// do not ring.
+pub(crate) fn filtfilt(sos: &iir_filters::sos::Sos, x: &[f64]) -> Vec<f64> {
+    use iir_filters::filter::{DirectForm2Transposed, Filter};
+    if x.is_empty() {
+        return Vec::new();
+    }
+    let pass = |x: &mut Vec<f64>| {
+        let x0 = x[0];
+        let mut f = DirectForm2Transposed::new(sos);
+        for v in x.iter_mut() {
+            *v = x0 + f.filter(*v - x0);
+        }
+    };
+    let mut y = x.to_vec();
+    pass(&mut y);
+    y.reverse();
+    pass(&mut y);
+    y.reverse();
+    y
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn three_sigma_removes_a_spike() {
+        let mut r: Vec<f64> = (0..200)
+            .map(|i| ((i * 37 % 17) as f64 - 8.0) * 0.1)
+            .collect();
+        r[50] = 40.0;
+        let mut keep = vec![true; r.len()];
+        flag_outliers(&r, Outliers::Sigma(3.0), &mut keep);
+        assert!(!keep[50]);
+        assert_eq!(keep.iter().filter(|k| !**k).count(), 1);
+        let mut keep = vec![true; r.len()];
+        flag_outliers(&r, Outliers::Grubbs(0.05), &mut keep);
+        assert!(!keep[50]);
+        assert_eq!(keep.iter().filter(|k| !**k).count(), 1);
+    }
+
+    #[test]
+    fn filtfilt_has_no_phase_lag_on_a_slow_sine() {
+        let fs = 100.0;
+        let sos = butter(4, 5.0, fs).unwrap();
+        let x: Vec<f64> = (0..2000)
+            .map(|i| (2.0 * std::f64::consts::PI * 0.5 * i as f64 / fs).sin())
+            .collect();
+        let y = filtfilt(&sos, &x);
+        // A 0.5 Hz sine passes a 5 Hz low-pass with gain ~1 and, forward-backward, zero lag.
+        let err = x[200..1800]
+            .iter()
+            .zip(&y[200..1800])
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(err < 1e-3, "{err}");
+    }
+}

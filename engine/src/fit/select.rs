@@ -1,0 +1,287 @@
+//! Which segments feed which fit: the procedure's fit statements, or segment kinds.
+
+use super::Options;
+use super::prep::{PrepOptions, SegData};
+use crate::plan::{FitModel, Plan, segment_matches};
+use crate::recording::{Recording, SegmentKind};
+use crate::results::{AmbientStats, EnvironmentInfo, ModelInfo, RecordingInfo, SegmentUse};
+use std::collections::HashMap;
+
+/// The analysis plan for one recording.
+#[derive(Debug, Default, Clone)]
+pub(crate) struct Selection {
+    /// Every segment to prepare, with its preprocessing.
+    pub prep: Vec<(usize, PrepOptions)>,
+    /// Accelerometer segments and whether the full model is asked.
+    pub accel: Option<(Vec<usize>, bool)>,
+    /// The gyro bias block.
+    pub gyro_bias: Option<usize>,
+    /// Gyro scale segments and axes.
+    pub gyro_scale: Option<(Vec<usize>, Vec<usize>)>,
+    /// Full gyro model segments.
+    pub gyro_full: Option<Vec<usize>>,
+    /// Allan block.
+    pub allan: Option<usize>,
+    /// Static segments for the temperature model.
+    pub temp_segments: Vec<usize>,
+    /// Whether the procedure asks for temperature compensation.
+    pub temp_requested: bool,
+    /// Segments used by no fit (candidates for verification).
+    pub unused: Vec<usize>,
+    /// Description for the results.
+    pub model: ModelInfo,
+    /// What could not be selected.
+    pub warnings: Vec<String>,
+    /// Uses per segment.
+    pub used_for: HashMap<usize, Vec<String>>,
+}
+
+impl Selection {
+    fn add(&mut self, ix: &[usize], po: PrepOptions, why: &str) {
+        for &i in ix {
+            if !self.prep.iter().any(|p| p.0 == i) {
+                self.prep.push((i, po));
+            }
+            let u = self.used_for.entry(i).or_default();
+            if !u.iter().any(|w| w == why) {
+                u.push(why.to_string());
+            }
+        }
+    }
+
+    /// The segment table of the results.
+    pub(crate) fn uses(&self, rec: &Recording, data: &HashMap<usize, SegData>) -> Vec<SegmentUse> {
+        rec.manifest
+            .segments
+            .iter()
+            .enumerate()
+            .map(|(i, s)| {
+                let a = rec.imu.t.partition_point(|&t| t < s.t_start);
+                let b = rec.imu.t.partition_point(|&t| t <= s.t_end);
+                let mut used_for = self.used_for.get(&i).cloned().unwrap_or_default();
+                if self.unused.contains(&i) && data.contains_key(&i) {
+                    used_for.push("verification".into());
+                }
+                SegmentUse {
+                    id: s.id.clone(),
+                    kind: kind_name(s.kind).into(),
+                    t_start: s.t_start,
+                    t_end: s.t_end,
+                    imu_samples: b - a,
+                    outliers_removed: data.get(&i).map_or(0, SegData::outliers),
+                    used_for,
+                }
+            })
+            .collect()
+    }
+}
+
+fn kind_name(k: SegmentKind) -> &'static str {
+    match k {
+        SegmentKind::Static => "static",
+        SegmentKind::Rate => "rate",
+        SegmentKind::Oscillation => "oscillation",
+    }
+}
+
+/// Chooses segments for each fit.
+pub(crate) fn select(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Selection {
+    let segs = &rec.manifest.segments;
+    let dur = |i: &usize| segs[*i].t_end - segs[*i].t_start;
+    let longest = |ix: &[usize]| {
+        ix.iter()
+            .copied()
+            .filter(|&i| segs[i].kind == SegmentKind::Static)
+            .max_by(|a, b| dur(a).total_cmp(&dur(b)))
+    };
+    let default_po = PrepOptions {
+        outliers: opts.outliers,
+        lowpass: opts.lowpass,
+    };
+    let mut sel = Selection::default();
+    match plan.filter(|p| !p.fits.is_empty()) {
+        Some(plan) => {
+            sel.model.selection = "procedure".into();
+            sel.model.procedure = Some(crate::recording::ProcedureRef {
+                name: plan.name.clone(),
+                version: plan.version.clone(),
+                sha256: String::new(),
+            });
+            for f in &plan.fits {
+                let ix: Vec<usize> = (0..segs.len())
+                    .filter(|&i| f.segments.iter().any(|p| segment_matches(p, &segs[i].id)))
+                    .collect();
+                let po = PrepOptions {
+                    outliers: f.outliers.or(opts.outliers),
+                    lowpass: f.lowpass.or(opts.lowpass),
+                };
+                let desc = format!(
+                    "{} from {}",
+                    serde_json::to_value(&f.model)
+                        .ok()
+                        .and_then(|v| v.as_str().map(String::from))
+                        .unwrap_or_default(),
+                    f.segments.join(", ")
+                );
+                sel.model.fits.push(desc.clone());
+                if ix.is_empty() {
+                    sel.warnings
+                        .push(format!("fit `{desc}` matches no segment of the recording"));
+                    if f.model == FitModel::TempCompensation {
+                        sel.temp_requested = true;
+                    }
+                    continue;
+                }
+                match f.model {
+                    FitModel::AccelBiasScale | FitModel::AccelFull => {
+                        sel.add(&ix, po, "accel");
+                        sel.accel = Some((ix.clone(), f.model == FitModel::AccelFull));
+                        sel.temp_segments
+                            .extend(ix.iter().filter(|&&i| segs[i].kind == SegmentKind::Static));
+                    }
+                    FitModel::GyroBias => {
+                        if let Some(b) = longest(&ix) {
+                            sel.add(&[b], po, "gyro_bias");
+                            sel.gyro_bias = Some(b);
+                            sel.allan.get_or_insert(b);
+                            sel.temp_segments.push(b);
+                        }
+                    }
+                    FitModel::GyroScale => {
+                        sel.add(&ix, po, "gyro_scale");
+                        sel.gyro_scale = Some((ix, f.axes.clone()));
+                    }
+                    FitModel::GyroFull => {
+                        sel.add(&ix, po, "gyro_full");
+                        sel.gyro_full = Some(ix);
+                    }
+                    FitModel::TempCompensation => {
+                        sel.temp_requested = true;
+                        let st: Vec<usize> = ix
+                            .iter()
+                            .copied()
+                            .filter(|&i| segs[i].kind == SegmentKind::Static)
+                            .collect();
+                        sel.add(&st, po, "temperature");
+                        sel.temp_segments.extend(st);
+                    }
+                    FitModel::Allan => {
+                        if let Some(b) = longest(&ix) {
+                            sel.add(&[b], po, "allan");
+                            sel.allan = Some(b);
+                        }
+                    }
+                    FitModel::SizeEffect => sel.warnings.push(
+                        "the size-effect fit is not part of `analyze`; its segments are left out"
+                            .into(),
+                    ),
+                }
+            }
+            sel.unused = (0..segs.len())
+                .filter(|i| {
+                    !sel.used_for.contains_key(i) && segs[*i].kind != SegmentKind::Oscillation
+                })
+                .collect();
+        }
+        None => {
+            sel.model.selection = "by_kind".into();
+            let st: Vec<usize> = (0..segs.len())
+                .filter(|&i| segs[i].kind == SegmentKind::Static)
+                .collect();
+            let rt: Vec<usize> = (0..segs.len())
+                .filter(|&i| segs[i].kind == SegmentKind::Rate)
+                .collect();
+            if !st.is_empty() {
+                sel.add(&st, default_po, "accel");
+                sel.accel = Some((st.clone(), false));
+                sel.model
+                    .fits
+                    .push("accel_bias_scale from every static segment".into());
+                let b = longest(&st).expect("static segments exist");
+                sel.add(&[b], default_po, "gyro_bias");
+                sel.gyro_bias = Some(b);
+                sel.allan = Some(b);
+                sel.model
+                    .fits
+                    .push(format!("gyro_bias from {} (longest static)", segs[b].id));
+                sel.temp_segments = st;
+            } else {
+                sel.warnings.push(
+                    "no static segment: accelerometer model and gyro bias not determined".into(),
+                );
+            }
+            if !rt.is_empty() {
+                sel.add(&rt, default_po, "gyro_scale");
+                sel.gyro_scale = Some((rt, vec![0, 1, 2]));
+                sel.model
+                    .fits
+                    .push("gyro_scale from every rate segment".into());
+            } else {
+                sel.warnings
+                    .push("no rate segment: gyro scale factors not determined".into());
+            }
+        }
+    }
+    sel.temp_segments.sort_unstable();
+    sel.temp_segments.dedup();
+    let unused = sel.unused.clone();
+    sel.add(&unused, default_po, "verification");
+    for i in &unused {
+        sel.used_for.remove(i);
+    }
+    sel
+}
+
+/// Identity of the recording.
+pub(crate) fn recording_info(rec: &Recording, path: &str) -> RecordingInfo {
+    let m = &rec.manifest;
+    let rate = |t: &[f64]| 1.0 / super::stats::median_step(t);
+    RecordingInfo {
+        paths: if path.is_empty() {
+            Vec::new()
+        } else {
+            vec![path.to_string()]
+        },
+        imu: m.imu.clone(),
+        procedure: m.procedure.clone(),
+        run_id: m.run.as_ref().map(|r| r.id.clone()),
+        latitude_deg: m.station.site.latitude_deg,
+        gravity_mps2: m.station.site.gravity_mps2,
+        imu_rows: rec.imu.t.len(),
+        table_rows: rec.table.t.len(),
+        imu_rate_hz: rate(&rec.imu.t),
+        table_rate_hz: rate(&rec.table.t),
+        duration_s: rec.imu.t.last().copied().unwrap_or(0.0)
+            - rec.imu.t.first().copied().unwrap_or(0.0),
+    }
+}
+
+/// Lab conditions: the manifest's block and the `ambient` column.
+pub(crate) fn environment(rec: &Recording) -> EnvironmentInfo {
+    let ambient = rec
+        .table
+        .ambient
+        .as_ref()
+        .filter(|a| !a.is_empty())
+        .map(|a| {
+            let keep = vec![true; a.len()];
+            let (mean, _, slope) = super::stats::mean_std_slope(&rec.table.t, a, &keep);
+            AmbientStats {
+                mean_c: mean,
+                min_c: a.iter().copied().fold(f64::MAX, f64::min),
+                max_c: a.iter().copied().fold(f64::MIN, f64::max),
+                drift_c_per_h: slope * 3600.0,
+            }
+        });
+    let imu_temp_range_c = rec.imu.temp.as_ref().filter(|t| !t.is_empty()).map(|t| {
+        [
+            t.iter().copied().fold(f64::MAX, f64::min),
+            t.iter().copied().fold(f64::MIN, f64::max),
+        ]
+    });
+    EnvironmentInfo {
+        recorded: rec.manifest.environment.clone(),
+        ambient,
+        imu_temp_range_c,
+    }
+}

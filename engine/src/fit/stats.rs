@@ -1,0 +1,107 @@
+//! Small statistics shared by the fits: mean, standard deviation, trend, and the
+//! batch-means inflation that keeps uncertainties honest under correlated noise.
+
+/// Mean of the kept samples.
+pub(crate) fn mean(x: &[f64], keep: &[bool]) -> f64 {
+    let (s, n) = x
+        .iter()
+        .zip(keep)
+        .filter(|p| *p.1)
+        .fold((0.0, 0usize), |(s, n), (v, _)| (s + v, n + 1));
+    if n == 0 { f64::NAN } else { s / n as f64 }
+}
+
+/// Sample standard deviation of the kept samples.
+pub(crate) fn std(x: &[f64], keep: &[bool]) -> f64 {
+    let m = mean(x, keep);
+    let (s, n) = x
+        .iter()
+        .zip(keep)
+        .filter(|p| *p.1)
+        .fold((0.0, 0usize), |(s, n), (v, _)| (s + (v - m).powi(2), n + 1));
+    if n < 2 {
+        0.0
+    } else {
+        (s / (n - 1) as f64).sqrt()
+    }
+}
+
+/// Mean, standard deviation and least-squares slope (per unit of `t`) of the kept samples.
+pub(crate) fn mean_std_slope(t: &[f64], x: &[f64], keep: &[bool]) -> (f64, f64, f64) {
+    let m = mean(x, keep);
+    let tm = mean(t, keep);
+    let (mut sxx, mut sxy) = (0.0, 0.0);
+    for i in 0..x.len() {
+        if keep[i] {
+            sxx += (t[i] - tm).powi(2);
+            sxy += (t[i] - tm) * (x[i] - m);
+        }
+    }
+    let slope = if sxx > 0.0 { sxy / sxx } else { 0.0 };
+    (m, std(x, keep), slope)
+}
+
+/// Pools the variance of batch means of residual series against their white-noise
+/// variance: the factor by which the variance of a mean exceeds `sigma^2 / n`. 1 for
+/// white noise; larger for low-pass filtered data or a wandering bias.
+#[derive(Debug, Default, Clone, Copy)]
+pub(crate) struct Inflation {
+    batch_ss: f64,
+    white_ss: f64,
+}
+
+impl Inflation {
+    /// Adds one segment's residuals (kept samples only), cut into about 10 batches.
+    pub(crate) fn add(&mut self, r: &[f64], keep: &[bool]) {
+        let kept: Vec<f64> = r.iter().zip(keep).filter(|p| *p.1).map(|p| *p.0).collect();
+        let n = kept.len();
+        if n < 40 {
+            return;
+        }
+        let nb = 10;
+        let len = n / nb;
+        let m = kept[..nb * len].iter().sum::<f64>() / (nb * len) as f64;
+        let var = kept.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1) as f64;
+        let mut ss = 0.0;
+        for b in 0..nb {
+            let bm = kept[b * len..(b + 1) * len].iter().sum::<f64>() / len as f64;
+            ss += len as f64 * (bm - m).powi(2);
+        }
+        self.batch_ss += ss;
+        self.white_ss += var * (nb - 1) as f64;
+    }
+
+    /// The variance factor, never below 1.
+    pub(crate) fn factor(&self) -> f64 {
+        if self.white_ss > 0.0 {
+            (self.batch_ss / self.white_ss).max(1.0)
+        } else {
+            1.0
+        }
+    }
+}
+
+/// Median step of a time series.
+pub(crate) fn median_step(t: &[f64]) -> f64 {
+    if t.len() < 2 {
+        return f64::NAN;
+    }
+    let stride = (t.len() / 2001).max(1);
+    let mut d: Vec<f64> = t.windows(2).step_by(stride).map(|w| w[1] - w[0]).collect();
+    d.sort_by(f64::total_cmp);
+    d[d.len() / 2]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slope_of_a_line() {
+        let t: Vec<f64> = (0..10).map(f64::from).collect();
+        let x: Vec<f64> = t.iter().map(|v| 2.0 + 0.5 * v).collect();
+        let keep = vec![true; 10];
+        let (m, _, s) = mean_std_slope(&t, &x, &keep);
+        assert!((m - 4.25).abs() < 1e-12 && (s - 0.5).abs() < 1e-12);
+    }
+}

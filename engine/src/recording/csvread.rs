@@ -1,0 +1,266 @@
+//! Columnar CSV reading for imu.csv and table.csv: columns found by header name, one
+//! reused `ByteRecord`, a fast exact path for short decimal numbers.
+
+// A refused recording is built once per read: the error's size costs nothing.
+#![allow(clippy::result_large_err)]
+
+use super::error::RecordingError;
+use miette::NamedSource;
+
+/// Columns of one CSV file, in the order they were asked for; `None` for an absent
+/// optional column.
+pub(crate) struct Columns {
+    /// Data per asked column.
+    pub cols: Vec<Option<Vec<f64>>>,
+    /// 1-based line of each row (for later located errors).
+    pub lines: Vec<u64>,
+}
+
+/// Reads `bytes` (the text of `file`) keeping `required` and `optional` columns by name.
+/// Extra columns are allowed and skipped.
+pub(crate) fn read_columns(
+    file: &str,
+    bytes: &[u8],
+    required: &[&str],
+    optional: &[&str],
+) -> Result<Columns, RecordingError> {
+    let mut rdr = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .from_reader(bytes);
+    let mut rec = csv::ByteRecord::new();
+    let src = || NamedSource::new(file, String::from_utf8_lossy(bytes).into_owned());
+    let header_ok = rdr.read_byte_record(&mut rec).map_err(|e| io(file, e))?;
+    if !header_ok {
+        return Err(RecordingError::EmptyStream {
+            file: file.to_string(),
+        });
+    }
+    let names: Vec<String> = rec
+        .iter()
+        .map(|f| String::from_utf8_lossy(f).trim().to_string())
+        .collect();
+    let header_len = bytes
+        .iter()
+        .position(|&b| b == b'\n')
+        .unwrap_or(bytes.len());
+    let mut idx = Vec::with_capacity(required.len() + optional.len());
+    for &c in required {
+        match names.iter().position(|n| n == c) {
+            Some(i) => idx.push(Some(i)),
+            None => {
+                return Err(RecordingError::MissingColumn {
+                    file: file.to_string(),
+                    column: c.to_string(),
+                    required: required.join(", "),
+                    found: names.join(", "),
+                    src: src(),
+                    span: (0, header_len).into(),
+                });
+            }
+        }
+    }
+    for &c in optional {
+        idx.push(names.iter().position(|n| n == c));
+    }
+    // Rough row count from the byte size, to allocate once.
+    let guess = bytes.len() / (header_len.max(8) + 1) + 16;
+    let mut cols: Vec<Option<Vec<f64>>> = idx
+        .iter()
+        .map(|i| i.map(|_| Vec::with_capacity(guess)))
+        .collect();
+    let mut lines = Vec::with_capacity(guess);
+    let width = names.len();
+    while rdr.read_byte_record(&mut rec).map_err(|e| io(file, e))? {
+        let pos = rec.position().expect("csv records carry positions");
+        if rec.len() != width {
+            if rec.len() == 1
+                && rec
+                    .get(0)
+                    .is_some_and(|f| f.iter().all(u8::is_ascii_whitespace))
+            {
+                continue; // blank line
+            }
+            let start = pos.byte() as usize;
+            let end = bytes[start..]
+                .iter()
+                .position(|&b| b == b'\n')
+                .map_or(bytes.len(), |p| start + p);
+            return Err(RecordingError::RaggedRow {
+                file: file.to_string(),
+                line: pos.line(),
+                found: rec.len(),
+                expected: width,
+                src: src(),
+                span: (start, end - start).into(),
+            });
+        }
+        for (k, i) in idx.iter().enumerate() {
+            let Some(i) = *i else { continue };
+            let cell = &rec[i];
+            match parse_f64(cell) {
+                Some(v) => cols[k].as_mut().expect("present column").push(v),
+                None => {
+                    let (offset, column) = cell_offset(bytes, pos.byte() as usize, i);
+                    return Err(RecordingError::NotANumber {
+                        file: file.to_string(),
+                        line: pos.line(),
+                        column,
+                        name: names[i].clone(),
+                        cell: String::from_utf8_lossy(cell).into_owned(),
+                        src: src(),
+                        span: (offset, cell.len().max(1)).into(),
+                    });
+                }
+            }
+        }
+        lines.push(pos.line());
+    }
+    Ok(Columns { cols, lines })
+}
+
+fn io(file: &str, e: csv::Error) -> RecordingError {
+    RecordingError::Io {
+        file: file.to_string(),
+        message: e.to_string(),
+    }
+}
+
+/// Byte offset and 1-based character column of field `field` of the line starting at `start`.
+pub(crate) fn cell_offset(bytes: &[u8], start: usize, field: usize) -> (usize, usize) {
+    let mut off = start;
+    for _ in 0..field {
+        match bytes[off..].iter().position(|&b| b == b',') {
+            Some(p) => off += p + 1,
+            None => break,
+        }
+    }
+    let column = String::from_utf8_lossy(&bytes[start..off]).chars().count() + 1;
+    (off, column)
+}
+
+/// Parses a finite decimal number. Short decimals (up to 19 significant digits, exponent
+/// within 10^±22 after scaling) take Clinger's exact fast path: an integer mantissa below
+/// 2^53 divided or multiplied by an exact power of ten rounds once, so the result is the
+/// correctly rounded value, as `str::parse` would give. Everything else falls back to it.
+pub(crate) fn parse_f64(cell: &[u8]) -> Option<f64> {
+    let b = cell.trim_ascii();
+    fast(b).or_else(|| {
+        let v: f64 = std::str::from_utf8(b).ok()?.parse().ok()?;
+        v.is_finite().then_some(v)
+    })
+}
+
+const POW10: [f64; 23] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+];
+
+fn fast(b: &[u8]) -> Option<f64> {
+    let (neg, mut i) = match b.first()? {
+        b'-' => (true, 1),
+        b'+' => (false, 1),
+        _ => (false, 0),
+    };
+    let mut mant: u64 = 0;
+    let mut digits = 0u32;
+    let mut frac = 0i32;
+    let mut any = false;
+    while i < b.len() && b[i].is_ascii_digit() {
+        mant = mant.wrapping_mul(10).wrapping_add(u64::from(b[i] - b'0'));
+        if mant != 0 {
+            digits += 1;
+        }
+        any = true;
+        i += 1;
+    }
+    if i < b.len() && b[i] == b'.' {
+        i += 1;
+        while i < b.len() && b[i].is_ascii_digit() {
+            mant = mant.wrapping_mul(10).wrapping_add(u64::from(b[i] - b'0'));
+            if mant != 0 {
+                digits += 1;
+            }
+            frac += 1;
+            any = true;
+            i += 1;
+        }
+    }
+    if !any || digits > 19 {
+        return None;
+    }
+    let mut exp: i32 = 0;
+    if i < b.len() && (b[i] == b'e' || b[i] == b'E') {
+        i += 1;
+        let eneg = match b.get(i) {
+            Some(b'-') => {
+                i += 1;
+                true
+            }
+            Some(b'+') => {
+                i += 1;
+                false
+            }
+            _ => false,
+        };
+        let s = i;
+        while i < b.len() && b[i].is_ascii_digit() && i - s < 4 {
+            exp = exp * 10 + i32::from(b[i] - b'0');
+            i += 1;
+        }
+        if i == s {
+            return None;
+        }
+        if eneg {
+            exp = -exp;
+        }
+    }
+    if i != b.len() || mant > (1u64 << 53) {
+        return None;
+    }
+    let e = exp - frac;
+    let m = mant as f64;
+    let v = match e {
+        0 => m,
+        1..=22 => m * POW10[e as usize],
+        -22..=-1 => m / POW10[(-e) as usize],
+        _ => return None,
+    };
+    Some(if neg { -v } else { v })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::parse_f64;
+
+    #[test]
+    fn fast_path_matches_std() {
+        for s in [
+            "0",
+            "-0.013975",
+            "9.788327",
+            "22.000",
+            "1e-3",
+            "-1.5E+2",
+            "0.0000001",
+            "123456789.123456",
+            "3.14159265358979",
+            "-100.0",
+            "0.1",
+            "17",
+            "2.5e-7",
+            "12345678901234567890.5",
+            "1e300",
+        ] {
+            let want: f64 = s.parse().unwrap();
+            assert_eq!(
+                parse_f64(s.as_bytes()).unwrap().to_bits(),
+                want.to_bits(),
+                "{s}"
+            );
+        }
+        for s in ["", "-", "abc", "1.2.3", "1e", "nan", "inf", "1,5", "--1"] {
+            assert!(parse_f64(s.as_bytes()).is_none(), "{s}");
+        }
+    }
+}

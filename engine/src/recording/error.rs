@@ -1,0 +1,245 @@
+//! Why a recording folder is refused: every variant names the file, line and column.
+
+use miette::{Diagnostic, NamedSource, SourceSpan};
+use thiserror::Error;
+
+/// A recording that cannot be read, located in its file.
+#[derive(Debug, Error, Diagnostic)]
+pub enum RecordingError {
+    /// A file of the folder could not be opened or read.
+    #[error("cannot read {file}: {message}")]
+    #[diagnostic(
+        code(recording::io),
+        help(
+            "a recording folder holds manifest.yaml, imu.csv and table.csv (spec/recording-format.md)"
+        )
+    )]
+    Io {
+        /// File path.
+        file: String,
+        /// OS message.
+        message: String,
+    },
+
+    /// A required column is absent from the header.
+    #[error("{file}:1: missing column `{column}`")]
+    #[diagnostic(
+        code(recording::missing_column),
+        help("{file} needs the columns {required}; the header has {found}")
+    )]
+    MissingColumn {
+        /// File name.
+        file: String,
+        /// Missing column.
+        column: String,
+        /// Required columns, comma-separated.
+        required: String,
+        /// Columns found.
+        found: String,
+        /// File text.
+        #[source_code]
+        src: NamedSource<String>,
+        /// The header line.
+        #[label("no `{column}` here")]
+        span: SourceSpan,
+    },
+
+    /// A cell that is not a finite number.
+    #[error("{file}:{line}:{column}: `{cell}` in column `{name}` is not a number")]
+    #[diagnostic(
+        code(recording::not_a_number),
+        help("every cell of {file} holds a finite decimal number (e.g. 9.80665 or 1.5e-3)")
+    )]
+    NotANumber {
+        /// File name.
+        file: String,
+        /// Line, 1-based.
+        line: u64,
+        /// Column (character), 1-based.
+        column: usize,
+        /// Column name.
+        name: String,
+        /// Cell text.
+        cell: String,
+        /// File text.
+        #[source_code]
+        src: NamedSource<String>,
+        /// The cell.
+        #[label("not a number")]
+        span: SourceSpan,
+    },
+
+    /// A row with a different number of cells than the header.
+    #[error("{file}:{line}: {found} cells where the header has {expected}")]
+    #[diagnostic(
+        code(recording::ragged_row),
+        help("each line of {file} has one cell per header column")
+    )]
+    RaggedRow {
+        /// File name.
+        file: String,
+        /// Line, 1-based.
+        line: u64,
+        /// Cells found.
+        found: usize,
+        /// Header cells.
+        expected: usize,
+        /// File text.
+        #[source_code]
+        src: NamedSource<String>,
+        /// The row.
+        #[label("this row")]
+        span: SourceSpan,
+    },
+
+    /// Time stamps that do not strictly increase.
+    #[error("{file}:{line}:{column}: time goes backwards or repeats ({t} s after {prev} s)")]
+    #[diagnostic(
+        code(recording::time_not_increasing),
+        help("the `t` column of {file} must strictly increase, one sample a line")
+    )]
+    TimeNotIncreasing {
+        /// File name.
+        file: String,
+        /// Line, 1-based.
+        line: u64,
+        /// Column, 1-based.
+        column: usize,
+        /// This stamp.
+        t: f64,
+        /// Previous stamp.
+        prev: f64,
+        /// File text.
+        #[source_code]
+        src: NamedSource<String>,
+        /// The stamp.
+        #[label("not after the previous line's {prev} s")]
+        span: SourceSpan,
+    },
+
+    /// A stream without any sample.
+    #[error("{file}: no samples")]
+    #[diagnostic(
+        code(recording::empty_stream),
+        help("{file} needs a header line and at least two samples")
+    )]
+    EmptyStream {
+        /// File name.
+        file: String,
+    },
+
+    /// manifest.yaml is not valid YAML or does not have the manifest's shape.
+    #[error("{file}:{line}:{column}: {message}")]
+    #[diagnostic(
+        code(recording::manifest),
+        help("see spec/recording-format.md for the manifest's keys")
+    )]
+    Manifest {
+        /// File name.
+        file: String,
+        /// Line, 1-based.
+        line: u64,
+        /// Column, 1-based.
+        column: u64,
+        /// Parser message.
+        message: String,
+        /// File text.
+        #[source_code]
+        src: NamedSource<String>,
+        /// Where.
+        #[label("{message}")]
+        span: SourceSpan,
+    },
+
+    /// A format tag this version does not read.
+    #[error("{file}:{line}:{column}: unknown recording format `{found}`")]
+    #[diagnostic(
+        code(recording::unknown_format),
+        help("this ratecal reads `ratecal-recording/1`")
+    )]
+    UnknownFormat {
+        /// File name.
+        file: String,
+        /// Line.
+        line: u64,
+        /// Column.
+        column: u64,
+        /// Tag found.
+        found: String,
+        /// File text.
+        #[source_code]
+        src: NamedSource<String>,
+        /// Where.
+        #[label("unknown format")]
+        span: SourceSpan,
+    },
+
+    /// A segment whose window is not inside both streams, or ends before it starts.
+    #[error("{file}:{line}:{column}: segment `{id}` ({t_start} s .. {t_end} s) {problem}")]
+    #[diagnostic(code(recording::segment_outside), help("{help}"))]
+    SegmentOutside {
+        /// File name.
+        file: String,
+        /// Line.
+        line: u64,
+        /// Column.
+        column: u64,
+        /// Segment id.
+        id: String,
+        /// Start, s.
+        t_start: f64,
+        /// End, s.
+        t_end: f64,
+        /// What is wrong.
+        problem: String,
+        /// What would fix it.
+        help: String,
+        /// File text.
+        #[source_code]
+        src: NamedSource<String>,
+        /// The segment.
+        #[label("this segment")]
+        span: SourceSpan,
+    },
+
+    /// A segment without IMU samples.
+    #[error(
+        "{file}:{line}:{column}: segment `{id}` ({t_start} s .. {t_end} s) holds no IMU sample"
+    )]
+    #[diagnostic(
+        code(recording::empty_segment),
+        help("a segment covers at least one IMU sample; check its times against imu.csv")
+    )]
+    EmptySegment {
+        /// File name.
+        file: String,
+        /// Line.
+        line: u64,
+        /// Column.
+        column: u64,
+        /// Segment id.
+        id: String,
+        /// Start, s.
+        t_start: f64,
+        /// End, s.
+        t_end: f64,
+        /// File text.
+        #[source_code]
+        src: NamedSource<String>,
+        /// The segment.
+        #[label("empty segment")]
+        span: SourceSpan,
+    },
+}
+
+/// 1-based line and column of a byte offset.
+pub(crate) fn line_col(text: &str, offset: usize) -> (u64, u64) {
+    let before = &text.as_bytes()[..offset.min(text.len())];
+    let line = before.iter().filter(|&&b| b == b'\n').count() as u64 + 1;
+    let start = before
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .map_or(0, |p| p + 1);
+    let column = String::from_utf8_lossy(&before[start..]).chars().count() as u64 + 1;
+    (line, column)
+}

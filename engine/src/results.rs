@@ -1,0 +1,374 @@
+//! The results model: what `fit` produces from a recording and what every renderer
+//! (text, JSON, Markdown, HTML) consumes. Serializes to `results.json`; the keys are a
+//! stable interface documented in `docs/results.md`.
+
+use crate::recording::{EnvironmentRecord, ProcedureRef};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// The format tag written in every results file.
+pub const FORMAT: &str = "ratecal-results/1";
+
+/// Everything the analysis found about one recording (or several, for repeatability).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Results {
+    /// `ratecal-results/1`.
+    pub format: String,
+    /// Parameters by dotted name (`accel.bias.x`, `gyro.scale.z`, `accel.misalignment.xy`...).
+    pub parameters: BTreeMap<String, Parameter>,
+    /// Every acceptance threshold of the procedure, evaluated (or not evaluated, with why).
+    pub acceptance: Vec<Acceptance>,
+    /// Why each unobservable parameter is unobservable, by parameter name.
+    #[serde(default)]
+    pub observability: BTreeMap<String, String>,
+    /// Which recording was analysed.
+    pub recording: RecordingInfo,
+    /// The model and fits that were applied.
+    pub model: ModelInfo,
+    /// Segments and what each was used for.
+    #[serde(default)]
+    pub segments: Vec<SegmentUse>,
+    /// Synchronisation of the table feedback to the IMU stamps.
+    pub sync: SyncReport,
+    /// Residuals per segment and channel.
+    #[serde(default)]
+    pub residuals: Vec<ResidualStats>,
+    /// Allan deviation of the long static block (plot-ready).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub allan: Option<AllanCurve>,
+    /// Accuracy verification at points not used in the fit.
+    #[serde(default)]
+    pub verification: Vec<VerificationPoint>,
+    /// Repeatability across runs (`analyze RUN1 RUN2 RUN3`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub repeatability: Option<Repeatability>,
+    /// Lab conditions (manifest `environment` block and `ambient` column).
+    pub environment: EnvironmentInfo,
+    /// Everything the analysis could not do as asked, in plain words.
+    #[serde(default)]
+    pub warnings: Vec<String>,
+}
+
+/// A parameter estimate, or the statement that the motion did not determine it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Parameter {
+    /// A value with its standard uncertainty, in `unit`.
+    Estimate {
+        /// Value.
+        value: f64,
+        /// Standard uncertainty (k = 1).
+        u: f64,
+        /// Unit (`m/s^2`, `ppm`, `deg/s`, `mrad`...).
+        unit: String,
+    },
+    /// `{ "observable": false }`.
+    Unobservable {
+        /// Always `false`.
+        observable: bool,
+    },
+}
+
+impl Parameter {
+    /// An estimate.
+    pub fn estimate(value: f64, u: f64, unit: &str) -> Self {
+        Parameter::Estimate {
+            value,
+            u,
+            unit: unit.to_string(),
+        }
+    }
+
+    /// `{ "observable": false }`.
+    pub fn unobservable() -> Self {
+        Parameter::Unobservable { observable: false }
+    }
+
+    /// `(value, u)` of an estimate.
+    pub fn value_u(&self) -> Option<(f64, f64)> {
+        match self {
+            Parameter::Estimate { value, u, .. } => Some((*value, *u)),
+            Parameter::Unobservable { .. } => None,
+        }
+    }
+
+    /// Unit of an estimate.
+    pub fn unit(&self) -> Option<&str> {
+        match self {
+            Parameter::Estimate { unit, .. } => Some(unit),
+            Parameter::Unobservable { .. } => None,
+        }
+    }
+}
+
+/// Outcome of one acceptance check.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    /// Meets the limit (under the decision rule).
+    Pass,
+    /// Misses the limit.
+    Fail,
+    /// Guard band: the expanded uncertainty straddles the limit.
+    Indeterminate,
+    /// Could not be evaluated (see `reason`).
+    NotEvaluated,
+}
+
+/// One evaluated acceptance threshold; `value`, `limit`, `margin` and `expanded_u` are in
+/// `unit`, the unit the procedure wrote the limit in.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Acceptance {
+    /// Human name (`accel.residual.std <= 0.002 g`).
+    pub name: String,
+    /// Quantity checked, dotted (`accel.residual.std`).
+    pub quantity: String,
+    /// Step that declared it, if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step: Option<String>,
+    /// Measured value (absent when not evaluated).
+    pub value: Option<f64>,
+    /// Comparison as written (`<=`, `<`, `>=`, `>`).
+    pub op: String,
+    /// Limit.
+    pub limit: f64,
+    /// Unit as the procedure wrote it.
+    pub unit: String,
+    /// Distance to the limit, positive on the passing side.
+    pub margin: Option<f64>,
+    /// Expanded uncertainty of the value, k = 2.
+    #[serde(rename = "U")]
+    pub expanded_u: Option<f64>,
+    /// `simple` or `guard_banded`.
+    pub rule: String,
+    /// Verdict.
+    pub verdict: Verdict,
+    /// Why it was not evaluated, or what the value means (e.g. std instead of CV).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+}
+
+/// Identity of the analysed recording.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct RecordingInfo {
+    /// Folders as given on the command line (several for repeatability).
+    pub paths: Vec<String>,
+    /// IMU description from the manifest.
+    pub imu: BTreeMap<String, String>,
+    /// Procedure that produced the recording (manifest block), if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub procedure: Option<ProcedureRef>,
+    /// Run id (ratecal recordings only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub run_id: Option<String>,
+    /// Station site latitude, deg.
+    pub latitude_deg: f64,
+    /// Station gravity, m/s^2.
+    pub gravity_mps2: f64,
+    /// IMU rows.
+    pub imu_rows: usize,
+    /// Table rows.
+    pub table_rows: usize,
+    /// IMU sample rate (median), Hz.
+    pub imu_rate_hz: f64,
+    /// Table feedback rate (median), Hz.
+    pub table_rate_hz: f64,
+    /// Time span of the IMU stream, s.
+    pub duration_s: f64,
+}
+
+/// What model was fitted and from which procedure.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ModelInfo {
+    /// Procedure used for the analysis (`--procedure` or the recording's), if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub procedure: Option<ProcedureRef>,
+    /// `procedure` (fit statements) or `by_kind` (segment kinds, standard model).
+    pub selection: String,
+    /// Fits applied, e.g. `accel_bias_scale from accel_static/*`.
+    pub fits: Vec<String>,
+}
+
+/// One segment and what the analysis did with it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SegmentUse {
+    /// Segment id.
+    pub id: String,
+    /// `static`, `rate`, `oscillation`.
+    pub kind: String,
+    /// Start, s.
+    pub t_start: f64,
+    /// End, s.
+    pub t_end: f64,
+    /// IMU samples in the window.
+    pub imu_samples: usize,
+    /// Samples removed as outliers (any channel).
+    pub outliers_removed: usize,
+    /// Uses: `accel`, `gyro_bias`, `gyro_scale`, `gyro_full`, `allan`, `temperature`,
+    /// `verification`; empty when unused.
+    pub used_for: Vec<String>,
+}
+
+/// Synchronisation of the table feedback onto the IMU time stamps (linear interpolation).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct SyncReport {
+    /// `linear_interpolation`.
+    pub method: String,
+    /// Median table feedback step, s.
+    pub table_step_s: f64,
+    /// Largest gap between the two table samples that bracket an IMU sample used, s.
+    pub max_gap_s: f64,
+    /// Largest distance from an IMU stamp to its nearest table sample, s: the time
+    /// uncertainty of the interpolated reference.
+    pub max_sync_error_s: f64,
+    /// Largest interpolation error of the feedback angle, deg, bounded by
+    /// `gap^2 / 8 * |angular acceleration|` (estimated from the feedback rates).
+    pub max_angle_error_deg: f64,
+}
+
+/// Residual statistics of one channel over one segment (observed minus model).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ResidualStats {
+    /// Segment id.
+    pub segment: String,
+    /// `accel` or `gyro`.
+    pub sensor: String,
+    /// `x`, `y`, `z`.
+    pub channel: String,
+    /// Samples.
+    pub n: usize,
+    /// Mean, sensor unit.
+    pub mean: f64,
+    /// Standard deviation, sensor unit.
+    pub std: f64,
+    /// Linear trend, sensor unit per second.
+    pub slope_per_s: f64,
+    /// Sensor unit (`m/s^2`, `deg/s`).
+    pub unit: String,
+}
+
+/// Overlapping Allan deviation of the gyros over the long static block.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AllanCurve {
+    /// Segment analysed.
+    pub segment: String,
+    /// Averaging times, s (octaves).
+    pub tau_s: Vec<f64>,
+    /// Allan deviation per axis (x, y, z), deg/s, one entry per tau.
+    pub adev_dps: [Vec<f64>; 3],
+}
+
+/// Accuracy at one point not used in the fit: compensated output vs reference.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct VerificationPoint {
+    /// Segment id.
+    pub segment: String,
+    /// `accel` or `gyro`.
+    pub sensor: String,
+    /// Largest per-axis error of the segment-mean compensated output, sensor unit.
+    pub max_error: f64,
+    /// Per-axis errors (x, y, z), sensor unit.
+    pub error: [f64; 3],
+    /// Standard uncertainty of the largest error, sensor unit.
+    pub u: f64,
+    /// Sensor unit.
+    pub unit: String,
+}
+
+/// Repeatability across complete runs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Repeatability {
+    /// Number of runs.
+    pub runs: usize,
+    /// Per parameter.
+    pub parameters: Vec<RepeatParameter>,
+}
+
+/// Spread of one parameter across runs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RepeatParameter {
+    /// Parameter name.
+    pub name: String,
+    /// Value in each run.
+    pub values: Vec<f64>,
+    /// Mean.
+    pub mean: f64,
+    /// Sample standard deviation.
+    pub std: f64,
+    /// Coefficient of variation std/|mean| (absent where meaningless).
+    pub cv: Option<f64>,
+    /// `cv`, or `std` for a near-zero parameter (a bias), where the CV is meaningless.
+    pub measure: String,
+    /// Parameter unit.
+    pub unit: String,
+}
+
+/// Lab conditions during the recording.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct EnvironmentInfo {
+    /// The manifest's `environment` block.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub recorded: Option<EnvironmentRecord>,
+    /// Statistics of the `ambient` column, if present.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ambient: Option<AmbientStats>,
+    /// IMU internal temperature range (not the lab's), degC.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub imu_temp_range_c: Option<[f64; 2]>,
+}
+
+/// Lab air temperature over the recording.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AmbientStats {
+    /// Mean, degC.
+    pub mean_c: f64,
+    /// Minimum, degC.
+    pub min_c: f64,
+    /// Maximum, degC.
+    pub max_c: f64,
+    /// Linear drift, degC/h.
+    pub drift_c_per_h: f64,
+}
+
+impl Results {
+    /// Whether any acceptance check failed (exit code 3).
+    pub fn has_failure(&self) -> bool {
+        self.acceptance.iter().any(|a| a.verdict == Verdict::Fail)
+    }
+
+    /// An estimate by name: `(value, u)`.
+    pub fn value(&self, name: &str) -> Option<(f64, f64)> {
+        self.parameters.get(name).and_then(Parameter::value_u)
+    }
+
+    /// Pretty JSON text of `results.json`.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("results serialize")
+    }
+
+    /// Parses a `results.json` text.
+    pub fn from_json(text: &str) -> Result<Self, serde_json::Error> {
+        serde_json::from_str(text)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parameter_shapes() {
+        let p = Parameter::estimate(0.021, 2e-5, "m/s^2");
+        assert_eq!(
+            serde_json::to_string(&p).unwrap(),
+            r#"{"value":0.021,"u":0.00002,"unit":"m/s^2"}"#
+        );
+        let q = Parameter::unobservable();
+        assert_eq!(
+            serde_json::to_string(&q).unwrap(),
+            r#"{"observable":false}"#
+        );
+        let back: Parameter = serde_json::from_str(r#"{"observable":false}"#).unwrap();
+        assert_eq!(back, q);
+    }
+}
