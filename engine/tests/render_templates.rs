@@ -4,7 +4,7 @@
 mod render_common;
 
 use ratecal_engine::render::{Format, Templates, render, render_all};
-use render_common::{foreign, full};
+use render_common::{foreign, full, minimal};
 
 const SHA: &str = "9f2c4e1ab7d35c08e6f1a2b3c4d5e6f708192a3b4c5d6e7f8091a2b3c4d5e6f7";
 const STATION_SHA: &str = "3b1d0f9e8c7a6b5d4e3f2a1b0c9d8e7f6a5b4c3d2e1f0a9b8c7d6e5f4a3b2c1d";
@@ -157,8 +157,28 @@ fn html_carries_every_plot_inline() {
 }
 
 #[test]
-fn foreign_recording_has_no_plots_and_no_errors() {
+fn foreign_recording_plots_what_it_has() {
     let html = render(&foreign(), &Templates::bundled(), Format::Html).unwrap();
-    assert_eq!(html.matches("<svg ").count(), 0);
+    // Residuals (accel, gyro), rate-point residuals, Allan; no temperature series, no findings.
+    assert_eq!(html.matches("<svg ").count(), 4);
     assert!(html.contains("No findings."));
+    assert!(!html.contains("<title>Temperature"));
+}
+
+#[test]
+fn minimal_results_without_manifest_still_make_a_report() {
+    for r in render_all(&minimal(), &Templates::bundled()).unwrap() {
+        assert!(
+            r.text.contains("6. Conclusions and recommendations"),
+            "{}",
+            r.file_name
+        );
+        assert!(r.text.contains("not recorded"), "{}", r.file_name);
+        assert!(
+            r.text.contains("No acceptance check could be evaluated"),
+            "{}",
+            r.file_name
+        );
+        assert!(!r.text.contains("DRY RUN"), "{}", r.file_name);
+    }
 }

@@ -4,9 +4,8 @@
 //! results.json may lack residuals or Allan curves; the context then holds `null` or `[]`
 //! and the templates say "not recorded".
 
-use super::ReportInput;
-use super::process;
-use serde_json::{Map, Value, json};
+use super::{ReportInput, process, views};
+use serde_json::{Value, json};
 
 /// Format tag of the context, for templates that want to check what they are given.
 pub const CONTEXT_FORMAT: &str = "ratecal-report/1";
@@ -22,33 +21,34 @@ pub fn build(input: &ReportInput) -> Value {
     };
     let run = get("run");
     let results = &input.results;
-    let parameters = parameters(results);
-    let acceptance = list(results, "acceptance");
-    let verification = list(results, "verification");
-    let repeatability = results.get("repeatability").cloned().unwrap_or(Value::Null);
-    let summary = summary(&acceptance, &verification, &repeatability, &parameters);
-    let imu_temp = stats(&input.temperature.imu);
-    let ambient = stats(&input.temperature.ambient);
-    let env = get("environment");
-    let recorded = env
-        .as_object()
-        .is_some_and(|e| e.values().any(|v| !v.is_null()));
+    let parameters = views::parameters(results);
+    let checks = views::checks(results);
+    let summary = views::summary(&checks, results, &parameters);
+    let environment = environment(input, &get("environment"));
+    let recording = results.get("recording").cloned().unwrap_or(Value::Null);
 
     let procedure = match get("procedure") {
-        Value::Null => input.plan.as_ref().map_or(
-            Value::Null,
-            |p| json!({ "name": p.name, "version": p.version, "sha256": null }),
-        ),
+        Value::Null => match recording.get("procedure") {
+            Some(p) if !p.is_null() => p.clone(),
+            _ => input.plan.as_ref().map_or(
+                Value::Null,
+                |p| json!({ "name": p.name, "version": p.version, "sha256": null }),
+            ),
+        },
         p => p,
     };
+    // An empty hash is as good as none: the report says "not recorded".
+    let sha = procedure
+        .get("sha256")
+        .filter(|s| s.as_str().is_some_and(|s| !s.is_empty()));
     let traceability = json!({
         "procedure_name": procedure.get("name"),
         "procedure_version": procedure.get("version"),
-        "procedure_sha256": procedure.get("sha256"),
+        "procedure_sha256": sha,
         "station_sha256": run.get("station_sha256"),
         "ratecal_version": input.ratecal_version,
         "run_ratecal_version": run.get("ratecal_version"),
-        "run_id": run.get("id"),
+        "run_id": run.get("id").or_else(|| recording.get("run_id")),
         "started": run.get("started"),
         "ended": run.get("ended"),
         "status": run.get("status"),
@@ -59,12 +59,47 @@ pub fn build(input: &ReportInput) -> Value {
         }).unwrap_or_default(),
         "results_format": results.get("format"),
     });
+    let imu = match get("imu") {
+        Value::Null => recording.get("imu").cloned().unwrap_or(json!({})),
+        i => i,
+    };
     let interval = input.plan.as_ref().and_then(|p| {
         p.meta
             .get("recalibration_interval")
             .or_else(|| p.meta.get("recalibration"))
     });
-    let temp_model = results.get("temperature_model").filter(|v| !v.is_null());
+    let repeatability = match results.get("repeatability") {
+        Some(r) if r.is_object() => {
+            let mut r = r.clone();
+            let n = match r.get("runs") {
+                Some(Value::Array(a)) => json!(a.len()),
+                Some(n) => n.clone(),
+                None => Value::Null,
+            };
+            r["run_count"] = n;
+            r
+        }
+        _ => Value::Null,
+    };
+    let sync = results.get("sync").map(|s| {
+        let ms = s
+            .get("max_sync_error_s")
+            .and_then(Value::as_f64)
+            .map(|v| v * 1e3)
+            .or_else(|| s.get("error_ms").and_then(Value::as_f64));
+        let mut s = s.clone();
+        if s.is_object() {
+            s["max_sync_error_ms"] = json!(ms);
+        }
+        s
+    });
+    let acquisition = json!({
+        "imu_rate_hz": recording.get("imu_rate_hz"),
+        "table_rate_hz": recording.get("table_rate_hz"),
+        "imu_rows": recording.get("imu_rows"),
+        "table_rows": recording.get("table_rows"),
+        "duration_s": recording.get("duration_s"),
+    });
 
     json!({
         "report": { "format": CONTEXT_FORMAT, "ratecal_version": input.ratecal_version },
@@ -72,240 +107,89 @@ pub fn build(input: &ReportInput) -> Value {
         "run": run,
         "procedure": procedure,
         "traceability": traceability,
-        "imu": get("imu"),
+        "imu": imu,
         "station": get("station"),
-        "environment": {
-            "recorded": recorded,
-            "temperature_c": env.get("temperature_c"),
-            "humidity_pct": env.get("humidity_pct"),
-            "pressure_kpa": env.get("pressure_kpa"),
-            "vibration_g": env.get("vibration_g"),
-            "ambient": ambient,
-            "imu_temperature": imu_temp,
-        },
-        "process": process::describe(manifest, input.plan.as_ref()),
+        "environment": environment,
+        "acquisition": acquisition,
+        "process": process::describe(manifest, input.plan.as_ref(), results),
         "plan": input.plan.as_ref().map(|p| serde_json::to_value(p).unwrap_or(Value::Null)),
         "results": results,
         "parameters": parameters,
-        "calibration": calibration_rows(results),
-        "other_parameters": other_parameters(results),
-        "acceptance": acceptance,
-        "verification": verification,
+        "calibration": views::calibration_rows(results),
+        "gyro_noise": views::gyro_noise_rows(results),
+        "other_parameters": views::other_parameters(results),
+        "acceptance": checks,
+        "verification": results.get("verification").cloned().unwrap_or(json!([])),
+        "verification_checks": views::checks_of(&checks, |q| q.ends_with(".error")),
         "repeatability": repeatability,
-        "residuals": list(results, "residuals"),
-        "residual_table": residual_table(results),
+        "repeatability_checks": views::checks_of(&checks, |q| q.starts_with("repeatability.")),
+        "residuals": results.get("residuals").cloned().unwrap_or(json!([])),
+        "residual_table": views::residual_table(results),
         "allan": results.get("allan").cloned().unwrap_or(Value::Null),
-        "warnings": list(results, "warnings"),
-        "findings": list(results, "findings"),
+        "sync": sync,
+        "warnings": results.get("warnings").cloned().unwrap_or(json!([])),
+        "findings": results.get("findings").cloned().unwrap_or(json!([])),
         "summary": summary,
         "recommendations": {
-            "temperature_span_c": imu_temp.get("span"),
-            "temperature_compensation": temp_model.is_some(),
-            "temperature_model": temp_model,
+            "temperature_span_c": environment["imu_temperature"].get("span"),
+            "temperature_compensation": views::has_temperature_model(results, &parameters),
             "recalibration_interval": interval,
         },
     })
 }
 
-fn list(v: &Value, key: &str) -> Value {
-    match v.get(key) {
-        Some(Value::Array(a)) => Value::Array(a.clone()),
-        _ => Value::Array(vec![]),
-    }
-}
-
-/// Splits `accel.bias.x` into sensor, kind and axis (`accel.misalignment.xy`: axis `xy`).
-fn split_name(name: &str) -> (String, String, String) {
-    let mut it = name.splitn(3, '.');
-    let a = it.next().unwrap_or_default().to_string();
-    let b = it.next().unwrap_or_default().to_string();
-    let c = it.next().unwrap_or_default().to_string();
-    (a, b, c)
-}
-
-fn param_entry(name: &str, p: &Value) -> Value {
-    let (sensor, kind, axis) = split_name(name);
-    let observable = p.get("observable").and_then(Value::as_bool).unwrap_or(true)
-        && p.get("value").is_some_and(|v| !v.is_null());
-    let mut m = p.as_object().cloned().unwrap_or_default();
-    m.insert("name".into(), json!(name));
-    m.insert("sensor".into(), json!(sensor));
-    m.insert("kind".into(), json!(kind));
-    m.insert("axis".into(), json!(axis));
-    m.insert("observable".into(), json!(observable));
-    Value::Object(m)
-}
-
-fn parameters(results: &Value) -> Value {
-    let Some(ps) = results.get("parameters").and_then(Value::as_object) else {
-        return json!([]);
-    };
-    Value::Array(ps.iter().map(|(n, p)| param_entry(n, p)).collect())
-}
-
-/// One row per sensor and axis: `{sensor, axis, bias, scale}` (each a parameter entry).
-fn calibration_rows(results: &Value) -> Value {
-    let ps = results.get("parameters").and_then(Value::as_object);
-    let mut rows = vec![];
-    for sensor in ["accel", "gyro"] {
-        for axis in ["x", "y", "z"] {
-            let entry = |kind: &str| {
-                let name = format!("{sensor}.{kind}.{axis}");
-                let p = ps.and_then(|m| m.get(&name)).cloned();
-                param_entry(&name, &p.unwrap_or(json!({ "observable": false })))
-            };
-            rows.push(json!({ "sensor": sensor, "axis": axis, "bias": entry("bias"), "scale": entry("scale") }));
-        }
-    }
-    Value::Array(rows)
-}
-
-/// Parameters other than the per-axis bias and scale (misalignments, lever arms...).
-fn other_parameters(results: &Value) -> Value {
-    let Some(ps) = results.get("parameters").and_then(Value::as_object) else {
-        return json!([]);
-    };
-    let main = |n: &str| {
-        let (s, k, a) = split_name(n);
-        matches!(s.as_str(), "accel" | "gyro")
-            && matches!(k.as_str(), "bias" | "scale")
-            && matches!(a.as_str(), "x" | "y" | "z")
-    };
-    Value::Array(
-        ps.iter()
-            .filter(|(n, _)| !main(n))
-            .map(|(n, p)| param_entry(n, p))
-            .collect(),
-    )
-}
-
-/// Worst verdict over acceptance checks, verification points and repeatability parameters.
-fn summary(acceptance: &Value, verification: &Value, repeat: &Value, params: &Value) -> Value {
-    let mut counts = Map::new();
-    let mut by: [Vec<Value>; 3] = Default::default(); // fail, indeterminate, not evaluated
-    let empty = vec![];
-    let rep = repeat
-        .get("parameters")
-        .and_then(Value::as_array)
-        .unwrap_or(&empty);
-    let all = acceptance
-        .as_array()
-        .unwrap_or(&empty)
-        .iter()
-        .map(|c| (c, "acceptance"));
-    let all = all
-        .chain(
-            verification
-                .as_array()
-                .unwrap_or(&empty)
-                .iter()
-                .map(|c| (c, "verification")),
-        )
-        .chain(rep.iter().map(|c| (c, "repeatability")));
-    for (check, source) in all {
-        let verdict = check
-            .get("verdict")
-            .and_then(Value::as_str)
-            .unwrap_or("not_evaluated");
-        let n = counts.entry(verdict.to_string()).or_insert(json!(0));
-        *n = json!(n.as_u64().unwrap_or(0) + 1);
-        let name = check
-            .get("name")
-            .or_else(|| check.get("quantity"))
+/// Lab conditions: the manifest's block (or the one results.json repeats), ambient and IMU
+/// temperature statistics from the series (or from results.json's summary).
+fn environment(input: &ReportInput, manifest_env: &Value) -> Value {
+    let res_env = input.results.get("environment");
+    let env = match manifest_env {
+        Value::Null => res_env
+            .and_then(|e| e.get("recorded"))
             .cloned()
-            .unwrap_or(Value::Null);
-        let item = json!({ "name": name, "source": source, "check": check });
-        match verdict {
-            "fail" => by[0].push(item),
-            "indeterminate" => by[1].push(item),
-            "pass" => {}
-            _ => by[2].push(item),
-        }
-    }
-    let passed = counts.get("pass").is_some();
-    let verdict = if !by[0].is_empty() {
-        "fail"
-    } else if !by[1].is_empty() {
-        "indeterminate"
-    } else if passed {
-        "pass"
-    } else {
-        "not_evaluated"
+            .unwrap_or(Value::Null),
+        e => e.clone(),
     };
-    let unobservable: Vec<Value> = params
-        .as_array()
-        .unwrap_or(&empty)
-        .iter()
-        .filter(|p| p.get("observable") == Some(&json!(false)))
-        .filter_map(|p| p.get("name").cloned())
-        .collect();
-    let [failed, indeterminate, not_evaluated] = by;
+    let recorded = env
+        .as_object()
+        .is_some_and(|e| e.values().any(|v| !v.is_null()));
+    let ambient = stats(&input.temperature.ambient).or_else(|| {
+        let a = res_env?.get("ambient")?;
+        let (min, max) = (a.get("min_c")?.as_f64()?, a.get("max_c")?.as_f64()?);
+        Some(
+            json!({ "min": min, "max": max, "mean": a.get("mean_c"), "span": max - min,
+                     "drift_c_per_h": a.get("drift_c_per_h") }),
+        )
+    });
+    let imu = stats(&input.temperature.imu).or_else(|| {
+        let r = res_env?.get("imu_temp_range_c")?.as_array()?;
+        let (min, max) = (r.first()?.as_f64()?, r.get(1)?.as_f64()?);
+        Some(json!({ "min": min, "max": max, "span": max - min }))
+    });
     json!({
-        "verdict": verdict,
-        "meets_standard": verdict == "pass",
-        "counts": counts,
-        "failed": failed,
-        "indeterminate": indeterminate,
-        "not_evaluated": not_evaluated,
-        "unobservable": unobservable,
+        "recorded": recorded,
+        "temperature_c": env.get("temperature_c"),
+        "humidity_pct": env.get("humidity_pct"),
+        "pressure_kpa": env.get("pressure_kpa"),
+        "vibration_g": env.get("vibration_g"),
+        "ambient": ambient,
+        "imu_temperature": imu,
     })
 }
 
-/// Residual rows grouped by segment, in the order segments first appear:
-/// `[{segment, channels: {ax: row, ...}}]`. Accepts a list of rows
-/// (`{segment, channel, mean, std, ...}`) or an object `{segment: {channel: {...}}}`.
-fn residual_table(results: &Value) -> Value {
-    let mut out: Vec<(String, Map<String, Value>)> = vec![];
-    let mut add = |seg: &str, ch: &str, row: &Value| {
-        let i = match out.iter().position(|(s, _)| s == seg) {
-            Some(i) => i,
-            None => {
-                out.push((seg.to_string(), Map::new()));
-                out.len() - 1
-            }
-        };
-        out[i].1.insert(ch.to_string(), row.clone());
-    };
-    match results.get("residuals") {
-        Some(Value::Array(rows)) => {
-            for row in rows {
-                let s = row.get("segment").and_then(Value::as_str);
-                let c = row.get("channel").and_then(Value::as_str);
-                if let (Some(s), Some(c)) = (s, c) {
-                    add(s, c, row);
-                }
-            }
-        }
-        Some(Value::Object(segs)) => {
-            for (s, chans) in segs {
-                for (c, row) in chans.as_object().into_iter().flatten() {
-                    add(s, c, row);
-                }
-            }
-        }
-        _ => {}
-    }
-    Value::Array(
-        out.into_iter()
-            .map(|(s, c)| json!({ "segment": s, "channels": c }))
-            .collect(),
-    )
-}
-
-/// Min, max, mean and span of a time series' values, or null when empty.
-fn stats(series: &[(f64, f64)]) -> Value {
+/// Min, max, mean and span of a time series' values, or `None` when empty.
+fn stats(series: &[(f64, f64)]) -> Option<Value> {
     let vals: Vec<f64> = series
         .iter()
         .map(|p| p.1)
         .filter(|v| v.is_finite())
         .collect();
     if vals.is_empty() {
-        return Value::Null;
+        return None;
     }
     let min = vals.iter().copied().fold(f64::INFINITY, f64::min);
     let max = vals.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let mean = vals.iter().sum::<f64>() / vals.len() as f64;
     let t0 = series.first().map_or(0.0, |p| p.0);
     let t1 = series.last().map_or(0.0, |p| p.0);
-    json!({ "min": min, "max": max, "mean": mean, "span": max - min, "duration_s": t1 - t0 })
+    Some(json!({ "min": min, "max": max, "mean": mean, "span": max - min, "duration_s": t1 - t0 }))
 }

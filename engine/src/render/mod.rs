@@ -20,6 +20,7 @@ pub mod filters;
 mod plots;
 mod process;
 pub mod svg;
+mod views;
 
 pub use context::CONTEXT_FORMAT;
 pub use error::{RenderError, TemplateError};

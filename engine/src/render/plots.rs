@@ -27,7 +27,10 @@ pub fn draw(input: &ReportInput) -> Plots {
         "residuals_gyro",
         residuals(r, ["gx", "gy", "gz"], "Gyroscope residuals", "°/s"),
     );
-    named.insert("rate_fit", rate_fit(r));
+    named.insert(
+        "rate_fit",
+        rate_fit(r).or_else(|| rate_residuals(r, input.manifest.as_ref())),
+    );
     named.insert("allan", allan(r));
     named.insert("temperature", temperature(&input.temperature));
     let findings = match r.get("findings").and_then(Value::as_array) {
@@ -54,7 +57,7 @@ fn residual_rows(r: &Value) -> Vec<(String, String, f64, f64)> {
             .filter_map(|row| {
                 Some((
                     text(row, &["segment"])?.to_string(),
-                    text(row, &["channel"])?.to_string(),
+                    super::views::channel_key(row)?,
                     num(row, &["mean"])?,
                     num(row, &["std"]).unwrap_or(0.0),
                 ))
@@ -184,23 +187,91 @@ fn rate_fit(r: &Value) -> Option<String> {
     .to_svg()
 }
 
+/// Residual means (± std) of the gyro channels at each rate point against the nominal rate:
+/// what the rate-point fit leaves unexplained. Used when results.json has no `rate_points`.
+fn rate_residuals(r: &Value, manifest: Option<&Value>) -> Option<String> {
+    let segs = manifest?.get("segments")?.as_array()?;
+    let rate_of = |id: &str| {
+        segs.iter()
+            .find(|s| text(s, &["id"]) == Some(id) && text(s, &["kind"]) == Some("rate"))
+            .and_then(|s| {
+                Some((
+                    text(s, &["axis"]).unwrap_or("?").to_string(),
+                    num(s, &["rate_dps"])?,
+                ))
+            })
+    };
+    let mut series: Vec<Series> = vec![];
+    for (seg, ch, mean, std) in residual_rows(r) {
+        let Some((axis, rate)) = rate_of(&seg) else {
+            continue;
+        };
+        if !ch.starts_with('g') {
+            continue;
+        }
+        let name = format!("{axis}: {ch}");
+        let k = match series.iter().position(|s| s.name == name) {
+            Some(k) => k,
+            None => {
+                let n = series.len();
+                series.push(Series {
+                    name,
+                    points: vec![],
+                    err: Some(vec![]),
+                    style: Style::Markers,
+                    color: PALETTE[n % PALETTE.len()].into(),
+                });
+                n
+            }
+        };
+        // Spread the series a little around each rate so the error bars stay apart.
+        let dx = (k as f64 - 2.5) * 1.2;
+        series[k].points.push((rate + dx, mean));
+        if let Some(e) = series[k].err.as_mut() {
+            e.push(std);
+        }
+    }
+    Chart {
+        title: "Gyro rate-point fit: residuals (output − model)".into(),
+        x_label: "nominal table rate (°/s)".into(),
+        y_label: "residual (°/s)".into(),
+        series,
+        zero_line: true,
+        ..Chart::default()
+    }
+    .to_svg()
+}
+
 fn allan(r: &Value) -> Option<String> {
     let a = r.get("allan")?;
-    let chans = a
-        .get("channels")
-        .and_then(Value::as_object)
-        .or_else(|| a.as_object())?;
     let unit = a.get("unit").and_then(Value::as_str).unwrap_or("deg/s");
-    let series = chans
-        .iter()
-        .filter_map(|(ch, c)| {
-            let tau = c.get("tau_s").or_else(|| c.get("tau"))?.as_array()?;
-            let adev = c.get("adev")?.as_array()?;
-            Some((ch, tau, adev))
-        })
+    // results.json: `{tau_s, adev_dps: [x, y, z]}`; also `{channels: {gx: {tau_s, adev}}}`.
+    let mut curves: Vec<(String, &Vec<Value>, &Vec<Value>)> = vec![];
+    if let (Some(tau), Some(adev)) = (
+        a.get("tau_s").and_then(Value::as_array),
+        a.get("adev_dps").and_then(Value::as_array),
+    ) {
+        for (axis, d) in ["gx", "gy", "gz"].iter().zip(adev) {
+            if let Some(d) = d.as_array() {
+                curves.push((axis.to_string(), tau, d));
+            }
+        }
+    } else if let Some(chans) = a.get("channels").and_then(Value::as_object) {
+        for (ch, c) in chans {
+            let tau = c
+                .get("tau_s")
+                .or_else(|| c.get("tau"))
+                .and_then(Value::as_array);
+            if let (Some(tau), Some(d)) = (tau, c.get("adev").and_then(Value::as_array)) {
+                curves.push((ch.clone(), tau, d));
+            }
+        }
+    }
+    let series = curves
+        .into_iter()
         .enumerate()
         .map(|(k, (ch, tau, adev))| Series {
-            name: ch.clone(),
+            name: ch,
             points: tau
                 .iter()
                 .zip(adev)

@@ -7,23 +7,53 @@ use crate::plan::{
 };
 use serde_json::{Map, Value, json};
 
-/// The process description as JSON.
-pub fn describe(manifest: Option<&Map<String, Value>>, plan: Option<&Plan>) -> Value {
+/// The process description as JSON. Segments come from the manifest (or, without one,
+/// from results.json), each with what the analysis did with it (`used_for`,
+/// `outliers_removed`, `imu_samples`) when results.json says.
+pub fn describe(
+    manifest: Option<&Map<String, Value>>,
+    plan: Option<&Plan>,
+    results: &Value,
+) -> Value {
     let empty = vec![];
-    let segments = manifest
-        .and_then(|m| m.get("segments"))
+    let used = results
+        .get("segments")
         .and_then(Value::as_array)
         .unwrap_or(&empty);
+    let segments: Vec<Value> = manifest
+        .and_then(|m| m.get("segments"))
+        .and_then(Value::as_array)
+        .unwrap_or(used)
+        .iter()
+        .map(|s| {
+            let mut s = with_duration(s);
+            let id = s.get("id").cloned();
+            if let (Some(m), Some(u)) = (
+                s.as_object_mut(),
+                used.iter().find(|u| u.get("id") == id.as_ref()),
+            ) {
+                for k in ["used_for", "outliers_removed", "imu_samples"] {
+                    if let Some(v) = u.get(k) {
+                        m.entry(k).or_insert(v.clone());
+                    }
+                }
+            }
+            s
+        })
+        .collect();
     let of_kind = |kind: &str| -> Vec<Value> {
         segments
             .iter()
             .filter(|s| s.get("kind").and_then(Value::as_str) == Some(kind))
-            .map(with_duration)
+            .cloned()
             .collect()
     };
     let total: f64 = segments.iter().map(duration).sum();
+    let model = results.get("model");
     let mut out = json!({
-        "segments": segments.iter().map(with_duration).collect::<Vec<_>>(),
+        "segments": segments,
+        "selection": model.and_then(|m| m.get("selection")),
+        "applied_fits": model.and_then(|m| m.get("fits")).cloned().unwrap_or(json!([])),
         "static_points": of_kind("static"),
         "rate_points": of_kind("rate"),
         "oscillations": of_kind("oscillation"),

@@ -47,11 +47,23 @@ pub fn full() -> ReportInput {
     }
 }
 
-/// A recording from another acquisition system, with minimal results.
+/// A recording from another acquisition system (the shared example), analysed by `fit`
+/// without a procedure: no run block, no procedure block, no plan.
 pub fn foreign() -> ReportInput {
     ReportInput {
-        results: serde_json::from_str(&fixture("results-minimal.json")).unwrap(),
+        results: serde_json::from_str(&fixture("results-external.json")).unwrap(),
         manifest: Some(yaml("manifest-external.yaml")),
+        plan: None,
+        temperature: TemperatureSeries::default(),
+        ratecal_version: "0.1.0".into(),
+    }
+}
+
+/// Only the keys results.json must have; no manifest at all.
+pub fn minimal() -> ReportInput {
+    ReportInput {
+        results: serde_json::from_str(&fixture("results-minimal.json")).unwrap(),
+        manifest: None,
         plan: None,
         temperature: TemperatureSeries::default(),
         ratecal_version: "0.1.0".into(),
