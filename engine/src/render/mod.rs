@@ -46,6 +46,56 @@ pub struct ReportInput {
     pub ratecal_version: String,
 }
 
+impl ReportInput {
+    /// The input for a run in memory, as `ratecal run` has it after the analysis.
+    pub fn from_run(
+        results: &crate::results::Results,
+        manifest: &crate::recording::Manifest,
+        plan: Option<&Plan>,
+        recording: Option<&crate::recording::Recording>,
+        ratecal_version: &str,
+    ) -> Self {
+        ReportInput {
+            results: serde_json::to_value(results).unwrap_or_default(),
+            manifest: serde_json::to_value(manifest).ok(),
+            plan: plan.cloned(),
+            temperature: recording
+                .map(TemperatureSeries::from_recording)
+                .unwrap_or_default(),
+            ratecal_version: ratecal_version.to_string(),
+        }
+    }
+}
+
+/// Most points a temperature series keeps (the plot needs the shape, not every sample).
+pub const TEMPERATURE_POINTS: usize = 2000;
+
+impl TemperatureSeries {
+    /// The IMU `temp` column and the table's `ambient` column, thinned to at most
+    /// [`TEMPERATURE_POINTS`] each.
+    pub fn from_recording(rec: &crate::recording::Recording) -> Self {
+        let thin = |t: &[f64], v: &[f64]| -> Vec<(f64, f64)> {
+            let n = t.len().min(v.len());
+            let step = n.div_ceil(TEMPERATURE_POINTS).max(1);
+            (0..n).step_by(step).map(|i| (t[i], v[i])).collect()
+        };
+        TemperatureSeries {
+            imu: rec
+                .imu
+                .temp
+                .as_deref()
+                .map(|v| thin(&rec.imu.t, v))
+                .unwrap_or_default(),
+            ambient: rec
+                .table
+                .ambient
+                .as_deref()
+                .map(|v| thin(&rec.table.t, v))
+                .unwrap_or_default(),
+        }
+    }
+}
+
 /// Temperature samples `(t, degC)` on the stream clock, thinned or not.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TemperatureSeries {
