@@ -7,5 +7,6 @@ pub mod check;
 pub mod fit;
 pub mod plan;
 pub mod recording;
+pub mod render;
 pub mod results;
 pub mod run;
