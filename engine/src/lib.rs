@@ -3,5 +3,6 @@
 //! Results), `render` (Results -> report), `audit` (Plan vs Plan, run folders).
 //! Only `run` awaits; the engine does IO only through what it is handed.
 
+pub mod audit;
 pub mod plan;
 pub mod recording;
