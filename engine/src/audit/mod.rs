@@ -13,6 +13,8 @@ mod change;
 mod diff;
 mod direction;
 pub mod render;
+pub mod verify;
+pub mod versions;
 
 pub use change::{Change, ChangeKind, DiffReport, Side};
 pub use diff::diff;

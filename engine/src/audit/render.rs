@@ -2,20 +2,12 @@
 //! interface, and the one-line summary `ratecal log` prints per version.
 
 use super::change::{Change, ChangeKind, DiffReport};
-use serde_json::json;
 use std::fmt::Write as _;
 
-/// The JSON form: `{"old": {name, version, sha256}, "new": {...}, "changes": [{path, kind,
-/// old, new}]}`, `old`/`new` of a change being `null` when absent.
-pub fn json(report: &DiffReport) -> serde_json::Value {
-    let side =
-        |s: &super::change::Side| json!({"name": s.name, "version": s.version, "sha256": s.sha256});
-    let changes: Vec<_> = report
-        .changes
-        .iter()
-        .map(|c| json!({"path": c.path, "kind": c.kind.as_str(), "old": c.old, "new": c.new}))
-        .collect();
-    json!({"old": side(&report.old), "new": side(&report.new), "changes": changes})
+/// The JSON form, keys in this order: `{"old": {name, version, sha256}, "new": {...},
+/// "changes": [{path, kind, old, new}]}`, a change's `old`/`new` being `null` when absent.
+pub fn json(report: &DiffReport) -> String {
+    serde_json::to_string_pretty(report).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
 }
 
 /// Whether a change is about an abort rule (its loosening is a weakening).
