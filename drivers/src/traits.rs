@@ -140,10 +140,7 @@ pub struct DriverError {
 impl DriverError {
     /// Builds an error.
     pub fn new(kind: DriverErrorKind, message: impl Into<String>) -> Self {
-        DriverError {
-            kind,
-            message: message.into(),
-        }
+        DriverError { kind, message: message.into() }
     }
 
     /// Kind of the error.

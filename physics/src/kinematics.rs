@@ -110,14 +110,8 @@ impl TableState {
     /// A table at rest at the given angles (degrees).
     pub fn at_rest_deg(outer_deg: f64, inner_deg: f64) -> Self {
         TableState {
-            outer: AxisMotion {
-                angle: outer_deg * DEG,
-                ..Default::default()
-            },
-            inner: AxisMotion {
-                angle: inner_deg * DEG,
-                ..Default::default()
-            },
+            outer: AxisMotion { angle: outer_deg * DEG, ..Default::default() },
+            inner: AxisMotion { angle: inner_deg * DEG, ..Default::default() },
         }
     }
 
@@ -163,30 +157,17 @@ impl TableState {
 mod tests {
     use super::*;
 
-    const SITE: Site = Site {
-        latitude_deg: 55.7,
-        gravity_mps2: 9.8156,
-    };
+    const SITE: Site = Site { latitude_deg: 55.7, gravity_mps2: 9.8156 };
 
     #[test]
     fn static_attitudes_match_the_seed_formula() {
         let geo = Geometry::seed();
-        for (th, phi) in [
-            (0.0, 0.0),
-            (0.0, 180.0),
-            (90.0, 0.0),
-            (-90.0, 0.0),
-            (0.0, 90.0),
-            (37.0, -121.0),
-        ] {
+        for (th, phi) in [(0.0, 0.0), (0.0, 180.0), (90.0, 0.0), (-90.0, 0.0), (0.0, 90.0), (37.0, -121.0)] {
             let s = TableState::at_rest_deg(th, phi);
             let f = s.f_b(&geo, &SITE, &Vec3::zeros());
             let (t, p) = (th * DEG, phi * DEG);
             let want = Vec3::new(t.sin(), t.cos() * p.sin(), t.cos() * p.cos()) * SITE.gravity_mps2;
-            assert!(
-                (f - want).norm() < 1e-12,
-                "pitch {th} roll {phi}: {f} vs {want}"
-            );
+            assert!((f - want).norm() < 1e-12, "pitch {th} roll {phi}: {f} vs {want}");
         }
     }
 
@@ -206,16 +187,8 @@ mod tests {
     fn dw_p_matches_finite_difference() {
         let geo = Geometry::seed();
         let state = |t: f64| TableState {
-            outer: AxisMotion {
-                angle: 0.3 + 0.5 * t + 0.1 * t * t,
-                rate: 0.5 + 0.2 * t,
-                accel: 0.2,
-            },
-            inner: AxisMotion {
-                angle: -0.2 + 1.1 * t - 0.3 * t * t,
-                rate: 1.1 - 0.6 * t,
-                accel: -0.6,
-            },
+            outer: AxisMotion { angle: 0.3 + 0.5 * t + 0.1 * t * t, rate: 0.5 + 0.2 * t, accel: 0.2 },
+            inner: AxisMotion { angle: -0.2 + 1.1 * t - 0.3 * t * t, rate: 1.1 - 0.6 * t, accel: -0.6 },
         };
         let (t, h) = (0.7, 1e-6);
         let fd = (state(t + h).w_p(&geo) - state(t - h).w_p(&geo)) / (2.0 * h);

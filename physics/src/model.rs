@@ -60,39 +60,20 @@ pub struct IdealOutputs {
 }
 
 /// Noise-free sensed quantities for a table state.
-pub fn ideal_outputs(
-    state: &TableState,
-    geo: &Geometry,
-    site: &Site,
-    lever_m: &Mat3,
-) -> IdealOutputs {
+pub fn ideal_outputs(state: &TableState, geo: &Geometry, site: &Site, lever_m: &Mat3) -> IdealOutputs {
     let f_b0 = state.f_b(geo, site, &Vec3::zeros());
     let mut s = Vec3::zeros();
     for i in 0..3 {
         let r_i: Vec3 = lever_m.row(i).transpose();
-        let f = if r_i == Vec3::zeros() {
-            f_b0
-        } else {
-            state.f_b(geo, site, &(geo.c_pb * r_i))
-        };
+        let f = if r_i == Vec3::zeros() { f_b0 } else { state.f_b(geo, site, &(geo.c_pb * r_i)) };
         s[i] = f[i];
     }
-    IdealOutputs {
-        s,
-        w_ib_dps: state.w_ib(geo, site) / DEG,
-        f_b0,
-    }
+    IdealOutputs { s, w_ib_dps: state.w_ib(geo, site) / DEG, f_b0 }
 }
 
 impl ImuErrors {
     /// Noise-free accelerometer (m/s^2) and gyro (deg/s) outputs at temperature `temp_c`.
-    pub fn measure(
-        &self,
-        state: &TableState,
-        geo: &Geometry,
-        site: &Site,
-        temp_c: f64,
-    ) -> (Vec3, Vec3) {
+    pub fn measure(&self, state: &TableState, geo: &Geometry, site: &Site, temp_c: f64) -> (Vec3, Vec3) {
         let ideal = ideal_outputs(state, geo, site, &self.lever_m);
         self.apply(&ideal, temp_c)
     }
@@ -103,8 +84,7 @@ impl ImuErrors {
         let a = self.k_a * ideal.s + self.b_a + self.accel_thermal * dt;
         let w = ideal.w_ib_dps;
         let nonlin = Vec3::from_fn(|i, _| self.gyro_nonlinearity[i] * 1e-6 * w[i] * w[i].abs());
-        let g =
-            self.k_g * w + self.b_g + self.gyro_thermal * dt + self.g_sens * ideal.f_b0 + nonlin;
+        let g = self.k_g * w + self.b_g + self.gyro_thermal * dt + self.g_sens * ideal.f_b0 + nonlin;
         (a, g)
     }
 }

@@ -111,10 +111,7 @@ pub const UNITS: &[(&str, Dim, f64)] = &[
 
 /// Looks a unit up by name.
 pub fn unit(name: &str) -> Option<(Dim, f64)> {
-    UNITS
-        .iter()
-        .find(|(n, _, _)| *n == name)
-        .map(|&(_, d, f)| (d, f))
+    UNITS.iter().find(|(n, _, _)| *n == name).map(|&(_, d, f)| (d, f))
 }
 
 /// Converts `value unit` to the internal unit of its dimension. Kelvin is an absolute
@@ -122,11 +119,7 @@ pub fn unit(name: &str) -> Option<(Dim, f64)> {
 /// converting `K` bands as differences themselves.
 pub fn to_internal(value: f64, unit_name: &str) -> Option<(Dim, f64)> {
     let (dim, factor) = unit(unit_name)?;
-    let v = if unit_name == "K" {
-        value - 273.15
-    } else {
-        value * factor
-    };
+    let v = if unit_name == "K" { value - 273.15 } else { value * factor };
     Some((dim, v))
 }
 
@@ -135,13 +128,7 @@ pub fn parse_quantity(text: &str) -> Option<(Dim, f64)> {
     let text = text.trim();
     let split = text
         .char_indices()
-        .find(|&(i, c)| {
-            !(c.is_ascii_digit()
-                || c == '.'
-                || c == 'e'
-                || c == 'E'
-                || ((c == '-' || c == '+') && (i == 0 || text[..i].ends_with(['e', 'E']))))
-        })
+        .find(|&(i, c)| !(c.is_ascii_digit() || c == '.' || c == 'e' || c == 'E' || ((c == '-' || c == '+') && (i == 0 || text[..i].ends_with(['e', 'E'])))))
         .map(|(i, _)| i)
         .unwrap_or(text.len());
     let value: f64 = text[..split].trim().parse().ok()?;
@@ -159,16 +146,10 @@ mod tests {
     #[test]
     fn conversions() {
         assert_eq!(parse_quantity("5 arcsec"), Some((Dim::Angle, 5.0 / 3600.0)));
-        assert_eq!(
-            parse_quantity("0.001 g"),
-            Some((Dim::Accel, 0.001 * 9.80665))
-        );
+        assert_eq!(parse_quantity("0.001 g"), Some((Dim::Accel, 0.001 * 9.80665)));
         assert_eq!(parse_quantity("-100 deg/s"), Some((Dim::Rate, -100.0)));
         assert_eq!(parse_quantity("1e-3 m/s^2"), Some((Dim::Accel, 1e-3)));
-        assert_eq!(
-            parse_quantity("293.15 K"),
-            Some((Dim::Temperature, 0.0 + 20.0))
-        );
+        assert_eq!(parse_quantity("293.15 K"), Some((Dim::Temperature, 0.0 + 20.0)));
         assert_eq!(parse_quantity("3 furlongs"), None);
         assert_eq!(parse_quantity("60 min").map(|q| q.1), Some(3600.0));
     }

@@ -464,10 +464,7 @@ mod tests {
         assert!(segment_matches("accel_static/*", "accel_static/4"));
         assert!(segment_matches("gyro_bias", "gyro_bias"));
         assert!(!segment_matches("gyro_bias", "gyro_bias/2"));
-        assert!(segment_matches(
-            "gyro_scale/*/+100",
-            "gyro_scale/outer/+100"
-        ));
+        assert!(segment_matches("gyro_scale/*/+100", "gyro_scale/outer/+100"));
         assert!(!segment_matches("accel_static/*", "gyro_scale/outer/+100"));
     }
 }
