@@ -233,6 +233,6 @@ async fn noise_has_the_configured_size() {
     // Per-sample sigma = density * sqrt(100 Hz); differencing cancels the slow terms.
     let sa = std(&|x| x.accel[2]);
     let sg = std(&|x| x.gyro[0]);
-    assert!((sa / (5e-6 * 9.80665 * 10.0) - 1.0).abs() < 0.05, "{sa}");
+    assert!((sa / (2e-6 * 9.80665 * 10.0) - 1.0).abs() < 0.05, "{sa}");
     assert!((sg / 0.003 - 1.0).abs() < 0.05, "{sg}");
 }
