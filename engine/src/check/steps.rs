@@ -310,10 +310,7 @@ impl Ck<'_> {
                 let d = self.quantity(duration, Dim::Time, "an acquisition duration");
                 let r = self.quantity(rate, Dim::Frequency, "a sample rate");
                 let id = self.segment_id(&segment.node, segment.span);
-                let (Some(d), Some(r), Some(id)) = (d, r, id) else {
-                    return;
-                };
-                self.walk.time_s += d.value;
+                let Some(id) = id else { return };
                 let repeats = self
                     .walk
                     .repeats
@@ -321,12 +318,16 @@ impl Ck<'_> {
                     .filter(|(_, n)| *n > 1)
                     .map(|(v, _)| v.clone())
                     .collect();
+                // Registered even when its duration or rate is wrong, so that fits naming
+                // it do not report a second, spurious error.
                 self.walk.segments.push(SegInfo {
                     id: id.clone(),
                     span: segment.span,
                     motion: self.walk.motion.clone(),
                     repeats,
                 });
+                let (Some(d), Some(r)) = (d, r) else { return };
+                self.walk.time_s += d.value;
                 out.push(Node::Do(Action::Acquire(Acquire {
                     segment: id,
                     channels: channels.iter().map(|c| c.node.clone()).collect(),
@@ -414,12 +415,7 @@ impl Ck<'_> {
                     [m[(2, 0)], m[(2, 1)], m[(2, 2)]],
                 ];
                 let message = message.as_ref().map_or_else(
-                    || {
-                        format!(
-                            "Remount the IMU with its {} axis up",
-                            name.to_uppercase()
-                        )
-                    },
+                    || format!("Remount the IMU with its {} axis up", name.to_uppercase()),
                     |m| m.node.clone(),
                 );
                 out.push(Node::Do(Action::Remount { rotation, message }));
