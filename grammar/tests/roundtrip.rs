@@ -82,11 +82,9 @@ fn body(depth: u32) -> BoxedStrategy<Vec<String>> {
 /// Joins tokens of a text with random whitespace, `;` and comments at line ends.
 fn scramble(text: &str, seps: &[u8]) -> String {
     let mut out = String::new();
-    let mut k = 0;
-    for line in text.lines() {
+    for (k, line) in text.lines().enumerate() {
         out.push_str(line);
         let s = seps.get(k).copied().unwrap_or(0);
-        k += 1;
         match s % 6 {
             0 => out.push('\n'),
             1 => out.push_str("\n\n"),
