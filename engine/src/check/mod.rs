@@ -15,7 +15,9 @@
 //! `check::station_limit`, `check::import`, `check::structure`, `check::missing_runs`.
 
 mod header;
+mod motion;
 mod observe;
+mod segments;
 mod steps;
 mod values;
 

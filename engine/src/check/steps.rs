@@ -3,12 +3,10 @@
 
 use super::values::{RVal, Val, suggest};
 use super::{Ck, MAX_EXPANDED_ACTIONS, mount_up};
-use crate::plan::{
-    Acquire, Action, Axis, Dim, Node, OnTimeout, Plan, Settle, Signal, Stability, Step,
-};
+use crate::plan::{Acquire, Action, Axis, Dim, Node, OnTimeout, Plan, Settle, Step};
 use ratecal_grammar::Diagnostic;
 use ratecal_grammar::ast::{self, Block, Span, Stmt, Value, ValueKind};
-use ratecal_physics::{Mat3, TableState};
+use ratecal_physics::Mat3;
 
 /// Table rate used for the duration estimate when no station is given, deg/s.
 pub const DEFAULT_MAX_RATE_DPS: f64 = 300.0;
@@ -92,7 +90,7 @@ pub(crate) struct Walk {
     pub verify_from: Vec<ast::Spanned<String>>,
 }
 
-fn move_time(dist_deg: f64, v: f64, a: f64) -> f64 {
+pub(crate) fn move_time(dist_deg: f64, v: f64, a: f64) -> f64 {
     let d = dist_deg.abs();
     if d >= v * v / a {
         d / v + v / a
@@ -102,7 +100,7 @@ fn move_time(dist_deg: f64, v: f64, a: f64) -> f64 {
 }
 
 impl Ck<'_> {
-    fn table_limits(&self) -> (f64, f64) {
+    pub(crate) fn table_limits(&self) -> (f64, f64) {
         self.station
             .as_ref()
             .map_or((DEFAULT_MAX_RATE_DPS, DEFAULT_MAX_ACCEL_DPS2), |s| {
@@ -205,9 +203,12 @@ impl Ck<'_> {
             }
             Stmt::Spin { axis, rate } => {
                 let ax = self.axis(axis);
-                let r = self.quantity(rate, Dim::Rate, "a spin rate");
+                // Limits are reported on the value as written (a list element in a loop).
+                let rv = self.resolve(rate, None);
+                let at = rv.as_ref().map_or(rate.span, |r| r.span);
+                let r = rv.and_then(|r| self.as_quantity(&r, rate, Dim::Rate, "a spin rate"));
                 if let (Some(ax), Some(r)) = (ax, r) {
-                    self.spin(ax, r.value, rate.span);
+                    self.spin(ax, r.value, at);
                     out.push(Node::Do(Action::Spin {
                         axis: ax,
                         rate_dps: r.value,
@@ -310,10 +311,7 @@ impl Ck<'_> {
                 let d = self.quantity(duration, Dim::Time, "an acquisition duration");
                 let r = self.quantity(rate, Dim::Frequency, "a sample rate");
                 let id = self.segment_id(&segment.node, segment.span);
-                let (Some(d), Some(r), Some(id)) = (d, r, id) else {
-                    return;
-                };
-                self.walk.time_s += d.value;
+                let Some(id) = id else { return };
                 let repeats = self
                     .walk
                     .repeats
@@ -321,12 +319,16 @@ impl Ck<'_> {
                     .filter(|(_, n)| *n > 1)
                     .map(|(v, _)| v.clone())
                     .collect();
+                // Registered even when its duration or rate is wrong, so that fits naming
+                // it do not report a second, spurious error.
                 self.walk.segments.push(SegInfo {
                     id: id.clone(),
                     span: segment.span,
                     motion: self.walk.motion.clone(),
                     repeats,
                 });
+                let (Some(d), Some(r)) = (d, r) else { return };
+                self.walk.time_s += d.value;
                 out.push(Node::Do(Action::Acquire(Acquire {
                     segment: id,
                     channels: channels.iter().map(|c| c.node.clone()).collect(),
@@ -414,12 +416,7 @@ impl Ck<'_> {
                     [m[(2, 0)], m[(2, 1)], m[(2, 2)]],
                 ];
                 let message = message.as_ref().map_or_else(
-                    || {
-                        format!(
-                            "Remount the IMU with its {} axis up",
-                            name.to_uppercase()
-                        )
-                    },
+                    || format!("Remount the IMU with its {} axis up", name.to_uppercase()),
                     |m| m.node.clone(),
                 );
                 out.push(Node::Do(Action::Remount { rotation, message }));
@@ -490,465 +487,5 @@ impl Ck<'_> {
             self.scopes.pop();
             out.extend(nodes);
         }
-    }
-
-    fn move_to(&mut self, angles: &[ast::Angle], span: Span) -> Option<Action> {
-        let (mut outer, mut inner) = (None, None);
-        let mut origin: Option<Span> = None;
-        let mut pitch_roll = false;
-        let mut ok = true;
-        for a in angles {
-            let slot = match a.axis.node.as_str() {
-                "pitch" | "outer" => &mut outer,
-                "roll" | "inner" => &mut inner,
-                other => {
-                    self.err(
-                        Diagnostic::error(
-                            "check::unknown_name",
-                            format!("unknown table angle `{other}`"),
-                        )
-                        .label(a.axis.span, "not an angle name")
-                        .help(suggest(other, &["pitch", "roll", "outer", "inner"])),
-                    );
-                    ok = false;
-                    continue;
-                }
-            };
-            pitch_roll |= matches!(a.axis.node.as_str(), "pitch" | "roll");
-            if slot.is_some() {
-                self.err(
-                    Diagnostic::error(
-                        "check::structure",
-                        format!("`{}` is given twice", a.axis.node),
-                    )
-                    .label(a.axis.span, "second value for the same axis")
-                    .help("pitch is the outer axis, roll the inner one"),
-                );
-                ok = false;
-                continue;
-            }
-            let Some(r) = self.resolve(&a.value, None) else {
-                ok = false;
-                continue;
-            };
-            origin = Some(origin.map_or(
-                r.span,
-                |o: Span| if o == r.span { o } else { o.join(r.span) },
-            ));
-            match self.as_quantity(&r, &a.value, Dim::Angle, "a table angle") {
-                Some(q) => *slot = Some(q.value),
-                None => ok = false,
-            }
-        }
-        if !ok {
-            return None;
-        }
-        let m = &self.walk.motion;
-        let outer_deg = outer.or(m.outer).unwrap_or(0.0);
-        let inner_deg = inner.or(m.inner).unwrap_or(0.0);
-        let (v, a) = self.table_limits();
-        let stop_t = (m.outer_rate.abs().max(m.inner_rate.abs())) / a;
-        let t = move_time(outer_deg - m.outer.unwrap_or(0.0), v, a).max(move_time(
-            inner_deg - m.inner.unwrap_or(0.0),
-            v,
-            a,
-        ));
-        self.walk.time_s += stop_t + t;
-        let mount = m.mount;
-        self.walk.motion = super::steps::Motion {
-            outer: Some(outer_deg),
-            inner: Some(inner_deg),
-            mount,
-            origin: origin.unwrap_or(span),
-            pitch_roll,
-            ..Default::default()
-        };
-        Some(Action::MoveTo {
-            outer_deg,
-            inner_deg,
-        })
-    }
-
-    pub(crate) fn axis(&mut self, v: &Value) -> Option<Axis> {
-        let r = self.resolve(v, None)?;
-        match &r.v {
-            Val::Sym(s) | Val::Str(s) => match s.as_str() {
-                "outer" | "pitch" => Some(Axis::Outer),
-                "inner" | "roll" => Some(Axis::Inner),
-                other => {
-                    let mut names = vec!["outer", "inner", "pitch", "roll"];
-                    let known = self.known_names();
-                    names.extend(known.iter().map(String::as_str));
-                    self.err(
-                        Diagnostic::error("check::unknown_name", format!("unknown axis `{other}`"))
-                            .label(v.span, "not a table axis")
-                            .help(suggest(other, &names)),
-                    );
-                    None
-                }
-            },
-            _ => {
-                self.err(
-                    Diagnostic::error("check::type_mismatch", "expected a table axis")
-                        .label(r.span, "not an axis")
-                        .help("write `outer` (pitch) or `inner` (roll)"),
-                );
-                None
-            }
-        }
-    }
-
-    fn spin(&mut self, ax: Axis, rate: f64, span: Span) {
-        let (_, a) = self.table_limits();
-        let m = &mut self.walk.motion;
-        let cur = match ax {
-            Axis::Outer => &mut m.outer_rate,
-            Axis::Inner => &mut m.inner_rate,
-        };
-        let dt = (rate - *cur).abs() / a;
-        *cur = rate;
-        match ax {
-            Axis::Outer => m.outer = None,
-            Axis::Inner => m.inner = None,
-        }
-        m.osc = None;
-        self.walk.time_s += dt;
-        self.rate_limits(span);
-    }
-
-    fn stop(&mut self, ax: Option<Axis>) {
-        let (_, a) = self.table_limits();
-        let m = &mut self.walk.motion;
-        let mut dt: f64 = 0.0;
-        if ax != Some(Axis::Inner) {
-            dt = dt.max(m.outer_rate.abs() / a);
-            if m.outer_rate != 0.0 || matches!(m.osc, Some((Axis::Outer, ..))) {
-                m.outer = None;
-            }
-            m.outer_rate = 0.0;
-        }
-        if ax != Some(Axis::Outer) {
-            dt = dt.max(m.inner_rate.abs() / a);
-            if m.inner_rate != 0.0 || matches!(m.osc, Some((Axis::Inner, ..))) {
-                m.inner = None;
-            }
-            m.inner_rate = 0.0;
-        }
-        if ax.is_none() || m.osc.is_some_and(|o| Some(o.0) == ax) {
-            m.osc = None;
-        }
-        self.walk.time_s += dt;
-    }
-
-    fn oscillate(
-        &mut self,
-        ax: Axis,
-        amp_deg: f64,
-        period_s: f64,
-        center: Option<f64>,
-        span: Span,
-    ) {
-        let m = &mut self.walk.motion;
-        match ax {
-            Axis::Outer => m.outer = center.or(m.outer),
-            Axis::Inner => m.inner = center.or(m.inner),
-        }
-        m.osc = Some((ax, amp_deg, period_s));
-        let w = 2.0 * std::f64::consts::PI / period_s;
-        let (peak_rate, peak_acc) = (amp_deg.abs() * w, amp_deg.abs() * w * w);
-        if let Some(st) = self.station.clone()
-            && peak_acc > st.max_accel_dps2
-        {
-            {
-                self.err(
-                    Diagnostic::error(
-                        "check::station_limit",
-                        "the oscillation exceeds the table's angular acceleration",
-                    )
-                    .label(
-                        span,
-                        format!(
-                            "peak {peak_acc:.1} deg/s^2, the table allows {} deg/s^2",
-                            st.max_accel_dps2
-                        ),
-                    )
-                    .help("lower the amplitude or lengthen the period"),
-                );
-            }
-        }
-        self.rate_check(ax, peak_rate, span);
-    }
-
-    fn rate_limits(&mut self, span: Span) {
-        let m = self.walk.motion.clone();
-        if m.outer_rate != 0.0 {
-            self.rate_check(Axis::Outer, m.outer_rate, span);
-        }
-        if m.inner_rate != 0.0 {
-            self.rate_check(Axis::Inner, m.inner_rate, span);
-        }
-    }
-
-    /// Compares a rate about an axis with the table's maximum and, projected on the body
-    /// axes, with the gyro range.
-    fn rate_check(&mut self, ax: Axis, rate: f64, span: Span) {
-        let Some(st) = self.station.clone() else {
-            return;
-        };
-        if rate.abs() > st.max_rate_dps {
-            self.err(
-                Diagnostic::error("check::station_limit", "rate above the table's maximum")
-                    .label(
-                        span,
-                        format!(
-                            "{} deg/s, the table allows {} deg/s",
-                            rate.abs(),
-                            st.max_rate_dps
-                        ),
-                    )
-                    .help("lower the rate or use a faster table"),
-            );
-        }
-        let m = &self.walk.motion;
-        let mut state = TableState::at_rest_deg(m.outer.unwrap_or(0.0), m.inner.unwrap_or(0.0));
-        let r = rate.to_radians();
-        match ax {
-            Axis::Outer => state.outer.rate = r,
-            Axis::Inner => state.inner.rate = r,
-        }
-        let w_b = state
-            .w_b(&st.geometry.with_mount(m.mount))
-            .map(f64::to_degrees);
-        if let Some(i) = (0..3).find(|&i| w_b[i].abs() > st.gyro_range_dps * (1.0 + 1e-9)) {
-            self.err(
-                Diagnostic::error("check::station_limit", "rate above the IMU's gyro range")
-                    .label(
-                        span,
-                        format!(
-                            "{:.1} deg/s on {}, the gyro range is {} deg/s",
-                            w_b[i].abs(),
-                            ["X", "Y", "Z"][i],
-                            st.gyro_range_dps
-                        ),
-                    )
-                    .help("lower the rate below the gyro range"),
-            );
-        }
-    }
-
-    fn settle(&mut self, b: &Block<ast::SettleItem>) -> Settle {
-        let mut st = Settle {
-            min_time_s: 0.0,
-            stable: Vec::new(),
-            attitude_error_deg: None,
-            rate_error_dps: None,
-            timeout_s: None,
-            on_timeout: OnTimeout::Abort,
-        };
-        for item in &b.items {
-            match &item.node {
-                ast::SettleItem::AtLeast(v) => {
-                    if let Some(q) = self.quantity(v, Dim::Time, "a settle time") {
-                        st.min_time_s = q.value;
-                    }
-                }
-                ast::SettleItem::Timeout(v, act) => {
-                    if let Some(q) = self.quantity(v, Dim::Time, "a timeout") {
-                        st.timeout_s = Some(q.value);
-                    }
-                    if let Some(a) = act {
-                        st.on_timeout = match a.node.as_str() {
-                            "abort" => OnTimeout::Abort,
-                            "warn" => OnTimeout::Warn,
-                            "continue" => OnTimeout::Continue,
-                            other => {
-                                self.err(
-                                    Diagnostic::error(
-                                        "check::unknown_name",
-                                        format!("unknown timeout action `{other}`"),
-                                    )
-                                    .label(a.span, "not an action")
-                                    .help(suggest(other, &["abort", "warn", "continue"])),
-                                );
-                                OnTimeout::Abort
-                            }
-                        };
-                    }
-                }
-                ast::SettleItem::Fluctuation {
-                    signal,
-                    value,
-                    window,
-                    ..
-                } => {
-                    let (sig, dim) = match signal.node.as_str() {
-                        "accel" => (Signal::Accel, Dim::Accel),
-                        "gyro" => (Signal::Gyro, Dim::Rate),
-                        other => {
-                            self.err(
-                                Diagnostic::error(
-                                    "check::unknown_name",
-                                    format!("unknown signal `{other}`"),
-                                )
-                                .label(signal.span, "no fluctuation limit on this signal")
-                                .help(suggest(other, &["accel", "gyro"])),
-                            );
-                            continue;
-                        }
-                    };
-                    let q = self.quantity(value, dim, "a fluctuation limit");
-                    let w = self.quantity(window, Dim::Time, "a stability window");
-                    if let (Some(q), Some(w)) = (q, w) {
-                        st.stable.push(Stability {
-                            signal: sig,
-                            max_fluctuation: q.value,
-                            window_s: w.value,
-                        });
-                    }
-                }
-                ast::SettleItem::Limit(l) => match l.name.node.as_str() {
-                    "table.attitude_error" => {
-                        st.attitude_error_deg = self
-                            .quantity(&l.value, Dim::Angle, "an attitude error limit")
-                            .map(|q| q.value)
-                    }
-                    "table.rate_error" => {
-                        st.rate_error_dps = self
-                            .quantity(&l.value, Dim::Rate, "a rate error limit")
-                            .map(|q| q.value)
-                    }
-                    other => self.err(
-                        Diagnostic::error(
-                            "check::unknown_name",
-                            format!("unknown settle condition `{other}`"),
-                        )
-                        .label(l.name.span, "not a settle condition")
-                        .help(suggest(
-                            other,
-                            &[
-                                "table.attitude_error",
-                                "table.rate_error",
-                                "accel fluctuation",
-                                "gyro fluctuation",
-                            ],
-                        )),
-                    ),
-                },
-            }
-        }
-        st
-    }
-
-    /// Expands `{var}` / `{var:+}` in a segment name; repeat indices stay as `{var}`.
-    fn segment_id(&mut self, template: &str, span: Span) -> Option<String> {
-        let mut out = String::new();
-        let mut rest = template;
-        while let Some(open) = rest.find('{') {
-            out.push_str(&rest[..open]);
-            let Some(close) = rest[open..].find('}') else {
-                self.err(
-                    Diagnostic::error("check::bad_segment_name", "unclosed `{` in a segment name")
-                        .label(span, "here")
-                        .help("write `{name}` to insert a loop variable"),
-                );
-                return None;
-            };
-            let inner = &rest[open + 1..open + close];
-            let (name, plus) = match inner.strip_suffix(":+") {
-                Some(n) => (n, true),
-                None => (inner, false),
-            };
-            if self.walk.repeats.iter().any(|(v, _)| v == name) {
-                out.push_str(&rest[open..open + close + 1]);
-            } else {
-                let found = self
-                    .scopes
-                    .iter()
-                    .rev()
-                    .flat_map(|s| s.iter())
-                    .find(|(n, _)| n == name)
-                    .map(|(_, v)| v.clone());
-                match found.map(|v| v.v) {
-                    Some(Val::Num { text, q }) => {
-                        if plus && !text.starts_with(['+', '-']) {
-                            out.push('+');
-                        }
-                        let _ = q;
-                        out.push_str(&text);
-                    }
-                    Some(Val::Sym(s)) | Some(Val::Str(s)) => out.push_str(&s),
-                    Some(_) => {
-                        self.err(
-                            Diagnostic::error(
-                                "check::type_mismatch",
-                                format!("`{name}` cannot go in a segment name"),
-                            )
-                            .label(span, "a list or tuple")
-                            .help("insert a number or a name"),
-                        );
-                        return None;
-                    }
-                    None => {
-                        let mut names: Vec<String> = self
-                            .scopes
-                            .iter()
-                            .flatten()
-                            .map(|(n, _)| n.clone())
-                            .collect();
-                        names.extend(self.walk.repeats.iter().map(|(v, _)| v.clone()));
-                        let refs: Vec<&str> = names.iter().map(String::as_str).collect();
-                        self.err(
-                            Diagnostic::error(
-                                "check::unknown_name",
-                                format!("unknown name `{name}` in a segment name"),
-                            )
-                            .label(span, "not a loop variable here")
-                            .help(if refs.is_empty() {
-                                "no loop variable is in scope here".to_string()
-                            } else {
-                                suggest(name, &refs)
-                            }),
-                        );
-                        return None;
-                    }
-                }
-            }
-            rest = &rest[open + close + 1..];
-        }
-        out.push_str(rest);
-        Some(out)
-    }
-
-    /// Duplicate segments, and segments inside repeats that do not use the index.
-    pub(crate) fn finish_segments(&mut self) {
-        let segs = std::mem::take(&mut self.walk.segments);
-        let mut seen: std::collections::HashMap<&str, Span> = std::collections::HashMap::new();
-        for s in &segs {
-            for v in &s.repeats {
-                if v.is_empty() || !s.id.contains(&format!("{{{v}}}")) {
-                    self.err(
-                        Diagnostic::error("check::segment_in_repeat", format!("segment `{}` would be recorded once per repetition under the same name", s.id))
-                            .label(s.span, "inside a `repeat`")
-                            .help("name the index (`repeat 3 as run`) and use it: \"name/{run}\""),
-                    );
-                }
-            }
-            if let Some(first) = seen.get(s.id.as_str()) {
-                let mut d = Diagnostic::error(
-                    "check::duplicate_segment",
-                    format!("segment `{}` is recorded twice", s.id),
-                )
-                .label(s.span, "recorded again here");
-                if *first != s.span {
-                    d = d.label(*first, "first recorded here");
-                }
-                self.err(d.help(
-                    "segment names must be unique: insert a loop variable, e.g. \"name/{n}\"",
-                ));
-            } else {
-                seen.insert(&s.id, s.span);
-            }
-        }
-        self.walk.segments = segs;
     }
 }

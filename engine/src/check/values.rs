@@ -289,9 +289,10 @@ fn respan(mut r: RVal, span: Span) -> RVal {
 }
 
 fn article(d: Dim) -> &'static str {
-    match d {
-        Dim::Angle | Dim::Accel => "an",
-        _ => "a",
+    if d.name().starts_with(['a', 'e', 'i', 'o', 'u']) {
+        "an"
+    } else {
+        "a"
     }
 }
 
