@@ -124,9 +124,11 @@ fn axis(values: impl Iterator<Item = f64>, log: bool) -> Option<Axis> {
         return None;
     }
     if log {
+        // A decade computed as -1.9999999 must not add an empty decade below.
+        let (lo, hi) = ((lo + 1e-9).floor(), (hi - 1e-9).ceil());
         return Some(Axis {
-            lo: lo.floor(),
-            hi: hi.ceil().max(lo.floor() + 1.0),
+            lo,
+            hi: hi.max(lo + 1.0),
             log,
         });
     }
