@@ -4,20 +4,29 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+/// The shared example recording when this machine has it (streams included), else just
+/// its manifest from the fixtures: a report needs results.json and the manifest only.
 fn run_dir() -> tempfile::TempDir {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let example = root.join("../shared/examples/standard-with-lever-arm");
-    let example = if example.is_dir() {
-        example
-    } else {
-        PathBuf::from("/work/shared/examples/standard-with-lever-arm")
-    };
+    let fixtures = root.join("engine/tests/fixtures/report");
+    let example = PathBuf::from("/work/shared/examples/standard-with-lever-arm");
     let dir = tempfile::tempdir().unwrap();
-    for f in ["manifest.yaml", "imu.csv", "table.csv"] {
-        std::fs::copy(example.join(f), dir.path().join(f)).unwrap();
+    if example.is_dir() {
+        for f in ["manifest.yaml", "imu.csv", "table.csv"] {
+            std::fs::copy(example.join(f), dir.path().join(f)).unwrap();
+        }
+    } else {
+        std::fs::copy(
+            fixtures.join("manifest-external.yaml"),
+            dir.path().join("manifest.yaml"),
+        )
+        .unwrap();
     }
-    let results = root.join("engine/tests/fixtures/report/results-external.json");
-    std::fs::copy(results, dir.path().join("results.json")).unwrap();
+    std::fs::copy(
+        fixtures.join("results-external.json"),
+        dir.path().join("results.json"),
+    )
+    .unwrap();
     dir
 }
 
@@ -56,7 +65,12 @@ fn markdown_to_stdout_and_html_to_a_file() {
     assert!(stdout.is_empty());
     let html = std::fs::read_to_string(out).unwrap();
     // The streams' temp column gives the temperature plot besides the results' plots.
-    assert!(html.contains("<title>Temperature over the run"));
+    let has_streams = dir.path().join("imu.csv").is_file();
+    assert_eq!(
+        html.contains("<title>Temperature over the run"),
+        has_streams
+    );
+    assert!(html.contains("<title>Allan deviation"));
 }
 
 #[test]
