@@ -241,6 +241,12 @@ pub fn render_all(input: &ReportInput, templates: &Templates) -> Result<Vec<Repo
         .collect()
 }
 
+/// The data model a template sees, as JSON, without `plots` and `template` (which hold
+/// SVG markup and the template's name). Documented in `docs/report-templates.md`.
+pub fn context_json(input: &ReportInput) -> serde_json::Value {
+    context::build(input)
+}
+
 fn environment(templates: &Templates) -> Environment<'static> {
     let mut env = Environment::new();
     env.set_debug(true);

@@ -98,18 +98,14 @@ impl Axis {
     }
 }
 
+/// The round step (1, 2 or 5 times a power of ten) nearest to `raw` on a log scale.
 fn nice_step(raw: f64) -> f64 {
     let mag = 10f64.powf(raw.log10().floor());
     let f = raw / mag;
-    let nice = if f <= 1.0 {
-        1.0
-    } else if f <= 2.0 {
-        2.0
-    } else if f <= 5.0 {
-        5.0
-    } else {
-        10.0
-    };
+    let nice = [1.0, 2.0, 5.0, 10.0]
+        .into_iter()
+        .min_by(|a: &f64, b: &f64| (a / f).ln().abs().total_cmp(&(b / f).ln().abs()))
+        .unwrap_or(1.0);
     nice * mag
 }
 
@@ -124,9 +120,11 @@ fn axis(values: impl Iterator<Item = f64>, log: bool) -> Option<Axis> {
         return None;
     }
     if log {
+        // A decade computed as -1.9999999 must not add an empty decade below.
+        let (lo, hi) = ((lo + 1e-9).floor(), (hi - 1e-9).ceil());
         return Some(Axis {
-            lo: lo.floor(),
-            hi: hi.ceil().max(lo.floor() + 1.0),
+            lo,
+            hi: hi.max(lo + 1.0),
             log,
         });
     }
