@@ -1,17 +1,89 @@
-//! `ratecal log` (not implemented yet).
+//! `ratecal log FOLDER`: every version of a procedure folder, oldest first, with the
+//! SHA-256 of its canonical text, whether `versions.lock` records it as released, and a
+//! one-line summary of its semantic changes from the version before. Exit 0, or 2 when
+//! the folder or one of its versions cannot be read or checked.
 
+use ratecal_engine::audit::versions::{self, LOCK_FILE, Version};
+use ratecal_engine::audit::{diff, render};
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// Arguments of `ratecal log`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Inputs.
-    inputs: Vec<std::path::PathBuf>,
+    /// Procedure folder (one `<version>.rcal` per version and `versions.lock`).
+    folder: PathBuf,
+}
+
+/// Version files of a folder, sorted by version.
+pub(crate) fn version_files(folder: &Path) -> std::io::Result<Vec<(Version, PathBuf)>> {
+    let mut out = Vec::new();
+    for entry in std::fs::read_dir(folder)? {
+        let path = entry?.path();
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        if let Some(v) = versions::version_of_file_name(&name) {
+            out.push((v, path));
+        }
+    }
+    out.sort_by(|a, b| a.0.cmp(&b.0));
+    Ok(out)
 }
 
 /// Runs the subcommand.
 pub fn main(args: Args) -> ExitCode {
-    let _ = args.inputs;
-    eprintln!("ratecal log: not implemented yet");
-    ExitCode::from(1)
+    let folder = &args.folder;
+    let files = match version_files(folder) {
+        Ok(f) if !f.is_empty() => f,
+        Ok(_) | Err(_) => {
+            let e = miette::miette!(
+                code = "log::not_a_procedure_folder",
+                help =
+                    "give a folder holding <version>.rcal files, e.g. procedures/imu-2d-standard",
+                "{} holds no procedure versions",
+                folder.display()
+            );
+            eprintln!("{e:?}");
+            return ExitCode::from(2);
+        }
+    };
+    let lock_text = std::fs::read_to_string(folder.join(LOCK_FILE)).ok();
+    let lock = lock_text
+        .as_deref()
+        .map(|t| versions::parse_lock(LOCK_FILE, t).0)
+        .unwrap_or_default();
+    let mut previous: Option<super::diff::Loaded> = None;
+    let mut failed = false;
+    println!("{}", folder.display());
+    for (version, path) in files {
+        let Some(loaded) = super::diff::load_file(path) else {
+            println!(
+                "{version:<8} {:<64}  (does not check: see the errors above)",
+                "-"
+            );
+            failed = true;
+            continue;
+        };
+        let status = match lock
+            .iter()
+            .find(|e| Version::parse(&e.version).as_ref() == Some(&version))
+        {
+            Some(e) if e.sha256 == loaded.sha256 => "released",
+            Some(_) => "CHANGED AFTER RELEASE",
+            None => "unreleased",
+        };
+        let summary = match &previous {
+            None => "first version".to_string(),
+            Some(p) => render::summary(&diff(&p.plan, &loaded.plan)),
+        };
+        println!("{version:<8} {}  {status:<10}  {summary}", loaded.sha256);
+        previous = Some(loaded);
+    }
+    if failed {
+        ExitCode::from(2)
+    } else {
+        ExitCode::SUCCESS
+    }
 }
