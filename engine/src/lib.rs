@@ -4,5 +4,6 @@
 //! Only `run` awaits; the engine does IO only through what it is handed.
 
 pub mod audit;
+pub mod check;
 pub mod plan;
 pub mod recording;

@@ -2,10 +2,11 @@
 //! versions (files or `folder@version`), compared after parameters and imports are
 //! resolved. Exit codes like diff(1): 0 no semantic change, 1 changes, 2 error.
 
+use super::procedure::{self, FsSources};
 use ratecal_engine::audit::{self, render};
+use ratecal_engine::check::{CheckOptions, check_text};
 use ratecal_engine::plan::Plan;
 use std::io::IsTerminal;
-use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Output format.
@@ -40,36 +41,35 @@ pub(crate) struct Loaded {
 /// Resolves `file | folder | folder@version`, reads, checks and hashes a procedure. Its
 /// diagnostics go to standard error; `None` when it cannot be used.
 pub(crate) fn load(spec: &str) -> Option<Loaded> {
-    let path = match pending::resolve(spec) {
-        Ok(p) => p,
-        Err(e) => {
-            eprintln!("{e:?}");
-            return None;
+    match procedure::read(spec) {
+        Ok(f) => load_text(&f.display, &f.text),
+        Err(d) => {
+            procedure::report(&d);
+            None
         }
-    };
-    load_file(path)
+    }
 }
 
-/// Reads, checks and hashes one procedure file (diagnostics to standard error).
-pub(crate) fn load_file(path: PathBuf) -> Option<Loaded> {
-    let text = match std::fs::read_to_string(&path) {
-        Ok(t) => t,
-        Err(e) => {
-            eprintln!(
-                "{:?}",
-                miette::miette!(
-                    code = "diff::unreadable",
-                    help = "give a procedure file or folder",
-                    "{}: {e}",
-                    path.display()
-                )
-            );
+/// Checks and hashes one procedure text (diagnostics to standard error).
+pub(crate) fn load_text(display: &str, text: &str) -> Option<Loaded> {
+    let checked = match check_text(display, text, &FsSources, &CheckOptions::default()) {
+        Ok(c) => c,
+        Err(diags) => {
+            diags.iter().for_each(procedure::report);
             return None;
         }
     };
-    let plan = pending::check_text(&path, &text)?;
-    let sha256 = ratecal_grammar::canonical(&text).ok()?.sha256;
-    Some(Loaded { plan, sha256 })
+    let sha256 = match ratecal_grammar::canonical(text) {
+        Ok(c) => c.sha256,
+        Err(d) => {
+            procedure::report(&d);
+            return None;
+        }
+    };
+    Some(Loaded {
+        plan: checked.plan,
+        sha256,
+    })
 }
 
 /// Runs the subcommand.
@@ -89,40 +89,5 @@ pub fn main(args: Args) -> ExitCode {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(1)
-    }
-}
-
-/// Stand-ins until the language branch's `cli/procedure.rs` and checker land.
-mod pending {
-    use ratecal_engine::plan::Plan;
-    use std::path::{Path, PathBuf};
-
-    /// `file | folder (newest version) | folder@version` to a file.
-    pub fn resolve(spec: &str) -> miette::Result<PathBuf> {
-        let (dir, version) = match spec.rsplit_once('@') {
-            Some((d, v)) => (PathBuf::from(d), Some(v)),
-            None => (PathBuf::from(spec), None),
-        };
-        if let Some(v) = version {
-            return Ok(dir.join(format!(
-                "{v}.{}",
-                ratecal_engine::audit::versions::EXTENSION
-            )));
-        }
-        if dir.is_dir() {
-            let files = super::super::log::version_files(&dir)
-                .map_err(|e| miette::miette!("{}: {e}", dir.display()))?;
-            return files
-                .last()
-                .map(|(_, p)| p.clone())
-                .ok_or_else(|| miette::miette!("{} holds no versions", dir.display()));
-        }
-        Ok(dir)
-    }
-
-    /// Parses and checks a procedure text.
-    pub fn check_text(path: &Path, _text: &str) -> Option<Plan> {
-        eprintln!("{}: the checker is not available yet", path.display());
-        None
     }
 }

@@ -58,7 +58,11 @@ pub fn main(args: Args) -> ExitCode {
     let mut failed = false;
     println!("{}", folder.display());
     for (version, path) in files {
-        let Some(loaded) = super::diff::load_file(path) else {
+        let display = path.display().to_string();
+        let loaded = std::fs::read(&path)
+            .ok()
+            .and_then(|b| super::diff::load_text(&display, &String::from_utf8_lossy(&b)));
+        let Some(loaded) = loaded else {
             println!(
                 "{version:<8} {:<64}  (does not check: see the errors above)",
                 "-"
