@@ -2,7 +2,8 @@
 //! each procedure given; every diagnostic at once. Exit 0 (warnings allowed), 1 errors.
 
 use super::procedure::{self, FsSources};
-use ratecal_engine::check::{CheckOptions, check_text};
+use ratecal_drivers::Station;
+use ratecal_engine::check::{CheckOptions, StationLimits, check_text};
 use std::process::ExitCode;
 
 /// Arguments of `ratecal check`.
@@ -11,6 +12,9 @@ pub struct Args {
     /// Procedures: files, folders (newest version) or folder@version.
     #[arg(required = true)]
     inputs: Vec<String>,
+    /// Station file: compare rates and accelerations with its table and IMU limits.
+    #[arg(long)]
+    station: Option<std::path::PathBuf>,
     /// Output format: text, or json (the checked plans on standard output).
     #[arg(long, value_parser = ["text", "json"], default_value = "text")]
     format: String,
@@ -30,9 +34,39 @@ pub fn human_duration(s: f64) -> String {
     }
 }
 
+/// The limits `check` compares a plan with, from a station description.
+pub fn station_limits(st: &Station) -> StationLimits {
+    StationLimits {
+        max_rate_dps: st.table.max_rate.get(),
+        max_accel_dps2: st.table.max_accel_dps2,
+        gyro_range_dps: st.imu.gyro_range.get(),
+        accel_range_mps2: st.imu.accel_range.get(),
+        geometry: st.geometry(),
+    }
+}
+
 /// Runs the subcommand.
 pub fn main(args: Args) -> ExitCode {
-    let opts = CheckOptions::default();
+    let mut opts = CheckOptions::default();
+    if let Some(path) = &args.station {
+        let text = match std::fs::read_to_string(path) {
+            Ok(t) => t,
+            Err(e) => {
+                eprintln!(
+                    "ratecal check: cannot read station `{}`: {e}",
+                    path.display()
+                );
+                return ExitCode::from(1);
+            }
+        };
+        match Station::from_yaml(&text, &path.display().to_string()) {
+            Ok(st) => opts.station = Some(station_limits(&st)),
+            Err(e) => {
+                eprintln!("{:?}", miette::Report::new(*e));
+                return ExitCode::from(1);
+            }
+        }
+    }
     let mut failed = false;
     let mut plans = Vec::new();
     for input in &args.inputs {

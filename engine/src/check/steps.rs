@@ -205,9 +205,12 @@ impl Ck<'_> {
             }
             Stmt::Spin { axis, rate } => {
                 let ax = self.axis(axis);
-                let r = self.quantity(rate, Dim::Rate, "a spin rate");
+                // Limits are reported on the value as written (a list element in a loop).
+                let rv = self.resolve(rate, None);
+                let at = rv.as_ref().map_or(rate.span, |r| r.span);
+                let r = rv.and_then(|r| self.as_quantity(&r, rate, Dim::Rate, "a spin rate"));
                 if let (Some(ax), Some(r)) = (ax, r) {
-                    self.spin(ax, r.value, rate.span);
+                    self.spin(ax, r.value, at);
                     out.push(Node::Do(Action::Spin {
                         axis: ax,
                         rate_dps: r.value,
