@@ -95,6 +95,7 @@ fn added_verification_attitude() {
             Cmp::Le,
             q(0.01, "g", Dim::Accel, 0.01 * G),
         )],
+        segments: vec![],
     });
     let c = audit::diff(&standard(), &new);
     assert_eq!(

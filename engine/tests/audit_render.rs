@@ -22,6 +22,7 @@ fn revision() -> (Plan, Plan) {
             Cmp::Le,
             q(0.01, "g", Dim::Accel, 0.01 * G),
         )],
+        segments: vec![],
     });
     new.aborts.remove(1);
     new.requirements[0].limit = q(5.0, "arcsec", Dim::Angle, 5.0 / 3600.0);

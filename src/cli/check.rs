@@ -70,6 +70,13 @@ pub fn main(args: Args) -> ExitCode {
     let mut failed = false;
     let mut plans = Vec::new();
     for input in &args.inputs {
+        // A procedure folder also obeys the version rules of versions.lock (audit).
+        if std::path::Path::new(input).is_dir() {
+            for d in super::log::check_folder(std::path::Path::new(input)) {
+                procedure::report(&d);
+                failed |= d.is_error();
+            }
+        }
         let file = match procedure::read(input) {
             Ok(f) => f,
             Err(d) => {

@@ -8,7 +8,8 @@
 //! 1.0.0 5f1c...64 hex digits...
 //! ```
 
-use miette::{Diagnostic, NamedSource, SourceSpan};
+use ratecal_grammar::ast::Span;
+use ratecal_grammar::{Diagnostic, Source};
 use std::cmp::Ordering;
 
 /// Name of the lock file in a procedure folder.
@@ -98,7 +99,8 @@ pub struct LockEntry {
 }
 
 /// Reads `versions.lock`: its entries, and a diagnostic per malformed line.
-pub fn parse_lock(path: &str, text: &str) -> (Vec<LockEntry>, Vec<VersionDiagnostic>) {
+pub fn parse_lock(path: &str, text: &str) -> (Vec<LockEntry>, Vec<Diagnostic>) {
+    let src = source(path, text);
     let mut entries = Vec::new();
     let mut errors = Vec::new();
     let mut offset = 0;
@@ -126,10 +128,7 @@ pub fn parse_lock(path: &str, text: &str) -> (Vec<LockEntry>, Vec<VersionDiagnos
                 span,
             });
         } else {
-            errors.push(VersionDiagnostic::BadLockLine {
-                src: source(path, text),
-                span: span.into(),
-            });
+            errors.push(bad_lock_line(&src, span));
         }
     }
     (entries, errors)
@@ -175,150 +174,120 @@ pub struct FolderData {
     pub others: Vec<String>,
 }
 
-fn source(path: &str, text: &str) -> NamedSource<String> {
-    NamedSource::new(path, text.to_string())
+fn source(path: &str, text: &str) -> Source {
+    ratecal_grammar::source(path, text)
 }
 
-/// A broken rule of a procedure folder.
-#[derive(Debug, thiserror::Error, Diagnostic)]
-pub enum VersionDiagnostic {
-    /// A released version's canonical text no longer has the recorded hash.
-    #[error("released version {version} changed without a new version number")]
-    #[diagnostic(
-        code(versions::released_changed),
-        help(
+fn span((start, len): (usize, usize)) -> Span {
+    Span::new(start, start + len)
+}
+
+/// `versions::released_changed`: a released version's canonical text no longer has the
+/// recorded hash.
+fn released_changed(
+    lock: &Source,
+    at: (usize, usize),
+    version: &str,
+    file: &str,
+    actual: &str,
+) -> Diagnostic {
+    Diagnostic::error("versions::released_changed", format!("released version {version} changed without a new version number"))
+        .label(span(at), "recorded here")
+        .help(format!(
             "a released version never changes: restore {file} as released, or release the change under a new, higher version (its hash is {actual})"
-        )
-    )]
-    ReleasedChanged {
-        /// Version.
-        version: String,
-        /// The version file.
-        file: String,
-        /// Its hash now.
-        actual: String,
-        /// The lock.
-        #[source_code]
-        src: NamedSource<String>,
-        /// The lock line.
-        #[label("recorded here")]
-        span: SourceSpan,
-    },
-    /// Lock entries out of order, or a new version not above the last release.
-    #[error("version {version} does not increase: it must be higher than {previous}")]
-    #[diagnostic(
-        code(versions::not_increasing),
-        help("version numbers only increase: give the change a version higher than {previous}")
-    )]
-    NotIncreasing {
-        /// The offending version.
-        version: String,
-        /// The version it must exceed.
-        previous: String,
-        /// The lock or the version file.
-        #[source_code]
-        src: NamedSource<String>,
-        /// Where the version is written.
-        #[label("not above {previous}")]
-        span: SourceSpan,
-    },
-    /// A released version's file is gone.
-    #[error("released version {version} has no file {file}")]
-    #[diagnostic(
-        code(versions::release_missing),
-        help("a released version stays in its folder: restore {file}")
-    )]
-    ReleaseMissing {
-        /// Version.
-        version: String,
-        /// Expected file name.
-        file: String,
-        /// The lock.
-        #[source_code]
-        src: NamedSource<String>,
-        /// The lock line.
-        #[label("released here")]
-        span: SourceSpan,
-    },
-    /// The file name and the version inside disagree.
-    #[error("{file} declares version {declared}")]
-    #[diagnostic(
-        code(versions::name_mismatch),
-        help(
-            "name the file after its version: {declared}.rcal, or change the version it declares"
-        )
-    )]
-    NameMismatch {
-        /// File name.
-        file: String,
-        /// Declared version.
-        declared: String,
-        /// The version file.
-        #[source_code]
-        src: NamedSource<String>,
-        /// The declared version.
-        #[label("the file name says otherwise")]
-        span: SourceSpan,
-    },
-    /// Something that is neither a version file nor the lock.
-    #[error("{folder} holds {file}, which is not a version file")]
-    #[diagnostic(
-        code(versions::stray_file),
-        help("a procedure folder holds only <version>.rcal files and versions.lock")
-    )]
-    StrayFile {
-        /// Folder.
-        folder: String,
-        /// File name.
-        file: String,
-    },
-    /// A lock line that is not `<version> <sha256>`.
-    #[error("malformed line in versions.lock")]
-    #[diagnostic(
-        code(versions::bad_lock_line),
-        help("each line is `<version> <64 lowercase hex digits>` or a # comment")
-    )]
-    BadLockLine {
-        /// The lock.
-        #[source_code]
-        src: NamedSource<String>,
-        /// The line.
-        #[label("expected `<version> <sha256>`")]
-        span: SourceSpan,
-    },
-    /// A version file not in the lock: a draft, not released.
-    #[error("version {version} is not released (not in versions.lock)")]
-    #[diagnostic(
-        code(versions::unreleased),
-        severity(Warning),
-        help("to release it, add this line to versions.lock: {version} {sha256}")
-    )]
-    Unreleased {
-        /// Version.
-        version: String,
-        /// Its canonical hash.
-        sha256: String,
-    },
-    /// No lock at all.
-    #[error("{folder} has no versions.lock: no version is released")]
-    #[diagnostic(
-        code(versions::no_lock),
-        severity(Warning),
-        help("release versions by listing `<version> <sha256>` lines in versions.lock")
-    )]
-    NoLock {
-        /// Folder.
-        folder: String,
-    },
+        ))
+        .with_source(lock)
+}
+
+/// `versions::not_increasing`: a version not above the one before it.
+fn not_increasing(src: &Source, at: (usize, usize), version: &str, previous: &str) -> Diagnostic {
+    Diagnostic::error(
+        "versions::not_increasing",
+        format!("version {version} does not increase: it must be higher than {previous}"),
+    )
+    .label(span(at), format!("not above {previous}"))
+    .help(format!(
+        "version numbers only increase: give the change a version higher than {previous}"
+    ))
+    .with_source(src)
+}
+
+/// `versions::release_missing`: a released version's file is gone.
+fn release_missing(lock: &Source, at: (usize, usize), version: &str, file: &str) -> Diagnostic {
+    Diagnostic::error(
+        "versions::release_missing",
+        format!("released version {version} has no file {file}"),
+    )
+    .label(span(at), "released here")
+    .help(format!(
+        "a released version stays in its folder: restore {file}"
+    ))
+    .with_source(lock)
+}
+
+/// `versions::name_mismatch`: the file name and the declared version disagree.
+fn name_mismatch(src: &Source, at: (usize, usize), file: &str, declared: &str) -> Diagnostic {
+    Diagnostic::error("versions::name_mismatch", format!("{file} declares version {declared}"))
+        .label(span(at), "the file name says otherwise")
+        .help(format!("name the file after its version ({declared}.{EXTENSION}), or change the version it declares"))
+        .with_source(src)
+}
+
+/// `versions::stray_file`: neither a version file nor the lock.
+fn stray_file(folder: &str, file: &str) -> Diagnostic {
+    Diagnostic::error(
+        "versions::stray_file",
+        format!("{folder} holds {file}, which is not a version file"),
+    )
+    .help(format!(
+        "a procedure folder holds only <version>.{EXTENSION} files and {LOCK_FILE}"
+    ))
+    .with_source(&source(&format!("{folder}/{file}"), ""))
+}
+
+/// `versions::bad_lock_line`: a lock line that is not `<version> <sha256>`.
+fn bad_lock_line(lock: &Source, at: (usize, usize)) -> Diagnostic {
+    Diagnostic::error(
+        "versions::bad_lock_line",
+        format!("malformed line in {LOCK_FILE}"),
+    )
+    .label(span(at), "expected `<version> <sha256>`")
+    .help("each line is `<version> <64 lowercase hex digits>` or a # comment")
+    .with_source(lock)
+}
+
+/// `versions::unreleased` (warning): a version file not in the lock.
+fn unreleased(src: &Source, at: (usize, usize), version: &str, sha256: &str) -> Diagnostic {
+    Diagnostic::warning(
+        "versions::unreleased",
+        format!("version {version} is not released (not in {LOCK_FILE})"),
+    )
+    .label(span(at), "a draft")
+    .help(format!(
+        "to release it, add this line to {LOCK_FILE}: {version} {sha256}"
+    ))
+    .with_source(src)
+}
+
+/// `versions::no_lock` (warning): no lock at all.
+fn no_lock(folder: &str) -> Diagnostic {
+    Diagnostic::warning(
+        "versions::no_lock",
+        format!("{folder} has no {LOCK_FILE}: no version is released"),
+    )
+    .help(format!(
+        "release versions by listing `<version> <sha256>` lines in {LOCK_FILE}"
+    ))
+    .with_source(&source(&format!("{folder}/{LOCK_FILE}"), ""))
 }
 
 /// Where `version` is written in a procedure's text (its first occurrence after the
 /// word `version`), for pointing at it.
-fn version_span(text: &str, version: &str) -> SourceSpan {
+fn version_span(text: &str, version: &str) -> (usize, usize) {
     let at = text
         .find("version")
         .and_then(|k| text[k..].find(version).map(|j| k + j));
-    at.map_or((0, 0).into(), |k| (k, version.len()).into())
+    at.map_or((0, 0), |k| (k, version.len()))
 }
 
 /// Checks the rules of a procedure folder: every file is a version file or the lock; each
@@ -326,38 +295,32 @@ fn version_span(text: &str, version: &str) -> SourceSpan {
 /// canonical hash is the recorded one; the lock lists versions in increasing order; an
 /// unreleased version is above every released one (warning: not released yet). Files that
 /// did not parse (no `sha256`) are left to the checker's own diagnostics.
-pub fn check_versions(folder: &FolderData) -> Vec<VersionDiagnostic> {
+pub fn check_versions(folder: &FolderData) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     for f in &folder.others {
-        out.push(VersionDiagnostic::StrayFile {
-            folder: folder.path.clone(),
-            file: f.clone(),
-        });
+        out.push(stray_file(&folder.path, f));
     }
     for f in &folder.files {
         match (version_of_file_name(&f.file_name), &f.declared) {
-            (None, _) => out.push(VersionDiagnostic::StrayFile {
-                folder: folder.path.clone(),
-                file: f.file_name.clone(),
-            }),
+            (None, _) => out.push(stray_file(&folder.path, &f.file_name)),
             (Some(v), Some(d)) if Version::parse(d).as_ref() != Some(&v) => {
-                out.push(VersionDiagnostic::NameMismatch {
-                    file: f.file_name.clone(),
-                    declared: d.clone(),
-                    src: source(&f.path, &f.text),
-                    span: version_span(&f.text, d),
-                })
+                let src = source(&f.path, &f.text);
+                out.push(name_mismatch(
+                    &src,
+                    version_span(&f.text, d),
+                    &f.file_name,
+                    d,
+                ));
             }
             _ => {}
         }
     }
     let Some(lock_text) = &folder.lock else {
-        out.push(VersionDiagnostic::NoLock {
-            folder: folder.path.clone(),
-        });
+        out.push(no_lock(&folder.path));
         return out;
     };
     let lock_path = format!("{}/{LOCK_FILE}", folder.path.trim_end_matches('/'));
+    let lock = source(&lock_path, lock_text);
     let (entries, errors) = parse_lock(&lock_path, lock_text);
     out.extend(errors);
     let mut newest: Option<(Version, &str)> = None;
@@ -368,12 +331,7 @@ pub fn check_versions(folder: &FolderData) -> Vec<VersionDiagnostic> {
         if let Some((prev, prev_s)) = &newest
             && v <= *prev
         {
-            out.push(VersionDiagnostic::NotIncreasing {
-                version: e.version.clone(),
-                previous: prev_s.to_string(),
-                src: source(&lock_path, lock_text),
-                span: e.span.into(),
-            });
+            out.push(not_increasing(&lock, e.span, &e.version, prev_s));
             continue;
         }
         newest = Some((v.clone(), &e.version));
@@ -382,20 +340,16 @@ pub fn check_versions(folder: &FolderData) -> Vec<VersionDiagnostic> {
             .iter()
             .find(|f| version_of_file_name(&f.file_name).as_ref() == Some(&v));
         match file {
-            None => out.push(VersionDiagnostic::ReleaseMissing {
-                version: e.version.clone(),
-                file: format!("{}.{EXTENSION}", e.version),
-                src: source(&lock_path, lock_text),
-                span: e.span.into(),
-            }),
+            None => out.push(release_missing(
+                &lock,
+                e.span,
+                &e.version,
+                &format!("{}.{EXTENSION}", e.version),
+            )),
             Some(f) => match &f.sha256 {
-                Some(h) if *h != e.sha256 => out.push(VersionDiagnostic::ReleasedChanged {
-                    version: e.version.clone(),
-                    file: f.file_name.clone(),
-                    actual: h.clone(),
-                    src: source(&lock_path, lock_text),
-                    span: e.span.into(),
-                }),
+                Some(h) if *h != e.sha256 => {
+                    out.push(released_changed(&lock, e.span, &e.version, &f.file_name, h))
+                }
                 _ => {}
             },
         }
@@ -410,19 +364,15 @@ pub fn check_versions(folder: &FolderData) -> Vec<VersionDiagnostic> {
         {
             continue;
         }
+        let src = source(&f.path, &f.text);
+        let at = version_span(&f.text, &v.to_string());
         match &newest {
-            Some((top, top_s)) if v <= *top => out.push(VersionDiagnostic::NotIncreasing {
-                version: v.to_string(),
-                previous: top_s.to_string(),
-                src: source(&f.path, &f.text),
-                span: version_span(&f.text, &v.to_string()),
-            }),
+            Some((top, top_s)) if v <= *top => {
+                out.push(not_increasing(&src, at, &v.to_string(), top_s))
+            }
             _ => {
                 if let Some(h) = &f.sha256 {
-                    out.push(VersionDiagnostic::Unreleased {
-                        version: v.to_string(),
-                        sha256: h.clone(),
-                    });
+                    out.push(unreleased(&src, at, &v.to_string(), h));
                 }
             }
         }

@@ -256,6 +256,7 @@ pub fn standard() -> Plan {
                 Cmp::Le,
                 q(0.01, "g", Dim::Accel, 0.01 * G),
             )],
+            segments: vec![],
         }],
         estimated_duration_s,
     }

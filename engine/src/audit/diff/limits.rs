@@ -344,12 +344,18 @@ pub(super) fn verifications(old: &[Verification], new: &[Verification], out: &mu
         match p {
             Pair::Old(v) => out.push(Change::removed(point_str(&v.point), show(v)).alerting()),
             Pair::New(v) => out.push(Change::added(point_str(&v.point), show(v))),
-            Pair::Both(_, o, _, n) => limit_list(
-                &format!("{} / ", point_str(&n.point)),
-                &o.limits,
-                &n.limits,
-                out,
-            ),
+            Pair::Both(_, o, _, n) => {
+                let path = point_str(&n.point);
+                if o.segments != n.segments {
+                    out.push(Change::value(
+                        format!("{path} / from"),
+                        ChangeKind::Changed,
+                        o.segments.join(", "),
+                        n.segments.join(", "),
+                    ));
+                }
+                limit_list(&format!("{path} / "), &o.limits, &n.limits, out)
+            }
         }
     }
 }
