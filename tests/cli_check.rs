@@ -19,6 +19,7 @@ fn ratecal(args: &[&str]) -> (i32, String, String) {
 fn check_bundled_procedures() {
     let (code, out, _) = ratecal(&[
         "check",
+        "procedures/imu-2d-standard@1.0.0",
         "procedures/imu-2d-standard",
         "procedures/imu-2d-consumer@1.0.0",
         "procedures/size-effect/1.0.0.rcal",
@@ -28,6 +29,8 @@ fn check_bundled_procedures() {
         out.contains("imu-2d-standard 1.0.0: ok, estimated duration 1 h 13 min"),
         "{out}"
     );
+    // A folder stands for its newest version.
+    assert!(out.contains("imu-2d-standard 1.1.0: ok"), "{out}");
     assert!(out.contains("imu-2d-consumer 1.0.0: ok"));
     assert!(out.contains("size-effect 1.0.0: ok"));
 }
