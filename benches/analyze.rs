@@ -3,7 +3,6 @@
 //! `target/analyze-bench-recording/` (also read by `benches/analyze_pandas.py`).
 
 #[path = "../engine/tests/fit_support/mod.rs"]
-#[allow(dead_code)]
 mod fit_support;
 
 use criterion::{Criterion, criterion_group, criterion_main};
