@@ -154,7 +154,13 @@ pub(crate) fn prepare(
             // the kinematics on the feedback samples and interpolate (half the work of
             // evaluating it at every IMU stamp, same answer to well below the noise).
             if cache.0 != j {
-                cache = (j, refs_at(j, 0.0), refs_at(j, 1.0));
+                // Moving one feedback step on, the old end is the new start.
+                let start = if cache.0.wrapping_add(1) == j {
+                    cache.2
+                } else {
+                    refs_at(j, 0.0)
+                };
+                cache = (j, start, refs_at(j, 1.0));
             }
             let ((f0, w0), (f1, w1)) = (cache.1, cache.2);
             (f0 + (f1 - f0) * w, w0 + (w1 - w0) * w)
@@ -233,8 +239,7 @@ pub(crate) fn flag_outliers(r: &[f64], rule: Outliers, keep: &mut [bool]) {
     match rule {
         Outliers::Sigma(k) => {
             for _ in 0..5 {
-                let m = super::stats::mean(r, keep);
-                let s = super::stats::std(r, keep);
+                let (m, s) = super::stats::mean_std(r, keep);
                 let mut changed = false;
                 for i in 0..r.len() {
                     if keep[i] && (r[i] - m).abs() > k * s {
