@@ -1,0 +1,479 @@
+//! The station file's structure (YAML). Every section refuses unknown keys; quantities
+//! carry their units (see `quantity.rs`), keys whose name ends in a unit take bare numbers.
+//! `docs/station.md` documents every key.
+
+use super::quantity::{
+    Accel, AccelDensity, Angle, Freq, Pressure, Rate, RateDensity, RateWalk, Ratio, Rotation, Temp,
+    TempDelta, TempRate, Time, UnitVec, fraction, positive,
+};
+use serde::{Deserialize, Serialize};
+
+/// A whole station: site, table, mount, IMU, temperature, environment and rehearsed faults.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Station {
+    /// Free-form name of the station.
+    #[serde(default)]
+    pub name: String,
+    /// Where the station is.
+    pub site: SiteSpec,
+    /// The rate table.
+    pub table: TableSpec,
+    /// How the IMU is mounted on the platform.
+    #[serde(default)]
+    pub mount: MountSpec,
+    /// The IMU.
+    pub imu: ImuSpec,
+    /// Lab and IMU temperature behaviour.
+    #[serde(default)]
+    pub temperature: TemperatureSpec,
+    /// Conditions measured once, recorded in the manifest.
+    #[serde(default)]
+    pub environment: Option<EnvironmentSpec>,
+    /// Faults to rehearse aborts with (simulated station only).
+    #[serde(default)]
+    pub faults: Vec<FaultSpec>,
+}
+
+/// The site: latitude and local gravity.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SiteSpec {
+    /// Geodetic latitude, deg.
+    pub latitude_deg: f64,
+    /// Local gravity, m/s^2.
+    pub gravity_mps2: f64,
+}
+
+/// Which driver runs the table.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum TableDriverSpec {
+    /// The simulated table.
+    Sim,
+    /// A table speaking the line protocol of `docs/station.md` over TCP.
+    Tcp {
+        /// `host:port`.
+        address: String,
+        /// Reply timeout.
+        #[serde(default = "default_timeout")]
+        timeout: Time,
+    },
+    /// Replays the table stream of a recording folder.
+    Replay {
+        /// The recording folder.
+        recording: String,
+    },
+}
+
+fn default_timeout() -> Time {
+    Time(2.0)
+}
+
+/// Which driver runs the IMU.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum ImuDriverSpec {
+    /// The simulated IMU (needs the simulated table: it senses the table's true motion).
+    Sim,
+    /// Replays the IMU stream of a recording folder.
+    Replay {
+        /// The recording folder.
+        recording: String,
+    },
+}
+
+/// Settling behaviour of the table servo: a second-order loop.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SettlingSpec {
+    /// Natural frequency of the servo loop.
+    #[serde(deserialize_with = "positive")]
+    pub natural_frequency: Freq,
+    /// Damping ratio (0 < damping; below 1 overshoots).
+    #[serde(deserialize_with = "positive")]
+    pub damping: f64,
+    /// Fraction of the commanded acceleration fed forward, 0 to 1: the rest makes the
+    /// tracking lag while accelerating and the overshoot after a move.
+    #[serde(default = "default_feedforward", deserialize_with = "fraction")]
+    pub feedforward: f64,
+}
+
+fn default_feedforward() -> f64 {
+    0.8
+}
+
+impl Default for SettlingSpec {
+    fn default() -> Self {
+        SettlingSpec {
+            natural_frequency: Freq(5.0),
+            damping: 0.6,
+            feedforward: default_feedforward(),
+        }
+    }
+}
+
+/// The dual-axis rate table.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TableSpec {
+    /// Which driver.
+    pub driver: TableDriverSpec,
+    /// Model name.
+    #[serde(default = "default_table_model")]
+    pub model: String,
+    /// `a_o`, outer axis unit vector in the lab frame (ENU).
+    pub outer_axis: UnitVec,
+    /// `a_i`, inner axis unit vector at outer angle zero.
+    pub inner_axis: UnitVec,
+    /// Maximum rate per axis.
+    #[serde(deserialize_with = "positive")]
+    pub max_rate: Rate,
+    /// Maximum angular acceleration per axis, deg/s^2.
+    #[serde(deserialize_with = "positive")]
+    pub max_accel_dps2: f64,
+    /// Encoder noise on the angle feedback (1 sigma).
+    #[serde(default)]
+    pub position_noise: Angle,
+    /// Rate ripple on the rate feedback (1 sigma, white).
+    #[serde(default)]
+    pub rate_ripple: Rate,
+    /// Servo settling behaviour.
+    #[serde(default)]
+    pub settling: SettlingSpec,
+    /// Feedback sample rate.
+    #[serde(deserialize_with = "positive")]
+    pub feedback_rate: Freq,
+}
+
+fn default_table_model() -> String {
+    "dual-axis rate table".into()
+}
+
+/// The IMU mount: `C_PB`, row-major (its columns are the body axes in P).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MountSpec {
+    /// `C_PB`, row-major.
+    pub rotation: Rotation,
+}
+
+impl Default for MountSpec {
+    fn default() -> Self {
+        MountSpec {
+            rotation: Rotation([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]),
+        }
+    }
+}
+
+/// The IMU: identity, sampling, noise, nominal errors and catalogue effects.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImuSpec {
+    /// Which driver.
+    pub driver: ImuDriverSpec,
+    /// Model name.
+    #[serde(default)]
+    pub model: String,
+    /// Serial number.
+    #[serde(default)]
+    pub serial: String,
+    /// Grade (`tactical`, `navigation`, `consumer`...).
+    #[serde(default)]
+    pub grade: String,
+    /// Output sample rate.
+    #[serde(deserialize_with = "positive")]
+    pub sample_rate: Freq,
+    /// Accelerometer range (outputs saturate there).
+    #[serde(deserialize_with = "positive")]
+    pub accel_range: Accel,
+    /// Gyro range (outputs saturate there).
+    #[serde(deserialize_with = "positive")]
+    pub gyro_range: Rate,
+    /// Accelerometer white-noise density; per-sample sigma = density * sqrt(sample rate).
+    #[serde(default)]
+    pub accel_noise_density: AccelDensity,
+    /// Gyro white-noise density; per-sample sigma = density * sqrt(sample rate).
+    #[serde(default)]
+    pub gyro_noise_density: RateDensity,
+    /// Gyro bias instability: sigma of a first-order Gauss-Markov bias.
+    #[serde(default)]
+    pub gyro_bias_instability: Rate,
+    /// Correlation time of the Gauss-Markov bias.
+    #[serde(default = "default_correlation", deserialize_with = "positive")]
+    pub gyro_bias_correlation_time: Time,
+    /// Gyro bias random walk.
+    #[serde(default)]
+    pub gyro_bias_random_walk: RateWalk,
+    /// Accelerometer biases (outputs at zero input), x y z.
+    #[serde(default)]
+    pub accel_bias: [Accel; 3],
+    /// Gyro biases (outputs at zero input, at the thermal reference), x y z.
+    #[serde(default)]
+    pub gyro_bias: [Rate; 3],
+    /// Accelerometer scale-factor errors (K - 1), x y z.
+    #[serde(default)]
+    pub accel_scale: [Ratio; 3],
+    /// Gyro scale-factor errors (K - 1), x y z.
+    #[serde(default)]
+    pub gyro_scale: [Ratio; 3],
+    /// Catalogue effects under their canonical ids.
+    #[serde(default)]
+    pub effects: EffectsSpec,
+}
+
+fn default_correlation() -> Time {
+    Time(300.0)
+}
+
+/// Catalogue effects (spec/physics.md), canonical ids and parameter names.
+/// `earth_rate` is not here: the Earth's rotation is site physics, always on.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EffectsSpec {
+    /// Accelerometer sensing points, mm.
+    #[serde(default)]
+    pub lever_arm: LeverArmSpec,
+    /// IMU stamps lag the motion.
+    #[serde(default)]
+    pub time_offset: TimeOffsetSpec,
+    /// Off-diagonal terms of `K_a`, mrad.
+    #[serde(default)]
+    pub accel_misalignment: MisalignmentSpec,
+    /// Off-diagonal terms of `K_g`, mrad.
+    #[serde(default)]
+    pub gyro_misalignment: MisalignmentSpec,
+    /// Gyro sensitivity to specific force, deg/s per g.
+    #[serde(default)]
+    pub g_sensitivity: GSensitivitySpec,
+    /// Gyro bias per degC, deg/s per degC.
+    #[serde(default)]
+    pub gyro_thermal_drift: AxesSpec,
+    /// Accelerometer bias per degC, m/s^2 per degC.
+    #[serde(default)]
+    pub accel_thermal_drift: AxesSpec,
+    /// Gyro scale nonlinearity, ppm per deg/s.
+    #[serde(default)]
+    pub gyro_scale_nonlinearity: AxesSpec,
+}
+
+macro_rules! params {
+    ($(#[$doc:meta])* $name:ident { $($field:ident),* }) => {
+        $(#[$doc])*
+        #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+        #[serde(deny_unknown_fields)]
+        pub struct $name {
+            $(
+                #[doc = concat!("`", stringify!($field), "` (see spec/physics.md).")]
+                #[serde(default)]
+                pub $field: f64,
+            )*
+        }
+    };
+}
+
+params!(
+    /// `lever_arm`: `r<i><j>_mm` = j-component of accelerometer i's sensing point, mm.
+    LeverArmSpec { rxx_mm, rxy_mm, rxz_mm, ryx_mm, ryy_mm, ryz_mm, rzx_mm, rzy_mm, rzz_mm });
+params!(
+    /// `time_offset`: the sample stamped t measured the motion at t - tau.
+    TimeOffsetSpec { tau_ms });
+params!(
+    /// Misalignment: `<i><j>_mrad` = K[i][j] * 1000.
+    MisalignmentSpec { xy_mrad, xz_mrad, yx_mrad, yz_mrad, zx_mrad, zy_mrad });
+params!(
+/// `g_sensitivity`: `<i><j>_dps_per_g` = G[i][j] * g.
+GSensitivitySpec {
+    xx_dps_per_g, xy_dps_per_g, xz_dps_per_g, yx_dps_per_g, yy_dps_per_g, yz_dps_per_g,
+    zx_dps_per_g, zy_dps_per_g, zz_dps_per_g
+});
+params!(
+    /// Per-axis coefficients `x`, `y`, `z` in the effect's unit.
+    AxesSpec { x, y, z });
+
+/// Lab air and IMU internal temperature.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TemperatureSpec {
+    /// Lab (or chamber) air.
+    #[serde(default)]
+    pub ambient: AmbientSpec,
+    /// IMU internal temperature.
+    #[serde(default)]
+    pub imu: ImuTemperatureSpec,
+    /// Reference temperature of the thermal drifts (`T_ref`).
+    #[serde(default = "default_reference")]
+    pub reference: Temp,
+    /// Whether the table feedback carries the ambient temperature (the `ambient` column).
+    #[serde(default = "yes")]
+    pub report_ambient: bool,
+}
+
+fn yes() -> bool {
+    true
+}
+
+fn default_reference() -> Temp {
+    Temp(20.0)
+}
+
+impl Default for TemperatureSpec {
+    fn default() -> Self {
+        TemperatureSpec {
+            ambient: AmbientSpec::default(),
+            imu: ImuTemperatureSpec::default(),
+            reference: default_reference(),
+            report_ambient: true,
+        }
+    }
+}
+
+/// Lab air: `mean + drift * t + noise`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AmbientSpec {
+    /// Temperature at the start.
+    pub mean: Temp,
+    /// Linear drift.
+    #[serde(default)]
+    pub drift: TempRate,
+    /// Sensor noise (1 sigma, white).
+    #[serde(default)]
+    pub noise: TempDelta,
+}
+
+impl Default for AmbientSpec {
+    fn default() -> Self {
+        AmbientSpec {
+            mean: Temp(20.0),
+            drift: TempRate(0.0),
+            noise: TempDelta(0.0),
+        }
+    }
+}
+
+/// IMU internal temperature: ambient plus a warm-up `offset (1 - exp(-t / time_constant))`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImuTemperatureSpec {
+    /// Steady offset over ambient once warm.
+    #[serde(default)]
+    pub warmup_offset: TempDelta,
+    /// Warm-up time constant.
+    #[serde(default = "default_warmup")]
+    pub warmup_time_constant: Time,
+    /// Sensor noise (1 sigma, white).
+    #[serde(default)]
+    pub noise: TempDelta,
+}
+
+fn default_warmup() -> Time {
+    Time(600.0)
+}
+
+impl Default for ImuTemperatureSpec {
+    fn default() -> Self {
+        ImuTemperatureSpec {
+            warmup_offset: TempDelta(0.0),
+            warmup_time_constant: default_warmup(),
+            noise: TempDelta(0.0),
+        }
+    }
+}
+
+/// Conditions measured once (recorded in the manifest's `environment`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnvironmentSpec {
+    /// Air temperature.
+    #[serde(default)]
+    pub temperature: Option<Temp>,
+    /// Relative humidity (`"45 %"`).
+    #[serde(default)]
+    pub humidity: Option<Ratio>,
+    /// Air pressure.
+    #[serde(default)]
+    pub pressure: Option<Pressure>,
+    /// Vibration level.
+    #[serde(default)]
+    pub vibration: Option<Accel>,
+}
+
+/// Which table axis a fault hits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AxisName {
+    /// Outer axis.
+    Outer,
+    /// Inner axis.
+    Inner,
+}
+
+/// What a faulty table axis does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TableFaultMode {
+    /// Stops following commands: brakes to rest and stays there.
+    Stuck,
+    /// Runs away: ramps to `rate` and keeps turning whatever it is told.
+    Runaway,
+}
+
+/// What a dropped-out IMU outputs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DropoutMode {
+    /// NaN on every channel.
+    Nan,
+    /// The last good sample, repeated.
+    Stuck,
+    /// No samples at all.
+    Missing,
+}
+
+/// A rehearsed fault (simulated station only).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum FaultSpec {
+    /// A table axis stops following or runs away at `at`; only a safe stop still works.
+    Table {
+        /// When.
+        at: Time,
+        /// Which axis.
+        axis: AxisName,
+        /// Stuck or runaway.
+        mode: TableFaultMode,
+        /// Runaway rate.
+        #[serde(default = "default_runaway")]
+        rate: Rate,
+    },
+    /// The IMU drops out at `at` for `duration`.
+    ImuDropout {
+        /// When.
+        at: Time,
+        /// How long.
+        duration: Time,
+        /// NaN, stuck or missing samples.
+        mode: DropoutMode,
+    },
+    /// The ambient temperature ramps by `delta` over `ramp`, holds for `duration`, ramps back.
+    TemperatureExcursion {
+        /// When it starts.
+        at: Time,
+        /// Size of the excursion.
+        delta: TempDelta,
+        /// Ramp time (up, and down again).
+        #[serde(default = "default_ramp")]
+        ramp: Time,
+        /// How long it holds at the full excursion.
+        duration: Time,
+    },
+}
+
+fn default_runaway() -> Rate {
+    Rate(20.0)
+}
+
+fn default_ramp() -> Time {
+    Time(60.0)
+}

@@ -1,0 +1,233 @@
+//! The station file: what the site, the table and the IMU are, and how to drive them.
+//! Parsing refuses unknown keys and wrong units with a diagnostic located in the file.
+
+mod describe;
+mod file;
+mod quantity;
+
+pub use describe::{Environment, ImuIdentity, StationInfo};
+
+pub use file::{
+    AmbientSpec, AxesSpec, AxisName, DropoutMode, EffectsSpec, EnvironmentSpec, FaultSpec,
+    GSensitivitySpec, ImuDriverSpec, ImuSpec, ImuTemperatureSpec, LeverArmSpec, MisalignmentSpec,
+    MountSpec, SettlingSpec, SiteSpec, Station, TableDriverSpec, TableFaultMode, TableSpec,
+    TemperatureSpec, TimeOffsetSpec,
+};
+pub use quantity::{
+    Accel, AccelDensity, Angle, Freq, Pressure, Rate, RateDensity, RateWalk, Ratio, Rotation, Temp,
+    TempDelta, TempRate, Time, UnitVec, Value,
+};
+
+use miette::{Diagnostic, NamedSource, SourceSpan};
+use ratecal_physics::{Geometry, ImuErrors, Mat3, Site, Vec3};
+
+/// The embedded default station's YAML (a simulated tactical-grade IMU on a simulated table).
+pub const DEFAULT_STATION_YAML: &str = include_str!("../../stations/default.yaml");
+
+/// A station file that cannot be used, located in the file.
+#[derive(Debug, thiserror::Error, Diagnostic)]
+#[error("{message}")]
+#[diagnostic(code(station::invalid))]
+pub struct StationError {
+    /// What is wrong.
+    pub message: String,
+    /// The file.
+    #[source_code]
+    pub src: NamedSource<String>,
+    /// Where.
+    #[label("{label}")]
+    pub span: Option<SourceSpan>,
+    /// The label's text.
+    pub label: String,
+    /// 1-based line, if known.
+    pub line: Option<usize>,
+    /// 1-based column, if known.
+    pub column: Option<usize>,
+    /// What to do.
+    #[help]
+    pub help: String,
+}
+
+const HELP: &str = "docs/station.md lists every key of a station file with its unit and default";
+
+impl Station {
+    /// Parses a station file; `file_name` names it in diagnostics.
+    pub fn from_yaml(text: &str, file_name: &str) -> Result<Station, Box<StationError>> {
+        serde_saphyr::from_str::<Station>(text).map_err(|e| Box::new(located(&e, text, file_name)))
+    }
+
+    /// The embedded default station: seed geometry, a lab at 55.70 deg N, a tactical-grade
+    /// IMU at 100 Hz and a table reporting at 50 Hz, both simulated.
+    pub fn default_sim() -> Station {
+        Station::from_yaml(DEFAULT_STATION_YAML, "<default station>")
+            .expect("the embedded default station parses")
+    }
+
+    /// The site as the physics crate needs it.
+    pub fn site(&self) -> Site {
+        Site {
+            latitude_deg: self.site.latitude_deg,
+            gravity_mps2: self.site.gravity_mps2,
+        }
+    }
+
+    /// Axis geometry and mount rotation.
+    pub fn geometry(&self) -> Geometry {
+        let v = |a: [f64; 3]| Vec3::new(a[0], a[1], a[2]);
+        let r = self.mount.rotation.0;
+        Geometry {
+            outer_axis: v(self.table.outer_axis.0),
+            inner_axis: v(self.table.inner_axis.0),
+            c_pb: Mat3::from_fn(|i, j| r[i][j]),
+        }
+    }
+
+    /// The IMU's deterministic errors in the physics crate's units.
+    pub fn imu_errors(&self) -> ImuErrors {
+        let imu = &self.imu;
+        let fx = &imu.effects;
+        let diag = |s: [Ratio; 3]| Mat3::from_diagonal(&Vec3::new(s[0].0, s[1].0, s[2].0));
+        let mis = |m: &MisalignmentSpec| {
+            Mat3::new(
+                0.0, m.xy_mrad, m.xz_mrad, m.yx_mrad, 0.0, m.yz_mrad, m.zx_mrad, m.zy_mrad, 0.0,
+            ) * 1e-3
+        };
+        let l = &fx.lever_arm;
+        let gs = &fx.g_sensitivity;
+        let axes = |a: &AxesSpec| Vec3::new(a.x, a.y, a.z);
+        ImuErrors {
+            k_a: Mat3::identity() + diag(imu.accel_scale) + mis(&fx.accel_misalignment),
+            b_a: Vec3::new(
+                imu.accel_bias[0].0,
+                imu.accel_bias[1].0,
+                imu.accel_bias[2].0,
+            ),
+            k_g: Mat3::identity() + diag(imu.gyro_scale) + mis(&fx.gyro_misalignment),
+            b_g: Vec3::new(imu.gyro_bias[0].0, imu.gyro_bias[1].0, imu.gyro_bias[2].0),
+            g_sens: Mat3::new(
+                gs.xx_dps_per_g,
+                gs.xy_dps_per_g,
+                gs.xz_dps_per_g,
+                gs.yx_dps_per_g,
+                gs.yy_dps_per_g,
+                gs.yz_dps_per_g,
+                gs.zx_dps_per_g,
+                gs.zy_dps_per_g,
+                gs.zz_dps_per_g,
+            ) / self.site.gravity_mps2,
+            lever_m: Mat3::new(
+                l.rxx_mm, l.rxy_mm, l.rxz_mm, l.ryx_mm, l.ryy_mm, l.ryz_mm, l.rzx_mm, l.rzy_mm,
+                l.rzz_mm,
+            ) * 1e-3,
+            gyro_thermal: axes(&fx.gyro_thermal_drift),
+            accel_thermal: axes(&fx.accel_thermal_drift),
+            t_ref_c: self.temperature.reference.0,
+            gyro_nonlinearity: axes(&fx.gyro_scale_nonlinearity),
+        }
+    }
+
+    /// The IMU's time offset `tau`, s.
+    pub fn time_offset_s(&self) -> f64 {
+        self.imu.effects.time_offset.tau_ms * 1e-3
+    }
+
+    /// The same station with every random term switched off (white noise, bias wander,
+    /// encoder noise, rate ripple, temperature noise): for closed-form tests.
+    pub fn noiseless(mut self) -> Station {
+        let imu = &mut self.imu;
+        imu.accel_noise_density = AccelDensity(0.0);
+        imu.gyro_noise_density = RateDensity(0.0);
+        imu.gyro_bias_instability = Rate(0.0);
+        imu.gyro_bias_random_walk = RateWalk(0.0);
+        self.table.position_noise = Angle(0.0);
+        self.table.rate_ripple = Rate(0.0);
+        self.temperature.ambient.noise = TempDelta(0.0);
+        self.temperature.imu.noise = TempDelta(0.0);
+        self
+    }
+}
+
+/// Turns a serde-saphyr error into a located diagnostic naming the real file.
+fn located(err: &serde_saphyr::Error, text: &str, file_name: &str) -> StationError {
+    let loc = err.location();
+    let (line, column) = match &loc {
+        Some(l) if l.line() > 0 => (Some(l.line() as usize), Some(l.column() as usize)),
+        _ => (None, None),
+    };
+    let offset = loc
+        .as_ref()
+        .and_then(|l| {
+            l.span()
+                .byte_offset()
+                .map(|o| (o as usize, l.span().byte_len().unwrap_or(1) as usize))
+        })
+        .or_else(|| line.zip(column).map(|(l, c)| (offset_of(text, l, c), 1)));
+    let message = message_of(err);
+    let help = help_for(&message);
+    let label = if message.contains("unknown field") {
+        "unknown key"
+    } else {
+        "here"
+    }
+    .to_string();
+    StationError {
+        message: format!("{file_name}: {message}"),
+        src: NamedSource::new(file_name, text.to_string()),
+        span: offset.map(|(o, n)| SourceSpan::new(o.min(text.len()).into(), n.max(1))),
+        label,
+        line,
+        column,
+        help,
+    }
+}
+
+/// The error's own text without serde-saphyr's location suffix and snippet.
+fn message_of(err: &serde_saphyr::Error) -> String {
+    let text = err.without_snippet().to_string();
+    let first = text.lines().next().unwrap_or("").trim().to_string();
+    match first.find(" at line ") {
+        Some(i) => first[..i].to_string(),
+        None => first,
+    }
+}
+
+fn help_for(message: &str) -> String {
+    if message.contains("earth_rate") {
+        return "the Earth's rotation is site physics, always on: set site.latitude_deg instead"
+            .into();
+    }
+    if message.contains("unknown field") {
+        let found = message.split('`').nth(1).unwrap_or("");
+        let keys: Vec<&str> = message
+            .split_once("expected ")
+            .map(|(_, k)| {
+                k.trim_start_matches("one of ")
+                    .split(", ")
+                    .map(|k| k.trim_matches('`'))
+                    .collect()
+            })
+            .unwrap_or_default();
+        let best = keys
+            .iter()
+            .map(|k| (strsim::jaro_winkler(found, k), *k))
+            .filter(|(score, _)| *score > 0.8)
+            .max_by(|a, b| a.0.total_cmp(&b.0));
+        return match best {
+            Some((_, k)) => format!("did you mean `{k}`? {HELP}"),
+            None => format!("this section takes: {}; {HELP}", keys.join(", ")),
+        };
+    }
+    if message.contains("unit") {
+        return format!("write the value with a unit of the right kind; {HELP}");
+    }
+    HELP.into()
+}
+
+fn offset_of(text: &str, line: usize, column: usize) -> usize {
+    let start: usize = text
+        .split_inclusive('\n')
+        .take(line.saturating_sub(1))
+        .map(str::len)
+        .sum();
+    (start + column.saturating_sub(1)).min(text.len())
+}
