@@ -105,6 +105,7 @@ fn plan() -> Plan {
                 q(0.01, "g"),
                 DecisionRule::GuardBanded,
             )],
+            segments: vec![],
         }],
         estimated_duration_s: 0.0,
     }
