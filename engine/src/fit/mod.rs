@@ -175,7 +175,8 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
         let segs = get(ix);
         let mut scratch = Out::default();
         let first = match block {
-            Some(b) => gyro::fit_bias(b, &Vec3::zeros(), &mut scratch),
+            // A first bias for the scale fit: the block mean of output minus reference.
+            Some(b) => fallback_bias(&[b]),
             None => fallback_bias(&segs),
         };
         let s = gyro::fit_scale(&segs, axes, first, &mut scratch);

@@ -204,9 +204,10 @@ pub(crate) fn cell_offset(bytes: &[u8], start: usize, field: usize) -> (usize, u
 /// within 10^±22 after scaling) take Clinger's exact fast path: an integer mantissa below
 /// 2^53 divided or multiplied by an exact power of ten rounds once, so the result is the
 /// correctly rounded value, as `str::parse` would give. Everything else falls back to it.
+#[inline]
 pub(crate) fn parse_f64(cell: &[u8]) -> Option<f64> {
-    let b = cell.trim_ascii();
-    fast(b).or_else(|| {
+    fast(cell).or_else(|| {
+        let b = cell.trim_ascii();
         let v: f64 = std::str::from_utf8(b).ok()?.parse().ok()?;
         v.is_finite().then_some(v)
     })
@@ -218,36 +219,32 @@ const POW10: [f64; 23] = [
 ];
 
 fn fast(b: &[u8]) -> Option<f64> {
-    let (neg, mut i) = match b.first()? {
-        b'-' => (true, 1),
-        b'+' => (false, 1),
-        _ => (false, 0),
+    let (neg, b) = match b.first()? {
+        b'-' => (true, &b[1..]),
+        b'+' => (false, &b[1..]),
+        _ => (false, b),
     };
     let mut mant: u64 = 0;
-    let mut digits = 0u32;
-    let mut frac = 0i32;
-    let mut any = false;
+    let mut i = 0;
+    // Integer part, then fraction; every digit counts towards the 19 that fit a u64
+    // (leading zeros too: rare, and the exact fallback handles them).
     while i < b.len() && b[i].is_ascii_digit() {
-        mant = mant.wrapping_mul(10).wrapping_add(u64::from(b[i] - b'0'));
-        if mant != 0 {
-            digits += 1;
-        }
-        any = true;
+        mant = mant.wrapping_mul(10) + u64::from(b[i] - b'0');
         i += 1;
     }
+    let int_digits = i;
+    let mut frac = 0usize;
     if i < b.len() && b[i] == b'.' {
         i += 1;
+        let s = i;
         while i < b.len() && b[i].is_ascii_digit() {
-            mant = mant.wrapping_mul(10).wrapping_add(u64::from(b[i] - b'0'));
-            if mant != 0 {
-                digits += 1;
-            }
-            frac += 1;
-            any = true;
+            mant = mant.wrapping_mul(10) + u64::from(b[i] - b'0');
             i += 1;
         }
+        frac = i - s;
     }
-    if !any || digits > 19 {
+    let digits = int_digits + frac;
+    if digits == 0 || digits > 19 {
         return None;
     }
     let mut exp: i32 = 0;
@@ -279,7 +276,7 @@ fn fast(b: &[u8]) -> Option<f64> {
     if i != b.len() || mant > (1u64 << 53) {
         return None;
     }
-    let e = exp - frac;
+    let e = exp - frac as i32;
     let m = mant as f64;
     let v = match e {
         0 => m,
