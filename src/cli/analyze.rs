@@ -3,8 +3,10 @@
 //! Exit codes: 0 results written and no check failed, 3 a check failed, 1 input error,
 //! 2 usage error (clap).
 
+use super::procedure::{self, FsSources};
+use ratecal_engine::check::{CheckOptions, NoImports, check_text};
 use ratecal_engine::fit::{self, Options};
-use ratecal_engine::plan::Plan;
+use ratecal_engine::plan::{Plan, segment_matches};
 use ratecal_engine::recording;
 use ratecal_engine::results::{Parameter, Results, Verdict};
 use std::path::PathBuf;
@@ -17,8 +19,10 @@ pub struct Args {
     /// procedure give the repeatability analysis.
     #[arg(required = true, value_name = "RUN_DIR")]
     runs: Vec<PathBuf>,
-    /// Procedure whose fit statements and thresholds apply (without it, segments are
-    /// chosen by kind and the standard model is fitted). A checked plan as JSON is accepted.
+    /// Procedure whose fit statements and thresholds apply: a file, a procedure folder
+    /// (newest version) or folder@version; a checked plan as JSON is accepted too. Without
+    /// it, the bundled standard procedure's fits apply when its segment names match,
+    /// otherwise segments are chosen by kind.
     #[arg(long, value_name = "PROCEDURE")]
     procedure: Option<PathBuf>,
     /// Where to write results.json (default: standard output).
@@ -30,10 +34,7 @@ pub struct Args {
 pub fn main(args: Args) -> ExitCode {
     let plan = match args.procedure.as_deref().map(load_plan).transpose() {
         Ok(p) => p,
-        Err(e) => {
-            eprintln!("{e:?}");
-            return ExitCode::from(1);
-        }
+        Err(()) => return ExitCode::from(1),
     };
     let mut runs = Vec::with_capacity(args.runs.len());
     for dir in &args.runs {
@@ -45,6 +46,7 @@ pub fn main(args: Args) -> ExitCode {
             }
         }
     }
+    let plan = plan.or_else(|| default_plan(&runs[0].1));
     let results = fit::analyze_runs(&runs, plan.as_ref(), &Options::default());
     let json = results.to_json();
     match &args.out {
@@ -64,20 +66,66 @@ pub fn main(args: Args) -> ExitCode {
     }
 }
 
-/// Loads the procedure. Until the procedure checker is merged, a checked plan serialized
-/// as JSON is accepted; procedure text is refused with a clear message.
-fn load_plan(path: &std::path::Path) -> miette::Result<Plan> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| miette::miette!("cannot read {}: {e}", path.display()))?;
-    if path.extension().is_some_and(|e| e == "json") {
+/// Loads and checks the procedure (a file, a folder's newest version, `folder@version`);
+/// a checked plan serialized as JSON is accepted too. Diagnostics go to standard error.
+fn load_plan(arg: &std::path::Path) -> Result<Plan, ()> {
+    if arg.extension().is_some_and(|e| e == "json") {
+        let text = std::fs::read_to_string(arg)
+            .map_err(|e| eprintln!("error: cannot read {}: {e}", arg.display()))?;
         return serde_json::from_str(&text)
-            .map_err(|e| miette::miette!("{}: not a checked plan: {e}", path.display()));
+            .map_err(|e| eprintln!("error: {}: not a checked plan: {e}", arg.display()));
     }
-    Err(miette::miette!(
-        help = "pass a checked plan as JSON, or analyse without --procedure (segments by kind, standard model)",
-        "{}: procedure text needs the procedure checker, which this build does not include yet",
-        path.display()
-    ))
+    let file = procedure::read(&arg.display().to_string()).map_err(|d| procedure::report(&d))?;
+    match check_text(
+        &file.display,
+        &file.text,
+        &FsSources,
+        &CheckOptions::default(),
+    ) {
+        Ok(checked) => {
+            checked.warnings.iter().for_each(procedure::report);
+            Ok(checked.plan)
+        }
+        Err(diags) => {
+            diags.iter().for_each(procedure::report);
+            Err(())
+        }
+    }
+}
+
+/// The bundled standard procedure, shipped in the binary.
+const STANDARD: &str = include_str!("../../procedures/imu-2d-standard/1.0.0.rcal");
+
+/// Without `--procedure`: the standard procedure's fit statements (not its thresholds, which
+/// the user did not ask for) when its segment patterns match the recording; otherwise the
+/// analysis picks segments by kind.
+fn default_plan(rec: &recording::Recording) -> Option<Plan> {
+    let mut plan = check_text(
+        "imu-2d-standard/1.0.0.rcal",
+        STANDARD,
+        &NoImports,
+        &CheckOptions::default(),
+    )
+    .ok()?
+    .plan;
+    let ids: Vec<&str> = rec
+        .manifest
+        .segments
+        .iter()
+        .map(|s| s.id.as_str())
+        .collect();
+    let all_match = plan.fits.iter().all(|f| {
+        f.segments
+            .iter()
+            .any(|p| ids.iter().any(|id| segment_matches(p, id)))
+    });
+    if !all_match {
+        return None;
+    }
+    plan.accepts.clear();
+    plan.verifications.clear();
+    plan.environment.clear();
+    Some(plan)
 }
 
 /// A short human summary on standard error (standard output may hold the JSON).

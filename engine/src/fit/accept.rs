@@ -110,8 +110,15 @@ pub(crate) fn evaluate(
                 .iter()
                 .filter(|p| p.sensor == sensor)
                 .find(|p| {
-                    wh.get(&p.segment)
-                        .is_some_and(|w| matches_point(&v.point, w))
+                    // The procedure may name the segments that record the point.
+                    if v.segments.is_empty() {
+                        wh.get(&p.segment)
+                            .is_some_and(|w| matches_point(&v.point, w))
+                    } else {
+                        v.segments
+                            .iter()
+                            .any(|pat| crate::plan::segment_matches(pat, &p.segment))
+                    }
                 });
             let where_ = match v.point {
                 VerifyPoint::Attitude {
@@ -119,7 +126,10 @@ pub(crate) fn evaluate(
                     inner_deg,
                 } => format!("at outer {outer_deg} deg, inner {inner_deg} deg"),
                 VerifyPoint::Rate { axis, rate_dps } => {
-                    format!("at {rate_dps} deg/s about the {axis:?} axis")
+                    format!(
+                        "at {rate_dps} deg/s about the {} axis",
+                        format!("{axis:?}").to_lowercase()
+                    )
                 }
             };
             out.push(match found {

@@ -25,7 +25,7 @@ pub use repeat::analyze_runs;
 use crate::plan::{Outliers, Plan};
 use crate::recording::Recording;
 use crate::results::{self, Parameter, ResidualStats, Results, SyncReport};
-use prep::SegData;
+use prep::{PrepOptions, SegData};
 use ratecal_physics::{Mat3, Vec3};
 use std::collections::{BTreeMap, HashMap};
 
@@ -112,17 +112,53 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
         table_step_s: stats::median_step(&rec.table.t),
         ..Default::default()
     };
+    // Segments are independent: prepare them on two threads, the longest alone.
+    let dur = |i: usize| rec.manifest.segments[i].t_end - rec.manifest.segments[i].t_start;
+    let total: f64 = sel.prep.iter().map(|p| dur(p.0)).sum();
+    let (mut first, mut second) = (Vec::new(), Vec::new());
+    let mut acc = 0.0;
+    let mut order = sel.prep.clone();
+    order.sort_by(|a, b| dur(b.0).total_cmp(&dur(a.0)));
+    for p in order {
+        if acc < total / 2.0 {
+            acc += dur(p.0);
+            first.push(p);
+        } else {
+            second.push(p);
+        }
+    }
+    let work = |list: &[(usize, PrepOptions)]| {
+        let mut sync = SyncReport::default();
+        let mut warnings = Vec::new();
+        let done: Vec<(usize, SegData)> = list
+            .iter()
+            .map(|&(i, po)| {
+                (
+                    i,
+                    prep::prepare(
+                        rec,
+                        &rec.manifest.segments[i],
+                        &geos[i],
+                        po,
+                        &mut sync,
+                        &mut warnings,
+                    ),
+                )
+            })
+            .collect();
+        (done, sync, warnings)
+    };
+    let (a, b) = std::thread::scope(|sc| {
+        let h = sc.spawn(|| work(&second));
+        (work(&first), h.join().expect("preparation thread"))
+    });
     let mut data: HashMap<usize, SegData> = HashMap::new();
-    for &(i, po) in &sel.prep {
-        let d = prep::prepare(
-            rec,
-            &rec.manifest.segments[i],
-            &geos[i],
-            po,
-            &mut sync,
-            &mut out.warnings,
-        );
-        data.insert(i, d);
+    for (done, sy, w) in [a, b] {
+        data.extend(done);
+        sync.max_gap_s = sync.max_gap_s.max(sy.max_gap_s);
+        sync.max_sync_error_s = sync.max_sync_error_s.max(sy.max_sync_error_s);
+        sync.max_angle_error_deg = sync.max_angle_error_deg.max(sy.max_angle_error_deg);
+        out.warnings.extend(w);
     }
     let get = |ix: &[usize]| ix.iter().filter_map(|i| data.get(i)).collect::<Vec<_>>();
 
@@ -139,7 +175,8 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
         let segs = get(ix);
         let mut scratch = Out::default();
         let first = match block {
-            Some(b) => gyro::fit_bias(b, &Vec3::zeros(), &mut scratch),
+            // A first bias for the scale fit: the block mean of output minus reference.
+            Some(b) => fallback_bias(&[b]),
             None => fallback_bias(&segs),
         };
         let s = gyro::fit_scale(&segs, axes, first, &mut scratch);

@@ -104,6 +104,34 @@ pub(crate) fn prepare(
     let (mut so, mut si) = (0.0, 0.0);
     let tab = &rec.table;
     let mut j = tab.t.partition_point(|&x| x <= t[0]).saturating_sub(1);
+    // Table state at feedback sample `j` plus a fraction `w` of the step to `j + 1`,
+    // through the kinematics of ratecal_physics: (specific force m/s^2, rate deg/s).
+    let refs_at = |j: usize, w: f64| -> (Vec3, Vec3) {
+        let j = j.min(tab.t.len() - 2);
+        let lerp = |x: &[f64]| x[j] + w * (x[j + 1] - x[j]);
+        let lerp_angle = |x: &[f64]| x[j] + w * unwrap(x[j + 1] - x[j]);
+        let state = TableState {
+            outer: AxisMotion {
+                angle: lerp_angle(&tab.outer) * DEG,
+                rate: lerp(&tab.outer_rate) * DEG,
+                accel: rate_derivative(&tab.t, &tab.outer_rate, j) * DEG,
+            },
+            inner: AxisMotion {
+                angle: lerp_angle(&tab.inner) * DEG,
+                rate: lerp(&tab.inner_rate) * DEG,
+                accel: rate_derivative(&tab.t, &tab.inner_rate, j) * DEG,
+            },
+        };
+        (
+            state.f_b(geo, &site, &Vec3::zeros()),
+            state.w_ib(geo, &site) / DEG,
+        )
+    };
+    let mut cache = (
+        usize::MAX,
+        (Vec3::zeros(), Vec3::zeros()),
+        (Vec3::zeros(), Vec3::zeros()),
+    );
     for &ti in &t {
         while j + 2 < tab.t.len() && tab.t[j + 1] <= ti {
             j += 1;
@@ -115,28 +143,30 @@ pub(crate) fn prepare(
         sync.max_sync_error_s = sync
             .max_sync_error_s
             .max((ti - t0).abs().min((t1 - ti).abs()));
-        let lerp = |x: &[f64]| x[j] + w * (x[j + 1] - x[j]);
-        let lerp_angle = |x: &[f64]| x[j] + w * unwrap(x[j + 1] - x[j]);
         let acc_o = rate_derivative(&tab.t, &tab.outer_rate, j);
         let acc_i = rate_derivative(&tab.t, &tab.inner_rate, j);
         let max_acc = acc_o.abs().max(acc_i.abs());
         sync.max_angle_error_deg = sync.max_angle_error_deg.max(gap * gap / 8.0 * max_acc);
-        let state = TableState {
-            outer: AxisMotion {
-                angle: lerp_angle(&tab.outer) * DEG,
-                rate: lerp(&tab.outer_rate) * DEG,
-                accel: acc_o * DEG,
-            },
-            inner: AxisMotion {
-                angle: lerp_angle(&tab.inner) * DEG,
-                rate: lerp(&tab.inner_rate) * DEG,
-                accel: acc_i * DEG,
-            },
+        so += tab.outer[j] + w * unwrap(tab.outer[j + 1] - tab.outer[j]);
+        si += tab.inner[j] + w * unwrap(tab.inner[j + 1] - tab.inner[j]);
+        let (f, wi) = if seg.kind == SegmentKind::Static {
+            // At rest the references hardly change between two feedback samples: evaluate
+            // the kinematics on the feedback samples and interpolate (half the work of
+            // evaluating it at every IMU stamp, same answer to well below the noise).
+            if cache.0 != j {
+                // Moving one feedback step on, the old end is the new start.
+                let start = if cache.0.wrapping_add(1) == j {
+                    cache.2
+                } else {
+                    refs_at(j, 0.0)
+                };
+                cache = (j, start, refs_at(j, 1.0));
+            }
+            let ((f0, w0), (f1, w1)) = (cache.1, cache.2);
+            (f0 + (f1 - f0) * w, w0 + (w1 - w0) * w)
+        } else {
+            refs_at(j, w)
         };
-        so += state.outer.angle / DEG;
-        si += state.inner.angle / DEG;
-        let f = state.f_b(geo, &site, &Vec3::zeros());
-        let wi = state.w_ib(geo, &site) / DEG;
         for k in 0..3 {
             f_ref[k].push(f[k]);
             w_ref[k].push(wi[k]);
@@ -209,8 +239,7 @@ pub(crate) fn flag_outliers(r: &[f64], rule: Outliers, keep: &mut [bool]) {
     match rule {
         Outliers::Sigma(k) => {
             for _ in 0..5 {
-                let m = super::stats::mean(r, keep);
-                let s = super::stats::std(r, keep);
+                let (m, s) = super::stats::mean_std(r, keep);
                 let mut changed = false;
                 for i in 0..r.len() {
                     if keep[i] && (r[i] - m).abs() > k * s {

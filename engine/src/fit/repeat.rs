@@ -85,16 +85,16 @@ pub fn analyze_runs(runs: &[(String, Recording)], plan: Option<&Plan>, opts: &Op
             let need = a.over_runs.unwrap_or(3) as usize;
             let worst = rep
                 .iter()
-                .filter(|p| p.cv.is_some())
+                .filter(|p| p.cv.is_some() && p.name.contains(".scale."))
                 .max_by(|x, y| x.cv.partial_cmp(&y.cv).expect("finite"));
             res.acceptance.push(match worst {
                 _ if each.len() < need => not_evaluated(a, &format!("needs {need} runs, {} given", each.len())),
-                None => not_evaluated(a, "no parameter with a meaningful coefficient of variation"),
+                None => not_evaluated(a, "no scale factor was determined in every run"),
                 Some(w) => {
                     let cv = w.cv.expect("filtered");
                     let mut j = judge(a, cv, cv / (2.0 * (n - 1.0)).sqrt(), None);
                     j.reason = Some(format!(
-                        "largest CV is {}'s; biases and misalignments are near zero, where a CV is meaningless: their standard deviations are in `repeatability`",
+                        "CV of the scale factors K (largest: {}); noise figures are not calibration parameters; biases and misalignments are near zero, where a CV is meaningless: their standard deviations are in `repeatability`",
                         w.name
                     ));
                     j

@@ -11,6 +11,30 @@ pub(crate) fn mean(x: &[f64], keep: &[bool]) -> f64 {
     if n == 0 { f64::NAN } else { s / n as f64 }
 }
 
+/// Mean and sample standard deviation of the kept samples in one pass (shifted by the
+/// first sample, so the sums do not lose precision on large offsets).
+pub(crate) fn mean_std(x: &[f64], keep: &[bool]) -> (f64, f64) {
+    let Some(shift) = x.iter().zip(keep).find(|p| *p.1).map(|p| *p.0) else {
+        return (f64::NAN, 0.0);
+    };
+    let (mut s, mut ss, mut n) = (0.0, 0.0, 0usize);
+    for (v, k) in x.iter().zip(keep) {
+        if *k {
+            let d = v - shift;
+            s += d;
+            ss += d * d;
+            n += 1;
+        }
+    }
+    let nf = n as f64;
+    let var = if n < 2 {
+        0.0
+    } else {
+        ((ss - s * s / nf) / (nf - 1.0)).max(0.0)
+    };
+    (shift + s / nf, var.sqrt())
+}
+
 /// Sample standard deviation of the kept samples.
 pub(crate) fn std(x: &[f64], keep: &[bool]) -> f64 {
     let m = mean(x, keep);

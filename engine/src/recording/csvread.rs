@@ -71,6 +71,9 @@ pub(crate) fn read_columns(
         .collect();
     let mut lines = Vec::with_capacity(guess);
     let width = names.len();
+    if let Some(fast) = fast_columns(bytes, header_len, width, &idx, guess) {
+        return Ok(fast);
+    }
     while rdr.read_byte_record(&mut rec).map_err(|e| io(file, e))? {
         let pos = rec.position().expect("csv records carry positions");
         if rec.len() != width {
@@ -119,6 +122,64 @@ pub(crate) fn read_columns(
     Ok(Columns { cols, lines })
 }
 
+/// The common case without the csv state machine: unquoted numeric cells, one record a
+/// line. Anything else (quotes, a ragged row, a bad cell) returns `None`, and the csv
+/// reader reads the file again to locate the problem exactly.
+fn fast_columns(
+    bytes: &[u8],
+    header_len: usize,
+    width: usize,
+    idx: &[Option<usize>],
+    guess: usize,
+) -> Option<Columns> {
+    if bytes.contains(&b'"') {
+        return None;
+    }
+    // field -> output column
+    let mut want = vec![usize::MAX; width];
+    for (k, i) in idx.iter().enumerate() {
+        if let Some(i) = i {
+            want[*i] = k;
+        }
+    }
+    let mut cols: Vec<Option<Vec<f64>>> = idx
+        .iter()
+        .map(|i| i.map(|_| Vec::with_capacity(guess)))
+        .collect();
+    let mut lines = Vec::with_capacity(guess);
+    let mut pos = (header_len + 1).min(bytes.len());
+    let mut line = 1u64;
+    while pos < bytes.len() {
+        line += 1;
+        let end = bytes[pos..]
+            .iter()
+            .position(|&b| b == b'\n')
+            .map_or(bytes.len(), |p| pos + p);
+        let row = &bytes[pos..end];
+        pos = end + 1;
+        let row = row.strip_suffix(b"\r").unwrap_or(row);
+        if row.iter().all(u8::is_ascii_whitespace) {
+            continue;
+        }
+        let mut field = 0;
+        for cell in row.split(|&b| b == b',') {
+            if field >= width {
+                return None;
+            }
+            let k = want[field];
+            if k != usize::MAX {
+                cols[k].as_mut()?.push(parse_f64(cell)?);
+            }
+            field += 1;
+        }
+        if field != width {
+            return None;
+        }
+        lines.push(line);
+    }
+    Some(Columns { cols, lines })
+}
+
 fn io(file: &str, e: csv::Error) -> RecordingError {
     RecordingError::Io {
         file: file.to_string(),
@@ -143,9 +204,10 @@ pub(crate) fn cell_offset(bytes: &[u8], start: usize, field: usize) -> (usize, u
 /// within 10^±22 after scaling) take Clinger's exact fast path: an integer mantissa below
 /// 2^53 divided or multiplied by an exact power of ten rounds once, so the result is the
 /// correctly rounded value, as `str::parse` would give. Everything else falls back to it.
+#[inline]
 pub(crate) fn parse_f64(cell: &[u8]) -> Option<f64> {
-    let b = cell.trim_ascii();
-    fast(b).or_else(|| {
+    fast(cell).or_else(|| {
+        let b = cell.trim_ascii();
         let v: f64 = std::str::from_utf8(b).ok()?.parse().ok()?;
         v.is_finite().then_some(v)
     })
@@ -157,36 +219,32 @@ const POW10: [f64; 23] = [
 ];
 
 fn fast(b: &[u8]) -> Option<f64> {
-    let (neg, mut i) = match b.first()? {
-        b'-' => (true, 1),
-        b'+' => (false, 1),
-        _ => (false, 0),
+    let (neg, b) = match b.first()? {
+        b'-' => (true, &b[1..]),
+        b'+' => (false, &b[1..]),
+        _ => (false, b),
     };
     let mut mant: u64 = 0;
-    let mut digits = 0u32;
-    let mut frac = 0i32;
-    let mut any = false;
+    let mut i = 0;
+    // Integer part, then fraction; every digit counts towards the 19 that fit a u64
+    // (leading zeros too: rare, and the exact fallback handles them).
     while i < b.len() && b[i].is_ascii_digit() {
-        mant = mant.wrapping_mul(10).wrapping_add(u64::from(b[i] - b'0'));
-        if mant != 0 {
-            digits += 1;
-        }
-        any = true;
+        mant = mant.wrapping_mul(10) + u64::from(b[i] - b'0');
         i += 1;
     }
+    let int_digits = i;
+    let mut frac = 0usize;
     if i < b.len() && b[i] == b'.' {
         i += 1;
+        let s = i;
         while i < b.len() && b[i].is_ascii_digit() {
-            mant = mant.wrapping_mul(10).wrapping_add(u64::from(b[i] - b'0'));
-            if mant != 0 {
-                digits += 1;
-            }
-            frac += 1;
-            any = true;
+            mant = mant.wrapping_mul(10) + u64::from(b[i] - b'0');
             i += 1;
         }
+        frac = i - s;
     }
-    if !any || digits > 19 {
+    let digits = int_digits + frac;
+    if digits == 0 || digits > 19 {
         return None;
     }
     let mut exp: i32 = 0;
@@ -218,7 +276,7 @@ fn fast(b: &[u8]) -> Option<f64> {
     if i != b.len() || mant > (1u64 << 53) {
         return None;
     }
-    let e = exp - frac;
+    let e = exp - frac as i32;
     let m = mant as f64;
     let v = match e {
         0 => m,

@@ -29,6 +29,8 @@ pub struct SimSpec {
     pub errors: ImuErrors,
     /// IMU temperature column: start and slope per hour.
     pub temp: Option<(f64, f64)>,
+    /// Recorded time before each window (moving and settling), s.
+    pub settle_s: f64,
 }
 
 pub const SITE: Site = Site {
@@ -57,6 +59,7 @@ impl SimSpec {
             bias_walk: 5e-6,
             errors: e,
             temp: None,
+            settle_s: 2.0,
         }
     }
 }
@@ -137,7 +140,7 @@ pub fn write(dir: &Path, spec: &SimSpec, windows: &[Window]) -> Truth {
     let dt_i = 1.0 / spec.imu_hz;
     let step = spec.bias_walk * dt_i.sqrt();
     let nw = Normal::new(0.0, step.max(1e-300)).unwrap();
-    let settle = 2.0;
+    let settle = spec.settle_s;
     // Timeline: each window preceded by `settle` seconds in the same state.
     let mut spans = Vec::new();
     let mut t = 0.0;

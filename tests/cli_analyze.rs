@@ -1,0 +1,74 @@
+//! `ratecal analyze` from the command line: exit codes and the results file.
+
+use std::path::Path;
+use std::process::Command;
+
+fn example() -> Option<std::path::PathBuf> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let found = ["../shared", "../../shared"]
+        .iter()
+        .map(|r| root.join(r).join("examples/standard-with-lever-arm"))
+        .find(|p| p.exists());
+    if found.is_none() {
+        println!("skipped: ../shared/examples/standard-with-lever-arm is absent");
+    }
+    found
+}
+
+fn analyze(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_ratecal"))
+        .arg("analyze")
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn writes_results_and_exits_zero() {
+    let Some(ex) = example() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("results.json");
+    let o = analyze(&[
+        ex.to_str().unwrap(),
+        "--procedure",
+        "procedures/imu-2d-standard",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out).unwrap()).unwrap();
+    assert_eq!(v["format"], "ratecal-results/1");
+    assert_eq!(
+        v["parameters"]["gyro.scale.z"],
+        serde_json::json!({ "observable": false })
+    );
+    for s in ["accel", "gyro"] {
+        for w in ["bias", "scale"] {
+            for a in ["x", "y", "z"] {
+                assert!(v["parameters"].get(format!("{s}.{w}.{a}")).is_some());
+            }
+        }
+    }
+    assert!(
+        v["acceptance"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|a| a["verdict"] == "not_evaluated")
+    );
+}
+
+#[test]
+fn input_and_usage_errors() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = analyze(&[tmp.path().to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("manifest.yaml"));
+    assert_eq!(analyze(&[]).status.code(), Some(2));
+}
