@@ -9,17 +9,23 @@ use ratecal_engine::recording::{Columns, Manifest, ManifestStation, RecordingWri
 use ratecal_engine::run::{NoProgress, RunOptions, RunStatus, execute};
 use std::time::Instant;
 
-#[allow(dead_code)]
-#[path = "../engine/tests/common/plans.rs"]
-mod plans;
-
 fn station_1khz() -> Station {
     let yaml = DEFAULT_STATION_YAML.replace("sample_rate: 100 Hz", "sample_rate: 1000 Hz");
     Station::from_yaml(&yaml, "bench").expect("station")
 }
 
+/// `procedures/imu-2d-standard`, checked.
 fn standard_plan() -> Plan {
-    plans::standard(3600.0)
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/procedures/imu-2d-standard/1.0.0.rcal"
+    );
+    let text = std::fs::read_to_string(path).expect("standard procedure");
+    let opts = ratecal_engine::check::CheckOptions::default();
+    match ratecal_engine::check::check_text(path, &text, &ratecal_engine::check::NoImports, &opts) {
+        Ok(c) => c.plan,
+        Err(d) => panic!("{d:?}"),
+    }
 }
 
 fn manifest(st: &Station) -> Manifest {

@@ -158,10 +158,9 @@ fn dry_run_writes_the_run_folder() {
         tmp.path(),
     );
     assert!(matches!(code(&o), 0 | 3));
-    assert_eq!(
-        std::fs::read(dir.join("imu.csv")).unwrap(),
-        std::fs::read(tmp.path().join("r2/imu.csv")).unwrap()
-    );
+    let same = std::fs::read(dir.join("imu.csv")).unwrap()
+        == std::fs::read(tmp.path().join("r2/imu.csv")).unwrap();
+    assert!(same, "same seed, different imu.csv");
 }
 
 fn station_with(fault: &str) -> String {
@@ -173,7 +172,7 @@ fn station_fault_aborts_with_4_and_resume_completes() {
     let tmp = tempfile::tempdir().unwrap();
     std::fs::write(tmp.path().join("p.rcal"), MINI).unwrap();
     // A lab excursion during the rate step (after both static segments).
-    let fault = "faults: [ { temperature_excursion: { at: 45 s, delta: 4 degC, ramp: 1 s, duration: 600 s } } ]";
+    let fault = "faults: [ { temperature_excursion: { at: 36 s, delta: 4 degC, ramp: 1 s, duration: 600 s } } ]";
     std::fs::write(tmp.path().join("st.yaml"), station_with(fault)).unwrap();
     let o = ratecal(
         &[
@@ -214,4 +213,27 @@ fn station_fault_aborts_with_4_and_resume_completes() {
     ratecal_engine::recording::read(&dir).unwrap();
     // Nothing left to resume.
     assert_eq!(code(&ratecal(&["run", "--resume", "r"], tmp.path())), 1);
+}
+
+#[test]
+fn standard_procedure_dry_run_passes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let proc_dir = concat!(env!("CARGO_MANIFEST_DIR"), "/procedures/imu-2d-standard");
+    let o = ratecal(
+        &["run", proc_dir, "--dry-run", "--out", "std", "--seed", "11"],
+        tmp.path(),
+    );
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let m = manifest(&tmp.path().join("std"));
+    assert_eq!(m.procedure.as_ref().unwrap().name, "imu-2d-standard");
+    let bias = m.segments.iter().find(|s| s.id == "gyro_bias").unwrap();
+    assert!((bias.t_end - bias.t_start - 3600.0).abs() < 1e-9);
+    assert_eq!(
+        m.segments
+            .iter()
+            .filter(|s| s.id.starts_with("accel_static/"))
+            .count(),
+        6
+    );
+    assert!(tmp.path().join("std/results.json").exists());
 }

@@ -17,8 +17,10 @@
 //! ```
 
 pub mod registry;
+pub mod replay;
 pub mod sim;
 pub mod station;
+pub mod tcp;
 mod traits;
 
 pub use registry::{DRIVERS, DriverKind, Drivers, build};

@@ -53,9 +53,20 @@ pub fn build(station: &Station, seed: u64) -> Result<Drivers, DriverError> {
             DriverErrorKind::InvalidCommand,
             "the simulated IMU senses the simulated table's motion: it needs `table.driver: sim`",
         )),
-        _ => Err(DriverError::new(
-            DriverErrorKind::Transport,
-            "tcp and replay drivers are not built yet",
-        )),
+        (table, ImuDriverSpec::Replay { recording }) => {
+            let table: Box<dyn TableDriver> = match table {
+                TableDriverSpec::Sim => Box::new(crate::sim::build(station, seed).0),
+                TableDriverSpec::Tcp { address, timeout } => Box::new(crate::tcp::TcpTable::new(
+                    address.clone(),
+                    station.table.clone(),
+                    timeout.0,
+                )),
+                TableDriverSpec::Replay { recording } => {
+                    Box::new(crate::replay::ReplayTable::open(recording, station)?)
+                }
+            };
+            let imu = crate::replay::ReplayImu::open(recording, station)?;
+            Ok((table, Box::new(imu)))
+        }
     }
 }

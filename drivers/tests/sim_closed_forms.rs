@@ -239,3 +239,32 @@ async fn time_offset_delays_the_outputs_by_tau() {
     }
     assert!(moving > 1000, "the oscillation makes the offset visible");
 }
+
+#[tokio::test(start_paused = true)]
+async fn remount_changes_the_mount_from_then_on() {
+    let s = station(&[]);
+    let tr = truth(&s);
+    let (mut table, mut imu) = build(&s, 1).unwrap();
+    table
+        .command(TableCommand::MoveTo {
+            outer_deg: 90.0,
+            inner_deg: 0.0,
+        })
+        .await
+        .unwrap();
+    tokio::time::sleep(Duration::from_secs(10)).await;
+    // Body X along platform Y: C_PB columns are the body axes in P.
+    imu.remount([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+        .await
+        .unwrap();
+    tokio::time::sleep(Duration::from_secs(10)).await;
+    let mut xs = Vec::new();
+    imu.read(&mut xs).await.unwrap();
+    assert_eq!(xs.len(), 2001);
+    let before = xs.iter().find(|x| x.t == 9.0).unwrap();
+    let after = xs.iter().find(|x| x.t >= 15.0).unwrap();
+    // Pitch 90: platform X is up, so the old body X reads +g and the new body Y reads -g.
+    assert!((before.accel[0] - ((1.0 + tr.sa[0]) * tr.g + tr.ba[0])).abs() < 1e-9);
+    assert!((after.accel[1] - ((1.0 + tr.sa[1]) * -tr.g + tr.ba[1])).abs() < 1e-9);
+    assert!((after.accel[0] - tr.ba[0]).abs() < 1e-9);
+}

@@ -44,3 +44,97 @@ fn wrong_unit_is_located() {
     assert!(shown.contains("unit of angle"), "{shown}");
     assert_eq!(err.line, Some(12));
 }
+
+#[test]
+fn every_example_station_parses_and_builds() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("stations");
+    let mut n = 0;
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let s = Station::from_yaml(&text, &path.display().to_string())
+            .unwrap_or_else(|e| panic!("{}", render(&e)));
+        ratecal_drivers::build(&s, 0).unwrap();
+        n += 1;
+    }
+    assert!(n >= 6);
+}
+
+#[test]
+fn effects_map_to_the_physics_parameters() {
+    let text = with(
+        "  effects: {}",
+        "  effects:\n    accel_misalignment: { xy_mrad: 0.4, zx_mrad: -0.6 }\n    gyro_misalignment: { yz_mrad: 2 }\n    g_sensitivity: { xz_dps_per_g: 0.0098156 }\n    lever_arm: { ryx_mm: 3 }\n    time_offset: { tau_ms: 2.5 }\n    gyro_scale_nonlinearity: { y: 7 }",
+    );
+    let s = Station::from_yaml(&text, "lab.yaml").unwrap();
+    let e = s.imu_errors();
+    assert!((e.k_a[(0, 0)] - (1.0 + 350e-6)).abs() < 1e-15);
+    assert!((e.k_a[(0, 1)] - 0.4e-3).abs() < 1e-15);
+    assert!((e.k_a[(2, 0)] + 0.6e-3).abs() < 1e-15);
+    assert!((e.k_g[(1, 2)] - 2e-3).abs() < 1e-15);
+    assert!((e.k_g[(1, 1)] - (1.0 - 310e-6)).abs() < 1e-15);
+    // 0.0098156 deg/s per g at g = 9.8156 m/s^2 is 0.001 deg/s per m/s^2.
+    assert!((e.g_sens[(0, 2)] - 0.001).abs() < 1e-15);
+    assert!((e.lever_m[(1, 0)] - 0.003).abs() < 1e-15);
+    assert!((e.b_a[0] - 1.2e-3 * 9.80665).abs() < 1e-15);
+    assert_eq!(e.gyro_nonlinearity[1], 7.0);
+    assert_eq!(s.time_offset_s(), 0.0025);
+}
+
+#[test]
+fn earth_rate_is_not_an_imu_defect() {
+    let text = with(
+        "  effects: {}",
+        "  effects: { earth_rate: { latitude_deg: 40 } }",
+    );
+    let err = Station::from_yaml(&text, "lab.yaml").unwrap_err();
+    assert!(err.help.contains("site physics"), "{}", render(&err));
+}
+
+#[test]
+fn bad_values_are_located() {
+    for (from, to, needle) in [
+        (
+            "outer_axis: [0, -1, 0]",
+            "outer_axis: [0, -2, 0]",
+            "unit vector",
+        ),
+        ("sample_rate: 100 Hz", "sample_rate: 100", "no unit"),
+        (
+            "gyro_noise_density: 0.0003 deg/s/rtHz",
+            "gyro_noise_density: 0.0003 deg/s",
+            "/rtHz",
+        ),
+        ("feedback_rate: 50 Hz", "feedback_rate: -50 Hz", "positive"),
+        (
+            "  imu: { warmup_offset: 4 degC",
+            "  imu: { warmup_offset: 4 degC/h",
+            "temperature rate",
+        ),
+    ] {
+        let line = DEFAULT_STATION_YAML
+            .lines()
+            .position(|l| l.contains(from))
+            .unwrap()
+            + 1;
+        let err = Station::from_yaml(&with(from, to), "lab.yaml").unwrap_err();
+        let shown = render(&err);
+        assert_eq!(err.line, Some(line), "{shown}");
+        assert!(
+            shown.contains(needle) && shown.contains("lab.yaml:"),
+            "{shown}"
+        );
+    }
+}
+
+#[test]
+fn describe_gives_the_manifest_facts() {
+    let info = Station::default_sim().describe();
+    assert_eq!(info.geometry, ratecal_physics::Geometry::seed());
+    assert_eq!(info.site.latitude_deg, 55.70);
+    assert_eq!(info.imu.grade, "tactical");
+    let env = info.environment.unwrap();
+    assert!((env.humidity_pct.unwrap() - 45.0).abs() < 1e-12);
+    assert!((env.vibration_g.unwrap() - 0.002).abs() < 1e-15);
+    assert!(info.simulated);
+}

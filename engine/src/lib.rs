@@ -3,6 +3,7 @@
 //! Results), `render` (Results -> report), `audit` (Plan vs Plan, run folders).
 //! Only `run` awaits; the engine does IO only through what it is handed.
 
+pub mod check;
 pub mod fit;
 pub mod plan;
 pub mod recording;

@@ -14,7 +14,7 @@ type P<'a> = Pair<'a, Rule>;
 
 /// Parses a file (without attaching comments).
 pub(crate) fn parse_file(text: &str) -> Result<File, Diagnostic> {
-    let mut pairs = Grammar::parse(Rule::file, text).map_err(syntax_error)?;
+    let mut pairs = Grammar::parse(Rule::file, text).map_err(|e| syntax_error(e, text))?;
     let file = pairs
         .next()
         .ok_or_else(|| Diagnostic::error("syntax::empty", "empty parse"))?;
@@ -33,7 +33,7 @@ pub(crate) fn parse_file(text: &str) -> Result<File, Diagnostic> {
     })
 }
 
-fn syntax_error(e: pest::error::Error<Rule>) -> Diagnostic {
+fn syntax_error(e: pest::error::Error<Rule>, text: &str) -> Diagnostic {
     use pest::error::{ErrorVariant, InputLocation};
     let pos = match e.location {
         InputLocation::Pos(p) => p,
@@ -56,9 +56,20 @@ fn syntax_error(e: pest::error::Error<Rule>) -> Diagnostic {
             format!("expected {} or {}", rest.join(", "), last)
         }
     };
+    let mut help = "see docs/language.md for the form of each statement".to_string();
+    // A keyword where a name was expected: say so.
+    if let Some(rest) = text.get(pos..)
+        && let Ok(mut kw) = Grammar::parse(Rule::reserved, rest)
+        && let Some(kw) = kw.next()
+    {
+        help = format!(
+            "`{}` is a keyword and cannot be used as a name; pick another name",
+            kw.as_str()
+        );
+    }
     Diagnostic::error("syntax::unexpected", format!("syntax error: {what}"))
         .label(Span::new(pos, pos), what)
-        .help("see docs/language.md for the form of each statement")
+        .help(help)
 }
 
 fn rule_name(r: Rule) -> Option<&'static str> {

@@ -1,17 +1,124 @@
-//! `ratecal check` (not implemented yet).
+//! `ratecal check`: syntax, units, names, station limits, observability and duration of
+//! each procedure given; every diagnostic at once. Exit 0 (warnings allowed), 1 errors.
 
+use super::procedure::{self, FsSources};
+use ratecal_drivers::Station;
+use ratecal_engine::check::{CheckOptions, StationLimits, check_text};
 use std::process::ExitCode;
 
 /// Arguments of `ratecal check`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Inputs.
-    inputs: Vec<std::path::PathBuf>,
+    /// Procedures: files, folders (newest version) or folder@version.
+    #[arg(required = true)]
+    inputs: Vec<String>,
+    /// Station file: compare rates and accelerations with its table and IMU limits.
+    #[arg(long)]
+    station: Option<std::path::PathBuf>,
+    /// Output format: text, or json (the checked plans on standard output).
+    #[arg(long, value_parser = ["text", "json"], default_value = "text")]
+    format: String,
+}
+
+/// Formats a duration in seconds as `1 h 22 min`, `12 min`, `45 s`.
+pub fn human_duration(s: f64) -> String {
+    if !s.is_finite() {
+        return "unbounded".to_string();
+    }
+    let total_min = (s / 60.0).round() as u64;
+    match (total_min / 60, total_min % 60) {
+        (0, 0) => format!("{} s", s.round() as u64),
+        (0, m) => format!("{m} min"),
+        (h, 0) => format!("{h} h"),
+        (h, m) => format!("{h} h {m} min"),
+    }
+}
+
+/// The limits `check` compares a plan with, from a station description.
+pub fn station_limits(st: &Station) -> StationLimits {
+    StationLimits {
+        max_rate_dps: st.table.max_rate.get(),
+        max_accel_dps2: st.table.max_accel_dps2,
+        gyro_range_dps: st.imu.gyro_range.get(),
+        accel_range_mps2: st.imu.accel_range.get(),
+        geometry: st.geometry(),
+    }
 }
 
 /// Runs the subcommand.
 pub fn main(args: Args) -> ExitCode {
-    let _ = args.inputs;
-    eprintln!("ratecal check: not implemented yet");
-    ExitCode::from(1)
+    let mut opts = CheckOptions::default();
+    if let Some(path) = &args.station {
+        let text = match std::fs::read_to_string(path) {
+            Ok(t) => t,
+            Err(e) => {
+                eprintln!(
+                    "ratecal check: cannot read station `{}`: {e}",
+                    path.display()
+                );
+                return ExitCode::from(1);
+            }
+        };
+        match Station::from_yaml(&text, &path.display().to_string()) {
+            Ok(st) => opts.station = Some(station_limits(&st)),
+            Err(e) => {
+                eprintln!("{:?}", miette::Report::new(*e));
+                return ExitCode::from(1);
+            }
+        }
+    }
+    let mut failed = false;
+    let mut plans = Vec::new();
+    for input in &args.inputs {
+        let file = match procedure::read(input) {
+            Ok(f) => f,
+            Err(d) => {
+                procedure::report(&d);
+                failed = true;
+                continue;
+            }
+        };
+        match check_text(&file.display, &file.text, &FsSources, &opts) {
+            Ok(checked) => {
+                checked.warnings.iter().for_each(procedure::report);
+                let p = &checked.plan;
+                let line = format!(
+                    "{} {}: ok, estimated duration {}",
+                    p.name,
+                    p.version,
+                    human_duration(p.estimated_duration_s)
+                );
+                if args.format == "json" {
+                    eprintln!("{line}");
+                } else {
+                    println!("{line}");
+                }
+                plans.push(checked.plan);
+            }
+            Err(diags) => {
+                diags.iter().for_each(procedure::report);
+                let n = diags.iter().filter(|d| d.is_error()).count();
+                eprintln!(
+                    "{}: {n} error{}",
+                    file.display,
+                    if n == 1 { "" } else { "s" }
+                );
+                failed = true;
+            }
+        }
+    }
+    if args.format == "json" {
+        match serde_json::to_string_pretty(&plans) {
+            Ok(s) => println!("{s}"),
+            Err(e) => {
+                eprintln!("ratecal check: cannot write JSON: {e}");
+                return ExitCode::from(1);
+            }
+        }
+    }
+    if failed {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    }
 }

@@ -6,6 +6,7 @@ pub mod check;
 pub mod diff;
 pub mod fmt;
 pub mod log;
+pub mod procedure;
 pub mod report;
 pub mod run;
 pub mod verify;

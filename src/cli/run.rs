@@ -76,9 +76,7 @@ fn run(args: Args) -> Result<ExitCode, Report> {
         mut opts,
         seed,
     } = prep;
-    let (mut table, mut imu) = ratecal_drivers::build(&station, seed)
-        .map_err(|e| miette::miette!("cannot start the station: {e}"))?;
-    let simulated = table.info().simulated && imu.info().simulated;
+    let simulated = station.describe().simulated;
     let cancel = Arc::new(AtomicBool::new(false));
     opts.cancel = Some(cancel.clone());
     let mut bar = progress::Bar::new(plan.estimated_duration_s, simulated);
@@ -91,21 +89,26 @@ fn run(args: Args) -> Result<ExitCode, Report> {
         .map_err(|e| miette::miette!("cannot start the runtime: {e}"))?;
     let wall = std::time::Instant::now();
     let outcome = rt.block_on(async {
+        // Built inside the runtime: the simulator's clock starts on the (paused) run clock.
+        let (mut table, mut imu) = ratecal_drivers::build(&station, seed)
+            .map_err(|e| miette::miette!("cannot start the station: {e}"))?;
         tokio::spawn(async move {
             if tokio::signal::ctrl_c().await.is_ok() {
                 cancel.store(true, Ordering::Relaxed);
             }
         });
-        execute(
-            &plan,
-            table.as_mut(),
-            imu.as_mut(),
-            &mut writer,
-            &mut bar,
-            &opts,
+        Ok::<_, Report>(
+            execute(
+                &plan,
+                table.as_mut(),
+                imu.as_mut(),
+                &mut writer,
+                &mut bar,
+                &opts,
+            )
+            .await,
         )
-        .await
-    });
+    })?;
     bar.finish();
     let wall = wall.elapsed().as_secs_f64();
     let outcome = outcome

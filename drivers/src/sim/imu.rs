@@ -9,11 +9,20 @@ use rand::rngs::ChaCha8Rng;
 use rand::{RngExt, SeedableRng};
 use rand_distr::StandardNormal;
 use ratecal_physics::{
-    AxisMotion, DEG, Geometry, IdealOutputs, ImuErrors, Mat3, Site, TableState, ideal_outputs,
+    AxisMotion, DEG, Geometry, IdealOutputs, ImuErrors, Mat3, Site, TableState, Vec3, ideal_outputs,
 };
 
 /// The gyro bias wander is stepped at least this often (s); between steps it holds.
 const BIAS_STEP_S: f64 = 0.01;
+
+/// The last physics evaluation: table state, temperature and what they gave.
+#[derive(Debug, Clone, Copy)]
+struct Cache {
+    state: TableState,
+    ideal: IdealOutputs,
+    temp: f64,
+    outputs: (Vec3, Vec3),
+}
 
 /// The simulated IMU (a real driver: used for dry runs and tests).
 #[derive(Debug)]
@@ -26,7 +35,9 @@ pub struct SimImu {
     tau: f64,
     next_k: u64,
     hints: [usize; 2],
-    cache: Option<(TableState, IdealOutputs)>,
+    cache: Option<Cache>,
+    /// IMU internal temperature, stepped with the bias wander.
+    temp: f64,
     rng: ChaCha8Rng,
     sigma_a: f64,
     sigma_g: f64,
@@ -83,6 +94,7 @@ impl SimImu {
             next_k: 0,
             hints: [0; 2],
             cache: None,
+            temp: 0.0,
             rng,
             sigma_a: imu.accel_noise_density.0 * fs.sqrt(),
             sigma_g: imu.gyro_noise_density.0 * fs.sqrt(),
@@ -115,6 +127,10 @@ impl SimImu {
                 break;
             }
             self.next_k += 1;
+            if k.is_multiple_of(self.bias_every) {
+                // Temperature moves slowly: it too is stepped with the bias wander.
+                self.temp = self.temps.imu(t);
+            }
             if k.is_multiple_of(self.bias_every) && k > 0 {
                 for i in 0..3 {
                     let n1: f64 = self.rng.sample(StandardNormal);
@@ -138,16 +154,31 @@ impl SimImu {
                     accel: i.accel * DEG,
                 },
             };
-            let ideal = match &self.cache {
-                Some((s, ideal)) if *s == state => *ideal,
+            // Holds are bit-for-bit constant: reuse the physics while nothing changes.
+            let temp = self.temp;
+            let (a, g) = match &self.cache {
+                Some(c) if c.state == state && c.temp == temp => c.outputs,
+                Some(c) if c.state == state => {
+                    let outputs = self.errors.apply(&c.ideal, temp);
+                    self.cache = Some(Cache {
+                        temp,
+                        outputs,
+                        ..*c
+                    });
+                    outputs
+                }
                 _ => {
                     let ideal = ideal_outputs(&state, &self.geo, &self.site, &self.errors.lever_m);
-                    self.cache = Some((state, ideal));
-                    ideal
+                    let outputs = self.errors.apply(&ideal, temp);
+                    self.cache = Some(Cache {
+                        state,
+                        ideal,
+                        temp,
+                        outputs,
+                    });
+                    outputs
                 }
             };
-            let temp = self.temps.imu(t);
-            let (a, g) = self.errors.apply(&ideal, temp);
             let mut s = ImuSample {
                 t,
                 accel: [0.0; 3],
@@ -160,7 +191,11 @@ impl SimImu {
                 s.accel[j] = (a[j] + self.sigma_a * na).clamp(-ra, ra);
                 s.gyro[j] = (g[j] + self.gm[j] + self.rw[j] + self.sigma_g * ng).clamp(-rg, rg);
             }
-            let nt: f64 = self.rng.sample(StandardNormal);
+            let nt: f64 = if self.temp_noise > 0.0 {
+                self.rng.sample(StandardNormal)
+            } else {
+                0.0
+            };
             s.temp_c = Some(temp + self.temp_noise * nt);
             match self.dropout(t) {
                 None => {

@@ -402,6 +402,9 @@ pub struct Verification {
     pub point: VerifyPoint,
     /// Limits (`accel.error <= 0.01 g`).
     pub limits: Vec<Accept>,
+    /// Segment patterns that record the point (`verify/attitude`), possibly empty.
+    #[serde(default)]
+    pub segments: Vec<String>,
 }
 
 /// A point not used in the fit.

@@ -52,40 +52,12 @@ pub struct LoadedProcedure {
     pub sha256: String,
 }
 
-/// Finds the procedure file: a file, or a procedure folder (its highest `<version>.<ext>`).
-pub fn procedure_file(path: &Path) -> Result<PathBuf, Report> {
-    if !path.is_dir() {
-        return Ok(path.to_path_buf());
-    }
-    let mut best: Option<(Vec<u64>, PathBuf)> = None;
-    let entries = std::fs::read_dir(path)
-        .into_diagnostic()
-        .wrap_err_with(|| format!("cannot read {}", path.display()))?;
-    for e in entries.flatten() {
-        let p = e.path();
-        let Some(stem) = p.file_stem().and_then(|s| s.to_str()) else {
-            continue;
-        };
-        if p.extension().is_none() || p.file_name().is_some_and(|n| n == "versions.lock") {
-            continue;
-        }
-        let Ok(v) = stem
-            .split('.')
-            .map(str::parse::<u64>)
-            .collect::<Result<Vec<_>, _>>()
-        else {
-            continue;
-        };
-        if best.as_ref().is_none_or(|(bv, _)| v > *bv) {
-            best = Some((v, p));
-        }
-    }
-    best.map(|(_, p)| p).ok_or_else(|| {
-        miette!(
-            help = "a procedure folder holds `<version>.rcal` files",
-            "no procedure version in {}",
-            path.display()
-        )
+/// Finds the procedure file: a file, a procedure folder (its newest version) or
+/// `folder@version`.
+pub fn procedure_file(arg: &Path) -> Result<PathBuf, Report> {
+    crate::cli::procedure::resolve(&arg.to_string_lossy()).map_err(|d| {
+        crate::cli::procedure::report(&d);
+        miette!("no procedure to run")
     })
 }
 

@@ -1,0 +1,295 @@
+//! A table driven over the ratecal line protocol, generic over any async byte stream (TCP,
+//! serial, an in-memory pipe). The protocol is documented in `docs/station.md`:
+//!
+//! ```text
+//! -> MOVE <outer_deg> <inner_deg>            <- OK | ERR <code> <message>
+//! -> RATE <OUTER|INNER> <dps>                <- OK | ERR ...
+//! -> STOP <OUTER|INNER>                      <- OK | ERR ...
+//! -> OSC <OUTER|INNER> <center> <amp> <period_s>  <- OK | ERR ...
+//! -> SAFE                                    <- OK | ERR ...
+//! -> FEED?                                   <- F <t> <outer> <inner> <outer_rate> <inner_rate> [<ambient>]
+//!                                               ... (zero or more) then END | ERR ...
+//! ```
+//!
+//! `ERR RANGE ...` means the command is outside what the table can do
+//! (`InvalidCommand`); any other `ERR` is an instrument fault (`Instrument`). A silent
+//! instrument is a `Timeout`; a closed or garbled link is a `Transport` failure.
+
+use crate::station::TableSpec;
+use crate::{
+    DriverError, DriverErrorKind, TableAxisId, TableCommand, TableDriver, TableInfo, TableSample,
+};
+use async_trait::async_trait;
+use std::time::Duration;
+use tokio::io::{AsyncBufReadExt, AsyncRead, AsyncWrite, AsyncWriteExt, BufStream};
+use tokio::net::TcpStream;
+use tokio::time::{Instant, timeout};
+
+fn axis_name(axis: TableAxisId) -> &'static str {
+    match axis {
+        TableAxisId::Outer => "OUTER",
+        TableAxisId::Inner => "INNER",
+    }
+}
+
+/// The request line for a command (without the newline).
+pub fn encode(cmd: &TableCommand) -> String {
+    match cmd {
+        TableCommand::MoveTo {
+            outer_deg,
+            inner_deg,
+        } => format!("MOVE {outer_deg} {inner_deg}"),
+        TableCommand::Rate { axis, rate_dps } => format!("RATE {} {rate_dps}", axis_name(*axis)),
+        TableCommand::Stop { axis } => format!("STOP {}", axis_name(*axis)),
+        TableCommand::Oscillate {
+            axis,
+            center_deg,
+            amplitude_deg,
+            period_s,
+        } => {
+            format!(
+                "OSC {} {center_deg} {amplitude_deg} {period_s}",
+                axis_name(*axis)
+            )
+        }
+        TableCommand::SafeStop => "SAFE".into(),
+    }
+}
+
+fn transport(msg: impl Into<String>) -> DriverError {
+    DriverError::new(DriverErrorKind::Transport, msg)
+}
+
+/// An `ERR <code> <message>` reply as a driver error.
+fn instrument_error(rest: &str) -> DriverError {
+    let kind = if rest.starts_with("RANGE") {
+        DriverErrorKind::InvalidCommand
+    } else {
+        DriverErrorKind::Instrument
+    };
+    DriverError::new(kind, format!("table reported: {rest}"))
+}
+
+/// A table on a line-protocol link over `S`.
+#[derive(Debug)]
+pub struct LineTable<S> {
+    io: BufStream<S>,
+    info: TableInfo,
+    timeout: Duration,
+    start: Instant,
+    /// Instrument time minus local time, fixed at the first feedback sample.
+    clock_offset: Option<f64>,
+    broken: bool,
+    line: String,
+}
+
+impl<S: AsyncRead + AsyncWrite + Unpin + Send> LineTable<S> {
+    /// Wraps a connected stream; `timeout` bounds every request-reply exchange.
+    pub fn new(stream: S, info: TableInfo, timeout: Duration) -> Self {
+        LineTable {
+            io: BufStream::new(stream),
+            info,
+            timeout,
+            start: Instant::now(),
+            clock_offset: None,
+            broken: false,
+            line: String::new(),
+        }
+    }
+
+    async fn read_line(&mut self) -> Result<&str, DriverError> {
+        self.line.clear();
+        let n = self
+            .io
+            .read_line(&mut self.line)
+            .await
+            .map_err(|e| transport(format!("table link: {e}")))?;
+        if n == 0 {
+            return Err(transport("table link closed"));
+        }
+        Ok(self.line.trim())
+    }
+
+    async fn send(&mut self, request: &str) -> Result<(), DriverError> {
+        let io = async {
+            self.io.write_all(request.as_bytes()).await?;
+            self.io.write_all(b"\n").await?;
+            self.io.flush().await
+        };
+        io.await.map_err(|e| transport(format!("table link: {e}")))
+    }
+
+    /// Runs one exchange under the timeout; after a timeout or a transport failure the
+    /// link is out of step and every later call fails until it is rebuilt.
+    async fn exchange<T>(
+        &mut self,
+        f: impl AsyncFnOnce(&mut Self) -> Result<T, DriverError>,
+    ) -> Result<T, DriverError> {
+        if self.broken {
+            return Err(transport("table link out of step after an earlier failure"));
+        }
+        let limit = self.timeout;
+        let out = match timeout(limit, f(self)).await {
+            Ok(r) => r,
+            Err(_) => Err(DriverError::new(
+                DriverErrorKind::Timeout,
+                format!("table did not answer within {} s", limit.as_secs_f64()),
+            )),
+        };
+        if let Err(e) = &out
+            && matches!(
+                e.kind(),
+                DriverErrorKind::Timeout | DriverErrorKind::Transport
+            )
+        {
+            self.broken = true;
+        }
+        out
+    }
+
+    /// Whether the link failed and must be rebuilt.
+    pub fn is_broken(&self) -> bool {
+        self.broken
+    }
+
+    fn parse_feedback(&mut self, line: &str) -> Result<TableSample, DriverError> {
+        let fields: Vec<f64> = line[1..]
+            .split_whitespace()
+            .map(str::parse)
+            .collect::<Result<_, _>>()
+            .map_err(|_| transport(format!("garbled feedback line `{line}`")))?;
+        if !(5..=6).contains(&fields.len()) {
+            return Err(transport(format!(
+                "feedback line `{line}` has {} fields, expected 5 or 6",
+                fields.len()
+            )));
+        }
+        let local = self.start.elapsed().as_secs_f64();
+        let offset = *self.clock_offset.get_or_insert(fields[0] - local);
+        Ok(TableSample {
+            t: fields[0] - offset,
+            outer_deg: fields[1],
+            inner_deg: fields[2],
+            outer_rate_dps: fields[3],
+            inner_rate_dps: fields[4],
+            ambient_c: fields.get(5).copied(),
+        })
+    }
+}
+
+#[async_trait]
+impl<S: AsyncRead + AsyncWrite + Unpin + Send> TableDriver for LineTable<S> {
+    fn info(&self) -> TableInfo {
+        self.info.clone()
+    }
+
+    async fn command(&mut self, cmd: TableCommand) -> Result<(), DriverError> {
+        let request = encode(&cmd);
+        self.exchange(async move |me: &mut Self| {
+            me.send(&request).await?;
+            let reply = me.read_line().await?;
+            match reply.split_once(' ').map_or((reply, ""), |(a, b)| (a, b)) {
+                ("OK", _) => Ok(()),
+                ("ERR", rest) => Err(instrument_error(rest)),
+                _ => Err(transport(format!(
+                    "unexpected reply `{reply}` to `{request}`"
+                ))),
+            }
+        })
+        .await
+    }
+
+    async fn read(&mut self, out: &mut Vec<TableSample>) -> Result<(), DriverError> {
+        let got = self
+            .exchange(async |me: &mut Self| {
+                me.send("FEED?").await?;
+                let mut got = Vec::new();
+                loop {
+                    let line = me.read_line().await?.to_string();
+                    if line == "END" {
+                        return Ok(got);
+                    } else if let Some(rest) = line.strip_prefix("ERR ") {
+                        return Err(instrument_error(rest));
+                    } else if line.starts_with('F') {
+                        got.push(me.parse_feedback(&line)?);
+                    } else {
+                        return Err(transport(format!("unexpected reply `{line}` to `FEED?`")));
+                    }
+                }
+            })
+            .await?;
+        out.extend(got);
+        Ok(())
+    }
+}
+
+/// The TCP table of a station: connects on first use and reconnects after a failure.
+#[derive(Debug)]
+pub struct TcpTable {
+    address: String,
+    info: TableInfo,
+    timeout: Duration,
+    link: Option<LineTable<TcpStream>>,
+}
+
+impl TcpTable {
+    /// A table at `address` (`host:port`); nothing is opened until the first call.
+    pub fn new(address: String, spec: TableSpec, timeout_s: f64) -> Self {
+        let info = TableInfo {
+            model: spec.model,
+            max_rate_dps: spec.max_rate.0,
+            max_accel_dps2: spec.max_accel_dps2,
+            feedback_hz: spec.feedback_rate.0,
+            simulated: false,
+        };
+        TcpTable {
+            address,
+            info,
+            timeout: Duration::from_secs_f64(timeout_s),
+            link: None,
+        }
+    }
+
+    async fn link(&mut self) -> Result<&mut LineTable<TcpStream>, DriverError> {
+        if self.link.as_ref().is_some_and(LineTable::is_broken) {
+            self.link = None;
+        }
+        if self.link.is_none() {
+            let stream = match timeout(self.timeout, TcpStream::connect(&self.address)).await {
+                Ok(Ok(s)) => s,
+                Ok(Err(e)) => {
+                    return Err(transport(format!(
+                        "cannot connect to table at {}: {e}",
+                        self.address
+                    )));
+                }
+                Err(_) => {
+                    return Err(DriverError::new(
+                        DriverErrorKind::Timeout,
+                        format!(
+                            "no connection to table at {} within {:?}",
+                            self.address, self.timeout
+                        ),
+                    ));
+                }
+            };
+            self.link = Some(LineTable::new(stream, self.info.clone(), self.timeout));
+        }
+        Ok(self.link.as_mut().expect("just connected"))
+    }
+}
+
+#[async_trait]
+impl TableDriver for TcpTable {
+    fn info(&self) -> TableInfo {
+        self.info.clone()
+    }
+
+    async fn command(&mut self, cmd: TableCommand) -> Result<(), DriverError> {
+        self.link().await?.command(cmd).await
+    }
+
+    async fn read(&mut self, out: &mut Vec<TableSample>) -> Result<(), DriverError> {
+        self.link().await?.read(out).await
+    }
+}

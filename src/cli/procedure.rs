@@ -1,0 +1,141 @@
+//! Procedure arguments shared by `check`, `fmt`, `run` and `diff`: a file, a folder (its
+//! newest version) or `folder@version`; reading it, and imports from the filesystem.
+
+use ratecal_engine::check::Sources;
+use ratecal_grammar::Diagnostic;
+use std::path::{Path, PathBuf};
+
+/// Extension of procedure files.
+pub const EXTENSION: &str = "rcal";
+
+/// A procedure file read from disk.
+#[derive(Debug, Clone)]
+pub struct ProcedureFile {
+    /// Where it was read.
+    pub path: PathBuf,
+    /// The name diagnostics show.
+    pub display: String,
+    /// Its text.
+    pub text: String,
+}
+
+fn io_error(what: &str, path: &Path, e: &std::io::Error) -> Diagnostic {
+    Diagnostic::error(
+        "io::read",
+        format!("cannot read {what} `{}`: {e}", path.display()),
+    )
+    .help("give a procedure file, a procedure folder, or folder@version")
+}
+
+/// Parses a version file stem (`1.2.3`, `1.2.3-rc1`) into a sortable key.
+fn version_key(stem: &str) -> Option<(u64, u64, u64, bool, String)> {
+    let (core, pre) = match stem.split_once(['-', '+']) {
+        Some((c, p)) => (c, Some(p)),
+        None => (stem, None),
+    };
+    let mut it = core.split('.').map(|p| p.parse::<u64>().ok());
+    let (a, b, c) = (it.next()??, it.next()??, it.next()??);
+    if it.next().is_some() {
+        return None;
+    }
+    // A release sorts after its pre-releases.
+    Some((a, b, c, pre.is_none(), pre.unwrap_or("").to_string()))
+}
+
+/// Every version file of a procedure folder, oldest first.
+pub fn versions(dir: &Path) -> Result<Vec<(String, PathBuf)>, Diagnostic> {
+    let entries = std::fs::read_dir(dir).map_err(|e| io_error("folder", dir, &e))?;
+    let mut out = Vec::new();
+    for e in entries.flatten() {
+        let p = e.path();
+        if p.extension().is_some_and(|x| x == EXTENSION)
+            && let Some(stem) = p.file_stem().and_then(|s| s.to_str())
+            && version_key(stem).is_some()
+        {
+            out.push((stem.to_string(), p));
+        }
+    }
+    out.sort_by_key(|(v, _)| version_key(v));
+    Ok(out)
+}
+
+/// Resolves an argument to a file: a file, a folder's newest version, or `folder@version`.
+pub fn resolve(arg: &str) -> Result<PathBuf, Diagnostic> {
+    let path = Path::new(arg);
+    if path.is_file() {
+        return Ok(path.to_path_buf());
+    }
+    if let Some((dir, version)) = arg.rsplit_once('@') {
+        let dir = Path::new(dir);
+        if dir.is_dir() {
+            let file = dir.join(format!("{version}.{EXTENSION}"));
+            if file.is_file() {
+                return Ok(file);
+            }
+            let known: Vec<String> = versions(dir)?.into_iter().map(|v| v.0).collect();
+            return Err(Diagnostic::error(
+                "io::version",
+                format!("`{}` has no version {version}", dir.display()),
+            )
+            .help(format!(
+                "versions: {}",
+                if known.is_empty() {
+                    "none".to_string()
+                } else {
+                    known.join(", ")
+                }
+            )));
+        }
+    }
+    if path.is_dir() {
+        return match versions(path)?.pop() {
+            Some((_, p)) => Ok(p),
+            None => Err(Diagnostic::error(
+                "io::version",
+                format!("`{}` holds no version file", path.display()),
+            )
+            .help(format!(
+                "a procedure folder holds files named <version>.{EXTENSION}, e.g. 1.0.0.{EXTENSION}"
+            ))),
+        };
+    }
+    Err(
+        Diagnostic::error("io::not_found", format!("no such procedure: `{arg}`"))
+            .help("give a procedure file, a procedure folder, or folder@version"),
+    )
+}
+
+/// Resolves and reads a procedure argument.
+pub fn read(arg: &str) -> Result<ProcedureFile, Diagnostic> {
+    let path = resolve(arg)?;
+    let bytes = std::fs::read(&path).map_err(|e| io_error("file", &path, &e))?;
+    // Invalid UTF-8 is replaced rather than refused: the parser then points at it.
+    let text = String::from_utf8_lossy(&bytes).into_owned();
+    Ok(ProcedureFile {
+        display: path.display().to_string(),
+        path,
+        text,
+    })
+}
+
+/// Imports resolved relative to the importing file's folder.
+pub struct FsSources;
+
+impl Sources for FsSources {
+    fn load(&self, from: &str, name: &str) -> Result<(String, String), String> {
+        let base = Path::new(from).parent().unwrap_or(Path::new("."));
+        let path = base.join(name);
+        match std::fs::read(&path) {
+            Ok(b) => Ok((
+                path.display().to_string(),
+                String::from_utf8_lossy(&b).into_owned(),
+            )),
+            Err(e) => Err(format!("cannot read `{}`: {e}", path.display())),
+        }
+    }
+}
+
+/// Prints a diagnostic on standard error.
+pub fn report(d: &Diagnostic) {
+    eprint!("{}", d.render());
+}
