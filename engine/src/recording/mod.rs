@@ -11,9 +11,13 @@ pub use error::RecordingError;
 pub use read::{parse_manifest, read};
 use std::collections::BTreeMap;
 
+mod fixed;
+mod streams;
 mod write;
 
-pub use write::{Columns, RecordingWriter, manifest_yaml, push_fixed, rfc3339, sha256_hex};
+pub use fixed::push_fixed;
+pub use streams::Columns;
+pub use write::{RecordingWriter, manifest_yaml, rfc3339, sha256_hex};
 
 /// `manifest.yaml`. Unknown keys are ignored on reading.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -1,134 +1,107 @@
 //! Streaming writer of a recording folder (`spec/recording-format.md`): `imu.csv` and
-//! `table.csv` are appended sample by sample through a fixed-size buffer that is hashed as
-//! it is flushed, so memory stays bounded however long the run and the files' SHA-256 are
-//! known at the end without reading them back. `manifest.yaml` is rewritten atomically at
+//! `table.csv` are appended batch by batch, on a writer thread (formatting, hashing and
+//! writing run beside the interpreter, on the second core), through a fixed-size buffer that
+//! is hashed as it is flushed, so memory stays bounded however long the run (a bounded
+//! queue of batches) and the files' SHA-256 are known at the end without reading them back. `manifest.yaml` is rewritten atomically at
 //! every checkpoint (segment end, abort, end of run), and `journal.jsonl` gets one JSON
 //! line per event.
 
+use super::streams::{Columns, IMU_HEADER, Stream, Streams, TABLE_HEADER};
 use super::{FORMAT, Manifest};
 use ratecal_drivers::{ImuSample, TableSample};
 use sha2::{Digest, Sha256};
 use std::fs::{File, OpenOptions};
-use std::io::{self, Read, Seek, SeekFrom, Write};
+use std::io::{self, Write};
 use std::path::{Path, PathBuf};
+use std::sync::mpsc;
 
-/// Header of `imu.csv` (the `temp` column is written only when the IMU reports it).
-const IMU_HEADER: &str = "t,ax,ay,az,gx,gy,gz";
-/// Header of `table.csv` (the `ambient` column is written only when the station measures it).
-const TABLE_HEADER: &str = "t,outer,inner,outer_rate,inner_rate";
-/// Flush threshold of a stream buffer, bytes.
-const CHUNK: usize = 1 << 16;
-
-/// Decimals written per quantity: 1 us for time, 1e-6 m/s^2, 1e-7 deg/s and deg, 1e-4 degC.
-const T_DEC: u32 = 6;
-const ACCEL_DEC: u32 = 6;
-const GYRO_DEC: u32 = 7;
-const ANGLE_DEC: u32 = 7;
-const TEMP_DEC: u32 = 4;
-
-/// Which optional columns the streams carry (fixed for the whole recording).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct Columns {
-    /// `imu.csv` has a `temp` column.
-    pub imu_temp: bool,
-    /// `table.csv` has an `ambient` column.
-    pub ambient: bool,
+/// What the interpreter's thread asks the writer thread.
+enum Msg {
+    Imu(Vec<ImuSample>),
+    Table(Vec<TableSample>),
+    /// Flush both streams to the OS; reply with the first error so far.
+    Sync(mpsc::Sender<io::Result<()>>),
+    /// Flush and reply with the files' SHA-256 (imu, table).
+    Hashes(mpsc::Sender<io::Result<(String, String)>>),
 }
 
-/// One CSV stream: an append-only file, a byte buffer, and the running hash of the file.
-struct Stream {
-    file: File,
-    buf: Vec<u8>,
-    hash: Sha256,
-    last_t: Option<f64>,
-}
-
-impl Stream {
-    fn create(path: &Path, header: &str) -> io::Result<Self> {
-        let file = File::create(path)?;
-        let mut s = Stream {
-            file,
-            buf: Vec::with_capacity(CHUNK + 512),
-            hash: Sha256::new(),
-            last_t: None,
-        };
-        s.buf.extend_from_slice(header.as_bytes());
-        s.buf.push(b'\n');
-        Ok(s)
-    }
-
-    /// Reopens a stream for appending: drops a torn last line (a crash mid-write), hashes
-    /// what is kept, and finds the last time stamp.
-    fn append(path: &Path) -> io::Result<(Self, String)> {
-        let mut file = OpenOptions::new().read(true).write(true).open(path)?;
-        let mut text = Vec::new();
-        file.read_to_end(&mut text)?;
-        let keep = text.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
-        text.truncate(keep);
-        file.set_len(keep as u64)?;
-        file.seek(SeekFrom::End(0))?;
-        let header = text.split(|&b| b == b'\n').next().unwrap_or_default();
-        let header = String::from_utf8_lossy(header).into_owned();
-        let last_t = text
-            .split(|&b| b == b'\n')
-            .filter(|l| !l.is_empty())
-            .skip(1)
-            .last()
-            .and_then(|l| l.split(|&b| b == b',').next())
-            .and_then(|c| std::str::from_utf8(c).ok()?.parse::<f64>().ok());
-        let mut hash = Sha256::new();
-        hash.update(&text);
-        let s = Stream {
-            file,
-            buf: Vec::with_capacity(CHUNK + 512),
-            hash,
-            last_t,
-        };
-        Ok((s, header))
-    }
-
-    fn end_row(&mut self) -> io::Result<()> {
-        self.buf.push(b'\n');
-        if self.buf.len() >= CHUNK {
-            self.flush()?;
-        }
-        Ok(())
-    }
-
-    fn flush(&mut self) -> io::Result<()> {
-        if !self.buf.is_empty() {
-            self.hash.update(&self.buf);
-            self.file.write_all(&self.buf)?;
-            self.buf.clear();
-        }
-        Ok(())
-    }
-
-    fn sync(&mut self) -> io::Result<()> {
-        self.flush()?;
-        self.file.flush()
-    }
-
-    fn sha256(&self) -> String {
-        hex::encode(self.hash.clone().finalize())
-    }
-}
+/// Batches in flight before `write_*` waits: bounds memory if the disk is slow.
+const QUEUE: usize = 256;
 
 /// Writes a recording folder incrementally. Sample times handed in are already on the
 /// recording's clock (0 at the start of the run). Samples the format cannot hold are
 /// dropped and counted: a time that does not strictly increase, or a non-finite value (a
 /// faulty IMU's NaN output; the format refuses non-numeric cells).
+///
+/// The streams are formatted, hashed and written on a writer thread; an IO error there
+/// surfaces at the next [`RecordingWriter::checkpoint`] (every segment end) or write.
 pub struct RecordingWriter {
     dir: PathBuf,
-    imu: Stream,
-    table: Stream,
+    tx: Option<mpsc::SyncSender<Msg>>,
+    thread: Option<std::thread::JoinHandle<u64>>,
     journal: File,
     columns: Columns,
     manifest: Manifest,
-    dropped: u64,
+}
+
+fn writer_thread(mut st: Streams, rx: mpsc::Receiver<Msg>) -> u64 {
+    let mut failed: Option<io::Error> = None;
+    let keep = |r: io::Result<()>, failed: &mut Option<io::Error>| {
+        if let Err(e) = r {
+            failed.get_or_insert(e);
+        }
+    };
+    for msg in rx {
+        match msg {
+            Msg::Imu(v) if failed.is_none() => keep(st.write_imu(&v), &mut failed),
+            Msg::Table(v) if failed.is_none() => keep(st.write_table(&v), &mut failed),
+            Msg::Imu(_) | Msg::Table(_) => {}
+            Msg::Sync(reply) => {
+                if failed.is_none() {
+                    keep(st.imu.sync().and_then(|()| st.table.sync()), &mut failed);
+                }
+                let _ = reply.send(
+                    failed
+                        .as_ref()
+                        .map_or(Ok(()), |e| Err(io::Error::new(e.kind(), e.to_string()))),
+                );
+            }
+            Msg::Hashes(reply) => {
+                if failed.is_none() {
+                    keep(st.imu.sync().and_then(|()| st.table.sync()), &mut failed);
+                }
+                let r = match &failed {
+                    Some(e) => Err(io::Error::new(e.kind(), e.to_string())),
+                    None => Ok((st.imu.sha256(), st.table.sha256())),
+                };
+                let _ = reply.send(r);
+            }
+        }
+    }
+    st.dropped
+}
+
+fn gone() -> io::Error {
+    io::Error::other("the recording writer thread stopped")
 }
 
 impl RecordingWriter {
+    fn start(dir: &Path, streams: Streams, journal: File, manifest: Manifest) -> io::Result<Self> {
+        let columns = streams.columns;
+        let (tx, rx) = mpsc::sync_channel(QUEUE);
+        let thread = std::thread::Builder::new()
+            .name("recording-writer".into())
+            .spawn(move || writer_thread(streams, rx))?;
+        Ok(RecordingWriter {
+            dir: dir.to_path_buf(),
+            tx: Some(tx),
+            thread: Some(thread),
+            journal,
+            columns,
+            manifest,
+        })
+    }
+
     /// Creates `dir` (if needed) and the recording's files; writes the manifest once.
     pub fn create(dir: &Path, manifest: Manifest, columns: Columns) -> io::Result<Self> {
         std::fs::create_dir_all(dir)?;
@@ -143,16 +116,19 @@ impl RecordingWriter {
         let imu = Stream::create(&dir.join("imu.csv"), &imu_header)?;
         let table = Stream::create(&dir.join("table.csv"), &table_header)?;
         let journal = File::create(dir.join("journal.jsonl"))?;
-        let mut w = RecordingWriter {
-            dir: dir.to_path_buf(),
-            imu,
-            table,
+        let mut manifest = manifest;
+        manifest.format = FORMAT.to_string();
+        let mut w = Self::start(
+            dir,
+            Streams {
+                imu,
+                table,
+                columns,
+                dropped: 0,
+            },
             journal,
-            columns,
             manifest,
-            dropped: 0,
-        };
-        w.manifest.format = FORMAT.to_string();
+        )?;
         w.checkpoint()?;
         Ok(w)
     }
@@ -179,15 +155,17 @@ impl RecordingWriter {
             (Some(a), Some(b)) => Some(a.max(b)),
             (a, b) => a.or(b),
         };
-        let w = RecordingWriter {
-            dir: dir.to_path_buf(),
-            imu,
-            table,
+        let w = Self::start(
+            dir,
+            Streams {
+                imu,
+                table,
+                columns,
+                dropped: 0,
+            },
             journal,
-            columns,
             manifest,
-            dropped: 0,
-        };
+        )?;
         Ok((w, last))
     }
 
@@ -211,69 +189,35 @@ impl RecordingWriter {
         &mut self.manifest
     }
 
-    /// Samples dropped because their time did not increase.
-    pub fn dropped(&self) -> u64 {
-        self.dropped
+    fn send(&self, msg: Msg) -> io::Result<()> {
+        self.tx
+            .as_ref()
+            .ok_or_else(gone)?
+            .send(msg)
+            .map_err(|_| gone())
     }
 
     /// Appends IMU samples (times on the recording clock).
     pub fn write_imu(&mut self, samples: &[ImuSample]) -> io::Result<()> {
-        for s in samples {
-            let temp_ok = !self.columns.imu_temp || s.temp_c.is_some_and(f64::is_finite);
-            let finite = s.accel.iter().chain(&s.gyro).all(|v| v.is_finite()) && temp_ok;
-            if self.imu.last_t.is_some_and(|l| s.t <= l) || !s.t.is_finite() || !finite {
-                self.dropped += 1;
-                continue;
-            }
-            self.imu.last_t = Some(s.t);
-            let b = &mut self.imu.buf;
-            push_fixed(b, s.t, T_DEC);
-            for v in s.accel {
-                b.push(b',');
-                push_fixed(b, v, ACCEL_DEC);
-            }
-            for v in s.gyro {
-                b.push(b',');
-                push_fixed(b, v, GYRO_DEC);
-            }
-            if self.columns.imu_temp {
-                b.push(b',');
-                push_fixed(b, s.temp_c.unwrap_or(f64::NAN), TEMP_DEC);
-            }
-            self.imu.end_row()?;
+        if samples.is_empty() {
+            return Ok(());
         }
-        Ok(())
+        self.send(Msg::Imu(samples.to_vec()))
     }
 
     /// Appends table feedback samples (times on the recording clock).
     pub fn write_table(&mut self, samples: &[TableSample]) -> io::Result<()> {
-        for s in samples {
-            let ambient_ok = !self.columns.ambient || s.ambient_c.is_some_and(f64::is_finite);
-            let finite = [s.outer_deg, s.inner_deg, s.outer_rate_dps, s.inner_rate_dps]
-                .iter()
-                .all(|v| v.is_finite());
-            if self.table.last_t.is_some_and(|l| s.t <= l)
-                || !s.t.is_finite()
-                || !finite
-                || !ambient_ok
-            {
-                self.dropped += 1;
-                continue;
-            }
-            self.table.last_t = Some(s.t);
-            let b = &mut self.table.buf;
-            push_fixed(b, s.t, T_DEC);
-            for v in [s.outer_deg, s.inner_deg, s.outer_rate_dps, s.inner_rate_dps] {
-                b.push(b',');
-                push_fixed(b, v, ANGLE_DEC);
-            }
-            if self.columns.ambient {
-                b.push(b',');
-                push_fixed(b, s.ambient_c.unwrap_or(f64::NAN), TEMP_DEC);
-            }
-            self.table.end_row()?;
+        if samples.is_empty() {
+            return Ok(());
         }
-        Ok(())
+        self.send(Msg::Table(samples.to_vec()))
+    }
+
+    /// Samples dropped because the format could not hold them; closes the streams (call
+    /// after [`RecordingWriter::finish`]).
+    pub fn close(mut self) -> u64 {
+        self.tx = None;
+        self.thread.take().and_then(|t| t.join().ok()).unwrap_or(0)
     }
 
     /// Appends one line to `journal.jsonl` (written through at once: the journal is what
@@ -288,8 +232,9 @@ impl RecordingWriter {
     /// Flushes both streams to the OS and rewrites the manifest atomically
     /// (`manifest.yaml.tmp` then rename).
     pub fn checkpoint(&mut self) -> io::Result<()> {
-        self.imu.sync()?;
-        self.table.sync()?;
+        let (tx, rx) = mpsc::channel();
+        self.send(Msg::Sync(tx))?;
+        rx.recv().map_err(|_| gone())??;
         let yaml = manifest_yaml(&self.manifest)?;
         let tmp = self.dir.join("manifest.yaml.tmp");
         std::fs::write(&tmp, yaml)?;
@@ -299,17 +244,26 @@ impl RecordingWriter {
     /// Ends the recording: records the SHA-256 of each data file in `run.files_sha256`,
     /// sets `run.ended`, and writes the final manifest.
     pub fn finish(&mut self) -> io::Result<()> {
-        self.imu.sync()?;
-        self.table.sync()?;
         self.journal.flush()?;
-        let imu = self.imu.sha256();
-        let table = self.table.sha256();
+        let (tx, rx) = mpsc::channel();
+        self.send(Msg::Hashes(tx))?;
+        let (imu, table) = rx.recv().map_err(|_| gone())??;
         if let Some(run) = self.manifest.run.as_mut() {
             run.files_sha256.insert("imu.csv".into(), imu);
             run.files_sha256.insert("table.csv".into(), table);
             run.ended = Some(rfc3339(std::time::SystemTime::now()));
         }
         self.checkpoint()
+    }
+}
+
+impl Drop for RecordingWriter {
+    fn drop(&mut self) {
+        // Lets the writer thread drain what it holds and close the files.
+        self.tx = None;
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
     }
 }
 
@@ -348,99 +302,9 @@ pub fn rfc3339(t: std::time::SystemTime) -> String {
     )
 }
 
-/// Appends `x` with exactly `dec` decimals (rounded half away from zero); non-finite values
-/// are written `NaN`, `inf`, `-inf` (so that a reader refuses them, naming the cell).
-pub fn push_fixed(buf: &mut Vec<u8>, x: f64, dec: u32) {
-    let scale = 10f64.powi(dec as i32);
-    let scaled = (x * scale).round();
-    if !x.is_finite() {
-        buf.extend_from_slice(if x.is_nan() {
-            b"NaN"
-        } else if x > 0.0 {
-            b"inf"
-        } else {
-            b"-inf"
-        });
-        return;
-    }
-    if scaled.abs() >= 9.0e18 {
-        // Beyond i64: fall back to the shortest exact representation.
-        let mut r = ryu::Buffer::new();
-        buf.extend_from_slice(r.format_finite(x).as_bytes());
-        return;
-    }
-    let n = scaled as i64;
-    if n < 0 {
-        buf.push(b'-');
-    }
-    let n = n.unsigned_abs();
-    let p = 10u64.pow(dec);
-    push_uint(buf, n / p);
-    if dec > 0 {
-        buf.push(b'.');
-        let frac = n % p;
-        let mut digits = [b'0'; 20];
-        let mut f = frac;
-        for i in (0..dec as usize).rev() {
-            digits[i] = b'0' + (f % 10) as u8;
-            f /= 10;
-        }
-        buf.extend_from_slice(&digits[..dec as usize]);
-    }
-}
-
-fn push_uint(buf: &mut Vec<u8>, mut n: u64) {
-    let mut digits = [0u8; 20];
-    let mut i = digits.len();
-    loop {
-        i -= 1;
-        digits[i] = b'0' + (n % 10) as u8;
-        n /= 10;
-        if n == 0 {
-            break;
-        }
-    }
-    buf.extend_from_slice(&digits[i..]);
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn fixed(x: f64, dec: u32) -> String {
-        let mut b = Vec::new();
-        push_fixed(&mut b, x, dec);
-        String::from_utf8(b).unwrap()
-    }
-
-    #[test]
-    fn fixed_matches_std_formatting() {
-        for &x in &[
-            0.0,
-            1.5,
-            -0.25,
-            9.80665,
-            -123.456789012,
-            1e-7,
-            -4e-7,
-            5700.000001,
-            359.9999999,
-        ] {
-            for dec in [0u32, 4, 6, 7] {
-                let text = fixed(x, dec);
-                let ours: f64 = text.parse().unwrap();
-                // Rounded to the nearest step (ties may go either way), with exactly `dec` decimals.
-                assert!(
-                    (ours - x).abs() <= 0.5 * 10f64.powi(-(dec as i32)) * (1.0 + 1e-9),
-                    "{x} {dec}: {text}"
-                );
-                assert_eq!(text.split('.').nth(1).map_or(0, str::len), dec as usize);
-            }
-        }
-        assert_eq!(fixed(-0.0000001, 6), "0.000000");
-        assert_eq!(fixed(f64::NAN, 6), "NaN");
-        assert_eq!(fixed(1e300, 6), "1e300");
-    }
 
     #[test]
     fn rfc3339_known_dates() {

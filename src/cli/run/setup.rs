@@ -1,0 +1,154 @@
+//! What `ratecal run` prepares before the interpreter starts: the station, the procedure
+//! (text, canonical hash, checked plan), the run folder and its manifest.
+
+use miette::{IntoDiagnostic, Report, WrapErr, miette};
+use ratecal_drivers::station::{ImuDriverSpec, TableDriverSpec};
+use ratecal_drivers::{DEFAULT_STATION_YAML, Station};
+use ratecal_engine::plan::Plan;
+use ratecal_engine::recording::{
+    EnvironmentRecord, FORMAT, Manifest, ManifestStation, Mount, ProcedureRef, RunInfo, TableAxes,
+    rfc3339, sha256_hex,
+};
+use std::path::{Path, PathBuf};
+
+/// A station and the text it came from.
+pub struct LoadedStation {
+    /// Parsed station.
+    pub station: Station,
+    /// Its YAML text (copied into the run folder).
+    pub yaml: String,
+}
+
+/// Reads a station file (or the embedded default); with `dry_run` both drivers become the
+/// simulator, keeping every other key (geometry, IMU model, faults).
+pub fn station(path: Option<&Path>, dry_run: bool) -> Result<LoadedStation, Report> {
+    let (yaml, name) = match path {
+        Some(p) => (
+            std::fs::read_to_string(p)
+                .into_diagnostic()
+                .wrap_err_with(|| format!("cannot read station file {}", p.display()))?,
+            p.display().to_string(),
+        ),
+        None => (
+            DEFAULT_STATION_YAML.to_string(),
+            "<default station>".to_string(),
+        ),
+    };
+    let mut station = Station::from_yaml(&yaml, &name).map_err(|e| Report::new(*e))?;
+    if dry_run {
+        station.table.driver = TableDriverSpec::Sim;
+        station.imu.driver = ImuDriverSpec::Sim;
+    }
+    Ok(LoadedStation { station, yaml })
+}
+
+/// A procedure ready to run.
+pub struct LoadedProcedure {
+    /// The checked plan.
+    pub plan: Plan,
+    /// The file's text (copied into the run folder).
+    pub text: String,
+    /// SHA-256 of the canonical text.
+    pub sha256: String,
+}
+
+/// Finds the procedure file: a file, a procedure folder (its newest version) or
+/// `folder@version`.
+pub fn procedure_file(arg: &Path) -> Result<PathBuf, Report> {
+    crate::cli::procedure::resolve(&arg.to_string_lossy()).map_err(|d| {
+        crate::cli::procedure::report(&d);
+        miette!("no procedure to run")
+    })
+}
+
+/// Reads, hashes and checks a procedure against the station's limits.
+pub fn procedure(path: &Path, station: &Station) -> Result<LoadedProcedure, Report> {
+    let text = std::fs::read_to_string(path)
+        .into_diagnostic()
+        .wrap_err_with(|| format!("cannot read procedure {}", path.display()))?;
+    let (plan, sha256) = super::check::plan(path, &text, station)?;
+    Ok(LoadedProcedure { plan, text, sha256 })
+}
+
+/// `runs/<procedure>-<UTC timestamp>` (with `-2`, `-3`... if taken).
+pub fn default_out(name: &str) -> PathBuf {
+    let stamp: String = rfc3339(std::time::SystemTime::now())
+        .chars()
+        .filter(|c| c.is_ascii_digit())
+        .collect();
+    let base = PathBuf::from("runs").join(format!("{name}-{}-{}", &stamp[..8], &stamp[8..]));
+    let mut p = base.clone();
+    let mut k = 2;
+    while p.exists() {
+        p = PathBuf::from(format!("{}-{k}", base.display()));
+        k += 1;
+    }
+    p
+}
+
+/// What the manifest says about this run before it starts.
+pub struct RunFacts<'a> {
+    pub dir: &'a Path,
+    pub dry_run: bool,
+    pub seed: u64,
+    pub operator: Option<String>,
+}
+
+/// The manifest of a new run.
+pub fn manifest(st: &LoadedStation, proc_: &LoadedProcedure, facts: &RunFacts) -> Manifest {
+    let info = st.station.describe();
+    let g = &info.geometry;
+    let c = g.c_pb;
+    let rotation = [
+        [c[(0, 0)], c[(0, 1)], c[(0, 2)]],
+        [c[(1, 0)], c[(1, 1)], c[(1, 2)]],
+        [c[(2, 0)], c[(2, 1)], c[(2, 2)]],
+    ];
+    Manifest {
+        format: FORMAT.into(),
+        station: ManifestStation {
+            site: info.site,
+            table: TableAxes {
+                outer_axis: [g.outer_axis[0], g.outer_axis[1], g.outer_axis[2]],
+                inner_axis: [g.inner_axis[0], g.inner_axis[1], g.inner_axis[2]],
+            },
+            mount: Some(Mount { rotation }),
+        },
+        imu: [
+            ("model", info.imu.model),
+            ("serial", info.imu.serial),
+            ("grade", info.imu.grade),
+        ]
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), v))
+        .collect(),
+        procedure: Some(ProcedureRef {
+            name: proc_.plan.name.clone(),
+            version: proc_.plan.version.clone(),
+            sha256: proc_.sha256.clone(),
+        }),
+        segments: Vec::new(),
+        environment: info.environment.map(|e| EnvironmentRecord {
+            temperature_c: e.temperature_c,
+            humidity_pct: e.humidity_pct,
+            pressure_kpa: e.pressure_kpa,
+            vibration_g: e.vibration_g,
+        }),
+        run: Some(RunInfo {
+            id: facts
+                .dir
+                .file_name()
+                .map_or_else(|| "run".into(), |n| n.to_string_lossy().into_owned()),
+            ratecal_version: env!("CARGO_PKG_VERSION").into(),
+            dry_run: facts.dry_run,
+            started: rfc3339(std::time::SystemTime::now()),
+            ended: None,
+            status: "running".into(),
+            abort: None,
+            operator: facts.operator.clone(),
+            seed: facts.dry_run.then_some(facts.seed),
+            station_sha256: Some(sha256_hex(st.yaml.as_bytes())),
+            files_sha256: Default::default(),
+        }),
+    }
+}

@@ -1,0 +1,239 @@
+//! `ratecal run` end to end: exit codes, the run folder, aborts driven by station files,
+//! `--resume`.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+const MINI: &str = r#"procedure mini version 1.0.0 {
+  title "Two attitudes and one rate"
+  imu class tactical
+
+  abort when table.attitude_error > 5 arcsec for 1 s
+  abort when ambient.temperature outside 18 degC .. 22 degC for 2 s
+
+  step statics "Two static attitudes" {
+    for (n, pitch, roll) in [(1, 0 deg, 0 deg), (2, 90 deg, 0 deg)] {
+      move to pitch pitch, roll roll
+      settle {
+        at least 5 s
+        table.attitude_error <= 5 arcsec
+        timeout 60 s -> abort
+      }
+      acquire accel, gyro, table for 10 s at 100 Hz as "accel_static/{n}"
+    }
+  }
+
+  step rates "One rate point" {
+    for axis in [outer] {
+      for rate in [50] deg/s {
+        spin axis at rate
+        settle {
+          at least 5 s
+          table.rate_error <= 0.5 deg/s
+          timeout 60 s -> abort
+        }
+        acquire gyro, table for 10 s at 100 Hz as "gyro_scale/{axis}/{rate:+}"
+      }
+      stop axis
+    }
+  }
+}
+"#;
+
+fn ratecal(args: &[&str], cwd: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_ratecal"))
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .unwrap()
+}
+
+fn code(o: &Output) -> i32 {
+    o.status.code().unwrap_or(-1)
+}
+
+fn text(o: &Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+fn manifest(dir: &Path) -> ratecal_engine::recording::Manifest {
+    ratecal_engine::recording::parse_manifest(
+        "manifest.yaml",
+        &std::fs::read_to_string(dir.join("manifest.yaml")).unwrap(),
+    )
+    .unwrap()
+}
+
+#[test]
+fn usage_and_input_errors() {
+    let tmp = tempfile::tempdir().unwrap();
+    assert_eq!(code(&ratecal(&["run"], tmp.path())), 2);
+    assert_eq!(
+        code(&ratecal(&["run", "nope.rcal", "--bogus"], tmp.path())),
+        2
+    );
+    let o = ratecal(&["run", "missing.rcal"], tmp.path());
+    assert_eq!(code(&o), 1, "{}", text(&o));
+    std::fs::write(tmp.path().join("p.rcal"), MINI).unwrap();
+    std::fs::write(
+        tmp.path().join("bad.yaml"),
+        "site: { latitude_deg: 55.7, gravity_mps2: 9.81 }\nbogus_key: 1\n",
+    )
+    .unwrap();
+    let o = ratecal(&["run", "p.rcal", "--station", "bad.yaml"], tmp.path());
+    assert_eq!(code(&o), 1, "{}", text(&o));
+    assert!(text(&o).contains("bad.yaml"), "{}", text(&o));
+    std::fs::write(
+        tmp.path().join("broken.rcal"),
+        "procedure broken version 1.0.0 {\n  step {\n",
+    )
+    .unwrap();
+    let o = ratecal(&["run", "broken.rcal", "--dry-run"], tmp.path());
+    assert_eq!(code(&o), 1, "{}", text(&o));
+    assert!(
+        !tmp.path().join("runs").exists(),
+        "no run folder for an input error"
+    );
+}
+
+#[test]
+fn dry_run_writes_the_run_folder() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(tmp.path().join("p.rcal"), MINI).unwrap();
+    let o = ratecal(
+        &[
+            "run",
+            "p.rcal",
+            "--dry-run",
+            "--out",
+            "r1",
+            "--seed",
+            "5",
+            "--operator",
+            "ada",
+        ],
+        tmp.path(),
+    );
+    assert!(matches!(code(&o), 0 | 3), "{}", text(&o));
+    let dir = tmp.path().join("r1");
+    for f in [
+        "manifest.yaml",
+        "imu.csv",
+        "table.csv",
+        "journal.jsonl",
+        "procedure.rcal",
+        "station.yaml",
+        "results.json",
+    ] {
+        assert!(dir.join(f).exists(), "{f}");
+    }
+    let m = manifest(&dir);
+    let ids: Vec<_> = m.segments.iter().map(|s| s.id.as_str()).collect();
+    assert_eq!(
+        ids,
+        ["accel_static/1", "accel_static/2", "gyro_scale/outer/+50"]
+    );
+    let run = m.run.unwrap();
+    assert_eq!(
+        (
+            run.status.as_str(),
+            run.seed,
+            run.operator.as_deref(),
+            run.dry_run
+        ),
+        ("completed", Some(5), Some("ada"), true)
+    );
+    let canon = ratecal_grammar::canonical(MINI).unwrap();
+    assert_eq!(m.procedure.unwrap().sha256, canon.sha256);
+    let rec = ratecal_engine::recording::read(&dir).unwrap();
+    assert!(rec.imu.t[0] >= 0.0 && rec.imu.t[0] < 0.02);
+    assert!(text(&o).contains("run folder"));
+    // Same seed, same recording.
+    let o = ratecal(
+        &["run", "p.rcal", "--dry-run", "--out", "r2", "--seed", "5"],
+        tmp.path(),
+    );
+    assert!(matches!(code(&o), 0 | 3));
+    let same = std::fs::read(dir.join("imu.csv")).unwrap()
+        == std::fs::read(tmp.path().join("r2/imu.csv")).unwrap();
+    assert!(same, "same seed, different imu.csv");
+}
+
+fn station_with(fault: &str) -> String {
+    ratecal_drivers::DEFAULT_STATION_YAML.replace("faults: []", fault)
+}
+
+#[test]
+fn station_fault_aborts_with_4_and_resume_completes() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(tmp.path().join("p.rcal"), MINI).unwrap();
+    // A lab excursion during the rate step (after both static segments).
+    let fault = "faults: [ { temperature_excursion: { at: 36 s, delta: 4 degC, ramp: 1 s, duration: 600 s } } ]";
+    std::fs::write(tmp.path().join("st.yaml"), station_with(fault)).unwrap();
+    let o = ratecal(
+        &[
+            "run",
+            "p.rcal",
+            "--station",
+            "st.yaml",
+            "--dry-run",
+            "--out",
+            "r",
+        ],
+        tmp.path(),
+    );
+    assert_eq!(code(&o), 4, "{}", text(&o));
+    assert!(text(&o).contains("ABORTED"));
+    let dir = tmp.path().join("r");
+    let m = manifest(&dir);
+    let run = m.run.as_ref().unwrap();
+    assert_eq!(run.status, "aborted");
+    let abort = run.abort.as_ref().unwrap();
+    assert!(abort.rule.contains("ambient.temperature"), "{}", abort.rule);
+    let rec = ratecal_engine::recording::read(&dir).unwrap();
+    assert!(*rec.imu.t.last().unwrap() >= abort.t - 0.02);
+
+    // The operator fixes the lab (the fault leaves the run folder's station) and resumes.
+    std::fs::write(dir.join("station.yaml"), station_with("faults: []")).unwrap();
+    let o = ratecal(&["run", "--resume", "r"], tmp.path());
+    assert!(matches!(code(&o), 0 | 3), "{}", text(&o));
+    let m = manifest(&dir);
+    let ids: Vec<_> = m.segments.iter().map(|s| s.id.as_str()).collect();
+    assert_eq!(
+        ids,
+        ["accel_static/1", "accel_static/2", "gyro_scale/outer/+50"]
+    );
+    assert_eq!(m.run.as_ref().unwrap().status, "completed");
+    assert!(m.segments[2].t_start > abort.t);
+    // One recording, time increasing through the resume; it reads back.
+    ratecal_engine::recording::read(&dir).unwrap();
+    // Nothing left to resume.
+    assert_eq!(code(&ratecal(&["run", "--resume", "r"], tmp.path())), 1);
+}
+
+#[test]
+fn standard_procedure_dry_run_passes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let proc_dir = concat!(env!("CARGO_MANIFEST_DIR"), "/procedures/imu-2d-standard");
+    let o = ratecal(
+        &["run", proc_dir, "--dry-run", "--out", "std", "--seed", "11"],
+        tmp.path(),
+    );
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let m = manifest(&tmp.path().join("std"));
+    assert_eq!(m.procedure.as_ref().unwrap().name, "imu-2d-standard");
+    let bias = m.segments.iter().find(|s| s.id == "gyro_bias").unwrap();
+    assert!((bias.t_end - bias.t_start - 3600.0).abs() < 1e-9);
+    assert_eq!(
+        m.segments
+            .iter()
+            .filter(|s| s.id.starts_with("accel_static/"))
+            .count(),
+        6
+    );
+    assert!(tmp.path().join("std/results.json").exists());
+}
