@@ -101,7 +101,6 @@ fn report(args: &Args) -> miette::Result<()> {
 /// `ratecal run` calls this after the analysis (build `input` with
 /// `ReportInput::from_run`).
 // `ratecal run` is wired to this on another branch; until the merge nothing here calls it.
-#[allow(dead_code)]
 pub fn write_reports(
     run_dir: &Path,
     input: &ReportInput,

@@ -287,7 +287,28 @@ fn analyze(dir: &Path, plan: &ratecal_engine::plan::Plan) -> ExitCode {
         );
     }
     println!("results: {}", dir.join("results.json").display());
-    // Hook: reports (branch `report`) render from results.json once merged.
+    // The checked plan beside the results lets `ratecal report` describe the process later.
+    if let Ok(json) = serde_json::to_string_pretty(plan) {
+        let _ = std::fs::write(dir.join("plan.json"), json);
+    }
+    let input = ratecal_engine::render::ReportInput::from_run(
+        &results,
+        &rec.manifest,
+        Some(plan),
+        Some(&rec),
+        env!("CARGO_PKG_VERSION"),
+    );
+    match super::report::write_reports(dir, &input, None) {
+        Ok(paths) => {
+            for p in paths {
+                println!("report: {}", p.display());
+            }
+        }
+        Err(e) => {
+            eprintln!("{e:?}");
+            return ExitCode::from(1);
+        }
+    }
     if results.has_failure() {
         ExitCode::from(3)
     } else {
