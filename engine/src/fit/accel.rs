@@ -158,19 +158,44 @@ pub(crate) fn k_param(i: usize, j: usize, v: f64, u: f64) -> Parameter {
 
 /// Residuals per segment and the pooled residual standard deviation.
 fn finish(segs: &[&SegData], k: Mat3, b: Vec3, out: &mut Out) {
+    let worst = model_residuals(segs, Sensor::Accel, &k, &b, out);
+    out.quantities.insert("accel.residual.std".into(), worst);
+    out.accel_model = Some((k, b));
+}
+
+/// Which sensor a fitted model describes.
+#[derive(Clone, Copy)]
+pub(super) enum Sensor {
+    /// Accelerometers: outputs `accel`, references `f_ref`, mask `keep_a`.
+    Accel,
+    /// Gyros: outputs `gyro`, references `w_ref`, mask `keep_g`.
+    Gyro,
+}
+
+/// Pushes the residuals of `out = K ref + b` per segment and axis, and returns the worst
+/// axis's pooled residual standard deviation with its standard uncertainty.
+pub(super) fn model_residuals(
+    segs: &[&SegData],
+    sensor: Sensor,
+    k: &Mat3,
+    b: &Vec3,
+    out: &mut Out,
+) -> (f64, f64) {
     let mut worst = (0.0f64, 0.0f64);
     for ax in 0..3 {
         let (mut ss, mut n) = (0.0, 0usize);
         for s in segs {
+            let (y, rf, keep, name, unit) = match sensor {
+                Sensor::Accel => (&s.accel, &s.f_ref, &s.keep_a, "accel", "m/s^2"),
+                Sensor::Gyro => (&s.gyro, &s.w_ref, &s.keep_g, "gyro", "deg/s"),
+            };
             let r: Vec<f64> = (0..s.t.len())
-                .map(|i| {
-                    s.accel[ax][i] - b[ax] - (0..3).map(|j| k[(ax, j)] * s.f_ref[j][i]).sum::<f64>()
-                })
+                .map(|i| y[ax][i] - b[ax] - (0..3).map(|j| k[(ax, j)] * rf[j][i]).sum::<f64>())
                 .collect();
             out.residuals
-                .push(residual_stats(s, "accel", ax, &r, &s.keep_a, "m/s^2"));
+                .push(residual_stats(s, name, ax, &r, keep, unit));
             for i in 0..r.len() {
-                if s.keep_a[i] {
+                if keep[i] {
                     ss += r[i] * r[i];
                     n += 1;
                 }
@@ -183,6 +208,5 @@ fn finish(segs: &[&SegData], k: Mat3, b: Vec3, out: &mut Out) {
             }
         }
     }
-    out.quantities.insert("accel.residual.std".into(), worst);
-    out.accel_model = Some((k, b));
+    worst
 }

@@ -1,7 +1,7 @@
 //! Gyro models: static bias and noise from the long static block, per-axis scale from
 //! rate points with the bias held fixed (seed model), and the full 3x3 model.
 
-use super::accel::{k_name, k_param};
+use super::accel::{Sensor, k_name, k_param, model_residuals};
 use super::lsq::Normal;
 use super::prep::SegData;
 use super::stats::{Inflation, mean, std};
@@ -182,31 +182,7 @@ pub(crate) fn fit_full(segs: &[&SegData], out: &mut Out) {
 }
 
 fn finish(segs: &[&SegData], k: Mat3, b: Vec3, out: &mut Out) {
-    let mut worst = (0.0f64, 0.0f64);
-    for ax in 0..3 {
-        let (mut ss, mut n) = (0.0, 0usize);
-        for s in segs {
-            let r: Vec<f64> = (0..s.t.len())
-                .map(|i| {
-                    s.gyro[ax][i] - b[ax] - (0..3).map(|j| k[(ax, j)] * s.w_ref[j][i]).sum::<f64>()
-                })
-                .collect();
-            out.residuals
-                .push(residual_stats(s, "gyro", ax, &r, &s.keep_g, "deg/s"));
-            for i in 0..r.len() {
-                if s.keep_g[i] {
-                    ss += r[i] * r[i];
-                    n += 1;
-                }
-            }
-        }
-        if n > 1 {
-            let sd = (ss / (n - 1) as f64).sqrt();
-            if sd > worst.0 {
-                worst = (sd, sd / (2.0 * (n - 1) as f64).sqrt());
-            }
-        }
-    }
+    let worst = model_residuals(segs, Sensor::Gyro, &k, &b, out);
     out.quantities.insert("gyro.residual.std".into(), worst);
     out.gyro_model = Some((k, b));
 }
