@@ -138,9 +138,9 @@ impl RecordingWriter {
     /// stamp found in either stream (`None` when both are empty).
     pub fn append(dir: &Path) -> io::Result<(Self, Option<f64>)> {
         let text = std::fs::read_to_string(dir.join("manifest.yaml"))?;
-        let manifest: Manifest = serde_saphyr::from_str(&text).map_err(|e| {
-            io::Error::new(io::ErrorKind::InvalidData, format!("manifest.yaml: {e}"))
-        })?;
+        // The reader's manifest parser, so a resumed run accepts exactly what analysis reads.
+        let manifest = super::parse_manifest("manifest.yaml", &text)
+            .map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e.to_string()))?;
         let (imu, imu_header) = Stream::append(&dir.join("imu.csv"))?;
         let (table, table_header) = Stream::append(&dir.join("table.csv"))?;
         let columns = Columns {
