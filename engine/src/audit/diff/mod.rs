@@ -9,7 +9,7 @@ mod step;
 
 use super::change::{Change, ChangeKind, fmt_num, fmt_s};
 use crate::plan::{Plan, Step};
-use pair::{Pair, moved, pair};
+use pair::{Pair, moved_pairs, pair};
 
 /// Every semantic change from `old` to `new`, in procedure order: metadata, station
 /// requirements, environment, run-wide abort rules, steps (with their fits and
@@ -94,17 +94,7 @@ fn step_path(s: &Step) -> String {
 
 fn steps(old: &Plan, new: &Plan, out: &mut Vec<Change>) {
     let pairs = pair(&old.steps, &new.steps, |s| s.name.clone());
-    let olds_in_new_order: Vec<usize> = pairs
-        .iter()
-        .filter_map(|p| {
-            if let Pair::Both(i, ..) = p {
-                Some(*i)
-            } else {
-                None
-            }
-        })
-        .collect();
-    let mut moved_flags = moved(&olds_in_new_order).into_iter();
+    let mut moved_flags = moved_pairs(&pairs).into_iter();
     for p in pairs {
         let name = match p {
             Pair::Both(_, s, _, _) | Pair::Old(s) | Pair::New(s) => s.name.clone(),

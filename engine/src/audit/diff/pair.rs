@@ -54,6 +54,19 @@ pub fn pair<'a, T, K: PartialEq>(
     placed.into_iter().map(|(_, p)| p).collect()
 }
 
+/// For each element present in both lists (in new order), whether it moved relative to
+/// the others.
+pub fn moved_pairs<T>(pairs: &[Pair<'_, T>]) -> Vec<bool> {
+    let olds: Vec<usize> = pairs
+        .iter()
+        .filter_map(|p| match p {
+            Pair::Both(i, ..) => Some(*i),
+            _ => None,
+        })
+        .collect();
+    moved(&olds)
+}
+
 /// Among paired elements, the old indices (in new order) that are not in a longest
 /// increasing subsequence: the elements that moved relative to the others.
 pub fn moved(old_indices_in_new_order: &[usize]) -> Vec<bool> {

@@ -6,7 +6,7 @@
 //! acquisition (`step gyro_scale / settle before gyro_scale/outer/+100 / min time`).
 
 use super::limits;
-use super::pair::{Pair, moved, pair};
+use super::pair::{Pair, moved_pairs, pair};
 use crate::audit::change::{Change, ChangeKind, fmt_internal, fmt_num, fmt_s, same, signal_dim};
 use crate::audit::direction;
 use crate::plan::{Acquire, Action, Axis, Dim, Node, Settle, Step};
@@ -191,17 +191,7 @@ fn values_same(a: &Option<serde_json::Value>, b: &Option<serde_json::Value>) -> 
 /// Added, removed and (when `order` matters) moved elements of a multiset.
 fn elements(path: &str, old: &[String], new: &[String], order: bool, out: &mut Vec<Change>) {
     let pairs = pair(old, new, |s| s.clone());
-    let olds: Vec<usize> = pairs
-        .iter()
-        .filter_map(|p| {
-            if let Pair::Both(i, ..) = p {
-                Some(*i)
-            } else {
-                None
-            }
-        })
-        .collect();
-    let mut flags = moved(&olds).into_iter();
+    let mut flags = moved_pairs(&pairs).into_iter();
     for p in pairs {
         match p {
             Pair::Old(s) => out.push(Change::removed(format!("{path} {s}"), s.clone())),
