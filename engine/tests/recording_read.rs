@@ -99,6 +99,74 @@ fn small_valid_recording_with_extra_column() {
     assert_eq!(rec.imu.gyro[5], [0.1, 0.2, 0.3]);
 }
 
+/// The fast path gives up on quotes, CRLF-free oddities and blank lines are its own; the
+/// exact reader must then give the same streams as the fast path gives for plain text.
+#[test]
+fn quoted_cells_and_blank_lines_read_like_plain_ones() {
+    let plain = tempfile::tempdir().unwrap();
+    small(plain.path(), MANIFEST, &imu_text(), &table_text());
+    let quoted = tempfile::tempdir().unwrap();
+    let imu = imu_text()
+        .replace(",0.02,", ",\"0.02\",")
+        .replace("\n0.30", "\n\n  \r\n0.30");
+    let table = table_text().replace("\n", "\r\n");
+    small(quoted.path(), MANIFEST, &imu, &table);
+    let a = recording::read(plain.path()).unwrap();
+    let b = recording::read(quoted.path()).unwrap();
+    assert_eq!(a.imu, b.imu);
+    assert_eq!(a.table, b.table);
+}
+
+/// A file bigger than the reader's buffer, split over its two threads, reads row for row
+/// like the text says, and a time step backwards deep inside it is located on its line.
+#[test]
+fn large_streams_split_across_threads_read_exactly() {
+    let tmp = tempfile::tempdir().unwrap();
+    let n = 40_000;
+    let mut imu = String::from("t,ax,ay,az,gx,gy,gz,temp\n");
+    for i in 0..n {
+        let t = i as f64 * 0.01;
+        imu += &format!(
+            "{t:.2},{:.6},-0.5,9.8,{:.7},0,0,22.5\n",
+            i as f64 * 1e-6,
+            -(i as f64) * 1e-7
+        );
+    }
+    let mut table = String::from("t,outer,inner,outer_rate,inner_rate\n");
+    for i in 0..n / 2 {
+        table += &format!("{:.2},0,0,0,0\n", i as f64 * 0.02);
+    }
+    let manifest = MANIFEST.replace("t_end: 0.5", "t_end: 300.0");
+    small(tmp.path(), &manifest, &imu, &table);
+    let rec = recording::read(tmp.path()).unwrap();
+    assert_eq!(rec.imu.t.len(), n);
+    for i in [0, 1, n / 2 - 1, n / 2, n / 2 + 1, n - 1] {
+        assert_eq!(
+            rec.imu.t[i],
+            format!("{:.2}", i as f64 * 0.01).parse::<f64>().unwrap()
+        );
+        assert_eq!(
+            rec.imu.accel[i][0],
+            format!("{:.6}", i as f64 * 1e-6).parse::<f64>().unwrap()
+        );
+        assert_eq!(
+            rec.imu.gyro[i][0],
+            format!("{:.7}", -(i as f64) * 1e-7).parse::<f64>().unwrap()
+        );
+    }
+    assert_eq!(rec.imu.temp.as_ref().unwrap().len(), n);
+    assert_eq!(rec.table.t.len(), n / 2);
+    // Row 30000 is on line 30002; make its time go back.
+    let bad = imu.replacen("\n300.00,", "\n299.00,", 1);
+    std::fs::write(tmp.path().join("imu.csv"), bad).unwrap();
+    let e = recording::read(tmp.path()).expect_err("time goes back");
+    assert!(
+        render(tmp.path(), &e).contains("imu.csv:30002:1"),
+        "{}",
+        render(tmp.path(), &e)
+    );
+}
+
 #[test]
 fn err_missing_column() {
     let imu = imu_text().replace("t,ax,ay,az,gx,gy,gz", "t,ax,ay,az,gx,gyy,gz");

@@ -1,5 +1,5 @@
-//! Columnar CSV reading for imu.csv and table.csv: columns found by header name, one
-//! reused `ByteRecord`, a fast exact path for short decimal numbers.
+//! The exact CSV reader for imu.csv and table.csv (the csv crate, one reused `ByteRecord`):
+//! it accepts what the fast path (`scan`) gives up on, and locates every problem.
 
 // A refused recording is built once per read: the error's size costs nothing.
 #![allow(clippy::result_large_err)]
@@ -12,8 +12,6 @@ use miette::NamedSource;
 pub(crate) struct Columns {
     /// Data per asked column.
     pub cols: Vec<Option<Vec<f64>>>,
-    /// 1-based line of each row (for later located errors).
-    pub lines: Vec<u64>,
 }
 
 /// Reads `bytes` (the text of `file`) keeping `required` and `optional` columns by name.
@@ -69,11 +67,7 @@ pub(crate) fn read_columns(
         .iter()
         .map(|i| i.map(|_| Vec::with_capacity(guess)))
         .collect();
-    let mut lines = Vec::with_capacity(guess);
     let width = names.len();
-    if let Some(fast) = fast_columns(bytes, header_len, width, &idx, guess) {
-        return Ok(fast);
-    }
     while rdr.read_byte_record(&mut rec).map_err(|e| io(file, e))? {
         let pos = rec.position().expect("csv records carry positions");
         if rec.len() != width {
@@ -117,67 +111,8 @@ pub(crate) fn read_columns(
                 }
             }
         }
-        lines.push(pos.line());
     }
-    Ok(Columns { cols, lines })
-}
-
-/// The common case without the csv state machine: unquoted numeric cells, one record a
-/// line. Anything else (quotes, a ragged row, a bad cell) returns `None`, and the csv
-/// reader reads the file again to locate the problem exactly.
-fn fast_columns(
-    bytes: &[u8],
-    header_len: usize,
-    width: usize,
-    idx: &[Option<usize>],
-    guess: usize,
-) -> Option<Columns> {
-    if bytes.contains(&b'"') {
-        return None;
-    }
-    // field -> output column
-    let mut want = vec![usize::MAX; width];
-    for (k, i) in idx.iter().enumerate() {
-        if let Some(i) = i {
-            want[*i] = k;
-        }
-    }
-    let mut cols: Vec<Option<Vec<f64>>> = idx
-        .iter()
-        .map(|i| i.map(|_| Vec::with_capacity(guess)))
-        .collect();
-    let mut lines = Vec::with_capacity(guess);
-    let mut pos = (header_len + 1).min(bytes.len());
-    let mut line = 1u64;
-    while pos < bytes.len() {
-        line += 1;
-        let end = bytes[pos..]
-            .iter()
-            .position(|&b| b == b'\n')
-            .map_or(bytes.len(), |p| pos + p);
-        let row = &bytes[pos..end];
-        pos = end + 1;
-        let row = row.strip_suffix(b"\r").unwrap_or(row);
-        if row.iter().all(u8::is_ascii_whitespace) {
-            continue;
-        }
-        let mut field = 0;
-        for cell in row.split(|&b| b == b',') {
-            if field >= width {
-                return None;
-            }
-            let k = want[field];
-            if k != usize::MAX {
-                cols[k].as_mut()?.push(parse_f64(cell)?);
-            }
-            field += 1;
-        }
-        if field != width {
-            return None;
-        }
-        lines.push(line);
-    }
-    Some(Columns { cols, lines })
+    Ok(Columns { cols })
 }
 
 fn io(file: &str, e: csv::Error) -> RecordingError {

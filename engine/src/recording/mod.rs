@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 mod csvread;
 mod error;
 mod read;
+mod scan;
 
 pub use error::RecordingError;
 pub use read::{parse_manifest, read};

@@ -5,6 +5,7 @@
 
 use super::csvread::{Columns, cell_offset, read_columns};
 use super::error::{RecordingError, line_col};
+use super::scan::{self, Layout, MAX_SLOTS, RowSink, SKIP};
 use super::{FORMAT, ImuStream, Manifest, Recording, TableStream};
 use miette::NamedSource;
 use std::path::Path;
@@ -16,35 +17,169 @@ const TABLE_COLS: [&str; 5] = ["t", "outer", "inner", "outer_rate", "inner_rate"
 /// promises: columns present, numbers finite, time strictly increasing, segments inside
 /// both streams and not empty.
 pub fn read(dir: &Path) -> Result<Recording, RecordingError> {
-    let load = |name: &str| {
-        let path = dir.join(name);
-        std::fs::read(&path).map_err(|e| RecordingError::Io {
-            file: path.display().to_string(),
-            message: e.to_string(),
-        })
-    };
-    let manifest_bytes = load("manifest.yaml")?;
-    let imu_bytes = load("imu.csv")?;
-    let table_bytes = load("table.csv")?;
-    let manifest_name = dir.join("manifest.yaml").display().to_string();
+    let manifest_path = dir.join("manifest.yaml");
+    let manifest_bytes = std::fs::read(&manifest_path).map_err(|e| io_error(&manifest_path, e))?;
+    let manifest_name = manifest_path.display().to_string();
     let manifest_text = String::from_utf8_lossy(&manifest_bytes).into_owned();
     let manifest = parse_manifest(&manifest_name, &manifest_text)?;
 
-    let imu_name = dir.join("imu.csv").display().to_string();
-    let table_name = dir.join("table.csv").display().to_string();
-    // The two files are independent: parse them on two threads.
-    let (imu, table) = std::thread::scope(|s| {
-        let h = s.spawn(|| parse_imu(&imu_name, &imu_bytes));
-        let table = parse_table(&table_name, &table_bytes);
-        (h.join().expect("imu reader thread"), table)
-    });
-    let (imu, table) = (imu?, table?);
+    let imu_path = dir.join("imu.csv");
+    let table_path = dir.join("table.csv");
+    let (imu, table) = fast_streams(&imu_path, &table_path)?;
+    let imu = match imu {
+        Some(s) => s,
+        None => parse_imu(&imu_path)?,
+    };
+    let table = match table {
+        Some(s) => s,
+        None => parse_table(&table_path)?,
+    };
+    check_time(&imu_path, &imu.t)?;
+    check_time(&table_path, &table.t)?;
     check_segments(&manifest_name, &manifest_text, &manifest, &imu, &table)?;
     Ok(Recording {
         manifest,
         imu,
         table,
     })
+}
+
+fn io_error(path: &Path, e: std::io::Error) -> RecordingError {
+    RecordingError::Io {
+        file: path.display().to_string(),
+        message: e.to_string(),
+    }
+}
+
+impl RowSink for ImuStream {
+    #[inline]
+    fn push(&mut self, r: &[f64; MAX_SLOTS]) {
+        self.t.push(r[0]);
+        self.accel.push([r[1], r[2], r[3]]);
+        self.gyro.push([r[4], r[5], r[6]]);
+        if let Some(tc) = &mut self.temp {
+            tc.push(r[7]);
+        }
+    }
+    fn append(&mut self, o: Self) {
+        self.t.extend(o.t);
+        self.accel.extend(o.accel);
+        self.gyro.extend(o.gyro);
+        if let (Some(a), Some(b)) = (&mut self.temp, o.temp) {
+            a.extend(b);
+        }
+    }
+}
+
+impl RowSink for TableStream {
+    #[inline]
+    fn push(&mut self, r: &[f64; MAX_SLOTS]) {
+        self.t.push(r[0]);
+        self.outer.push(r[1]);
+        self.inner.push(r[2]);
+        self.outer_rate.push(r[3]);
+        self.inner_rate.push(r[4]);
+        if let Some(a) = &mut self.ambient {
+            a.push(r[5]);
+        }
+    }
+    fn append(&mut self, o: Self) {
+        self.t.extend(o.t);
+        self.outer.extend(o.outer);
+        self.inner.extend(o.inner);
+        self.outer_rate.extend(o.outer_rate);
+        self.inner_rate.extend(o.inner_rate);
+        if let (Some(a), Some(b)) = (&mut self.ambient, o.ambient) {
+            a.extend(b);
+        }
+    }
+}
+
+/// Where the asked columns are in a header; `None` when a required one is missing (the
+/// exact reader then says so, located).
+fn layout(
+    names: &[String],
+    required: &[&str],
+    optional: &[&str],
+    data_start: u64,
+) -> Option<(Layout, bool)> {
+    let mut want = vec![SKIP; names.len()];
+    for (slot, c) in required.iter().enumerate() {
+        let i = names.iter().position(|n| n == c)?;
+        want[i] = slot;
+    }
+    let opt = optional
+        .first()
+        .and_then(|c| names.iter().position(|n| n == c));
+    if let Some(i) = opt {
+        want[i] = required.len();
+    }
+    Some((Layout { want, data_start }, opt.is_some()))
+}
+
+/// Both streams by the fast path (`scan`), the IMU file split over two threads with the
+/// table file on the second; `None` for a stream the exact reader must read instead.
+#[allow(clippy::type_complexity)]
+fn fast_streams(
+    imu_path: &Path,
+    table_path: &Path,
+) -> Result<(Option<ImuStream>, Option<TableStream>), RecordingError> {
+    let head = |p: &Path| {
+        let (names, start) = scan::header(p).map_err(|e| io_error(p, e))?;
+        let len = std::fs::metadata(p).map_err(|e| io_error(p, e))?.len();
+        Ok::<_, RecordingError>((names, start, len))
+    };
+    let (imu_names, imu_start, imu_len) = head(imu_path)?;
+    let (table_names, table_start, table_len) = head(table_path)?;
+    let imu_layout = layout(&imu_names, &IMU_COLS, &["temp"], imu_start);
+    let table_layout = layout(&table_names, &TABLE_COLS, &["ambient"], table_start);
+    let new_imu = |temp: bool| ImuStream {
+        temp: temp.then(Vec::new),
+        ..Default::default()
+    };
+    let new_table = |amb: bool| TableStream {
+        ambient: amb.then(Vec::new),
+        ..Default::default()
+    };
+    let table_bytes = if table_layout.is_some() {
+        table_len - table_start
+    } else {
+        0
+    };
+    let mid = match &imu_layout {
+        Some(_) => scan::split_point((imu_start, imu_len), table_bytes),
+        None => imu_start,
+    };
+    let (first, second) = std::thread::scope(|s| {
+        let h = s.spawn(|| {
+            let imu = imu_layout.as_ref().and_then(|(l, temp)| {
+                let mut part = new_imu(*temp);
+                scan::scan_range(imu_path, l, mid, imu_len, &mut part)
+                    .ok()
+                    .map(|_| part)
+            });
+            let table = table_layout.as_ref().and_then(|(l, amb)| {
+                let mut all = new_table(*amb);
+                scan::scan_range(table_path, l, table_start, table_len, &mut all)
+                    .ok()
+                    .map(|_| all)
+            });
+            (imu, table)
+        });
+        let first = imu_layout.as_ref().and_then(|(l, temp)| {
+            let mut part = new_imu(*temp);
+            scan::scan_range(imu_path, l, imu_start, mid, &mut part)
+                .ok()
+                .map(|_| part)
+        });
+        (first, h.join().expect("reader thread"))
+    });
+    let (second, table) = second;
+    let imu = first.zip(second).map(|(mut a, b)| {
+        a.append(b);
+        a
+    });
+    Ok((imu, table))
 }
 
 /// Parses manifest text (`file` names it in errors).
@@ -96,11 +231,17 @@ pub fn parse_manifest(file: &str, text: &str) -> Result<Manifest, RecordingError
     Ok(manifest)
 }
 
-fn parse_imu(file: &str, bytes: &[u8]) -> Result<ImuStream, RecordingError> {
-    let Columns { mut cols, lines } = read_columns(file, bytes, &IMU_COLS, &["temp"])?;
+/// The exact reader (csv crate), for what the fast path does not handle: it accepts
+/// quoted cells and locates every problem.
+fn exact(path: &Path, required: &[&str], optional: &[&str]) -> Result<Columns, RecordingError> {
+    let bytes = std::fs::read(path).map_err(|e| io_error(path, e))?;
+    read_columns(&path.display().to_string(), &bytes, required, optional)
+}
+
+fn parse_imu(path: &Path) -> Result<ImuStream, RecordingError> {
+    let Columns { mut cols } = exact(path, &IMU_COLS, &["temp"])?;
     let mut take = |k: usize| cols[k].take().expect("required column");
     let t = take(0);
-    check_time(file, bytes, &t, &lines)?;
     let (ax, ay, az, gx, gy, gz) = (take(1), take(2), take(3), take(4), take(5), take(6));
     let accel = (0..t.len()).map(|i| [ax[i], ay[i], az[i]]).collect();
     let gyro = (0..t.len()).map(|i| [gx[i], gy[i], gz[i]]).collect();
@@ -112,13 +253,11 @@ fn parse_imu(file: &str, bytes: &[u8]) -> Result<ImuStream, RecordingError> {
     })
 }
 
-fn parse_table(file: &str, bytes: &[u8]) -> Result<TableStream, RecordingError> {
-    let Columns { mut cols, lines } = read_columns(file, bytes, &TABLE_COLS, &["ambient"])?;
+fn parse_table(path: &Path) -> Result<TableStream, RecordingError> {
+    let Columns { mut cols } = exact(path, &TABLE_COLS, &["ambient"])?;
     let mut take = |k: usize| cols[k].take().expect("required column");
-    let t = take(0);
-    check_time(file, bytes, &t, &lines)?;
     Ok(TableStream {
-        t,
+        t: take(0),
         outer: take(1),
         inner: take(2),
         outer_rate: take(3),
@@ -127,18 +266,19 @@ fn parse_table(file: &str, bytes: &[u8]) -> Result<TableStream, RecordingError> 
     })
 }
 
-fn check_time(file: &str, bytes: &[u8], t: &[f64], lines: &[u64]) -> Result<(), RecordingError> {
+/// Time strictly increasing, at least two rows; a problem is located by reading the file
+/// again (only then).
+fn check_time(path: &Path, t: &[f64]) -> Result<(), RecordingError> {
+    let file = path.display().to_string();
     if t.len() < 2 {
-        return Err(RecordingError::EmptyStream {
-            file: file.to_string(),
-        });
+        return Err(RecordingError::EmptyStream { file });
     }
     let Some(k) = t.windows(2).position(|w| w[1] <= w[0]) else {
         return Ok(());
     };
-    let line = lines[k + 1];
-    // Find the byte where that line starts, and the `t` column in it.
-    let start = line_start(bytes, line);
+    let bytes = std::fs::read(path).map_err(|e| io_error(path, e))?;
+    let start = row_start(&bytes, k + 1);
+    let line = bytes[..start].iter().filter(|&&b| b == b'\n').count() as u64 + 1;
     let header = &bytes[..bytes
         .iter()
         .position(|&b| b == b'\n')
@@ -147,35 +287,42 @@ fn check_time(file: &str, bytes: &[u8], t: &[f64], lines: &[u64]) -> Result<(), 
         .split(|&b| b == b',')
         .position(|f| f.trim_ascii() == b"t")
         .unwrap_or(0);
-    let (offset, column) = cell_offset(bytes, start, field);
+    let (offset, column) = cell_offset(&bytes, start, field);
     let len = bytes[offset..]
         .iter()
         .position(|&b| b == b',' || b == b'\n')
         .unwrap_or(1)
         .max(1);
     Err(RecordingError::TimeNotIncreasing {
-        file: file.to_string(),
+        file: file.clone(),
         line,
         column,
         t: t[k + 1],
         prev: t[k],
-        src: NamedSource::new(file, String::from_utf8_lossy(bytes).into_owned()),
+        src: NamedSource::new(file, String::from_utf8_lossy(&bytes).into_owned()),
         span: (offset, len).into(),
     })
 }
 
-fn line_start(bytes: &[u8], line: u64) -> usize {
-    if line <= 1 {
-        return 0;
-    }
-    let mut seen = 1;
-    for (i, &b) in bytes.iter().enumerate() {
-        if b == b'\n' {
-            seen += 1;
-            if seen == line {
-                return i + 1;
+/// Byte offset where data row `row` (0-based, blank lines not counted) starts.
+fn row_start(bytes: &[u8], row: usize) -> usize {
+    let mut seen = 0;
+    let mut pos = bytes
+        .iter()
+        .position(|&b| b == b'\n')
+        .map_or(bytes.len(), |p| p + 1);
+    while pos < bytes.len() {
+        let end = bytes[pos..]
+            .iter()
+            .position(|&b| b == b'\n')
+            .map_or(bytes.len(), |p| pos + p);
+        if !bytes[pos..end].iter().all(u8::is_ascii_whitespace) {
+            if seen == row {
+                return pos;
             }
+            seen += 1;
         }
+        pos = end + 1;
     }
     bytes.len()
 }
