@@ -131,10 +131,7 @@ impl TableState {
     /// Time derivative of `w_P`, P axes (rad/s^2).
     pub fn dw_p(&self, geo: &Geometry) -> Vec3 {
         let r_i = rotation(&geo.inner_axis, self.inner.angle);
-        // d/dt R(a_i, th_i)^T = -[a_i]x R^T dth_i  (R^T rotates by -th_i about a_i)
-        let rt_ao = r_i.transpose() * geo.outer_axis;
-        rt_ao * self.outer.accel - geo.inner_axis.cross(&rt_ao) * self.inner.rate * self.outer.rate
-            + geo.inner_axis * self.inner.accel
+        dw_p(geo, &(r_i.transpose() * geo.outer_axis), self)
     }
 
     /// Body angular velocity relative to the lab, B axes (rad/s): `w_B = C_PB^T w_P`.
@@ -144,18 +141,66 @@ impl TableState {
 
     /// Inertial rate that ideal gyros sense, B axes (rad/s): `w_ib = w_B + C_LB^T Omega_L`.
     pub fn w_ib(&self, geo: &Geometry, site: &Site) -> Vec3 {
-        let c_lb = geo.c_lb(self.outer.angle, self.inner.angle);
-        self.w_b(geo) + c_lb.transpose() * site.earth_rate_l()
+        self.snapshot(geo, site).w_ib()
     }
 
     /// Specific force in B axes at a platform-fixed point `rho` (P axes, metres):
     /// `f_B = C_LB^T [0,0,g] + C_PB^T (dw_P x rho + w_P x (w_P x rho))`.
     pub fn f_b(&self, geo: &Geometry, site: &Site, rho: &Vec3) -> Vec3 {
-        let c_lb = geo.c_lb(self.outer.angle, self.inner.angle);
-        let w = self.w_p(geo);
-        let dw = self.dw_p(geo);
-        c_lb.transpose() * Vec3::new(0.0, 0.0, site.gravity_mps2)
-            + geo.c_pb.transpose() * (dw.cross(rho) + w.cross(&w.cross(rho)))
+        self.snapshot(geo, site).f_b(rho)
+    }
+
+    /// The kinematics of this instant with every rotation evaluated once, for callers that
+    /// need several sensed quantities of the same state (the simulator, the analysis).
+    pub fn snapshot(&self, geo: &Geometry, site: &Site) -> Snapshot {
+        let r_o = rotation(&geo.outer_axis, self.outer.angle);
+        let r_i = rotation(&geo.inner_axis, self.inner.angle);
+        let c_bl = (r_o * r_i * geo.c_pb).transpose();
+        let rt_ao = r_i.transpose() * geo.outer_axis;
+        Snapshot {
+            c_bp: geo.c_pb.transpose(),
+            w_p: rt_ao * self.outer.rate + geo.inner_axis * self.inner.rate,
+            dw_p: dw_p(geo, &rt_ao, self),
+            gravity_b: c_bl * Vec3::new(0.0, 0.0, site.gravity_mps2),
+            earth_rate_b: c_bl * site.earth_rate_l(),
+        }
+    }
+}
+
+/// `dw_P` given `R(a_i, th_i)^T a_o`: d/dt R^T = -[a_i]x R^T dth_i.
+fn dw_p(geo: &Geometry, rt_ao: &Vec3, s: &TableState) -> Vec3 {
+    rt_ao * s.outer.accel - geo.inner_axis.cross(rt_ao) * s.inner.rate * s.outer.rate
+        + geo.inner_axis * s.inner.accel
+}
+
+/// One table state's kinematics, rotations done: see [`TableState::snapshot`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Snapshot {
+    /// `C_PB^T`.
+    pub c_bp: Mat3,
+    /// `w_P`, rad/s.
+    pub w_p: Vec3,
+    /// `dw_P`, rad/s^2.
+    pub dw_p: Vec3,
+    /// `C_LB^T [0, 0, g]`, m/s^2.
+    pub gravity_b: Vec3,
+    /// `C_LB^T Omega_L`, rad/s.
+    pub earth_rate_b: Vec3,
+}
+
+impl Snapshot {
+    /// Specific force in B axes at platform point `rho` (P axes, metres), as
+    /// [`TableState::f_b`].
+    #[inline]
+    pub fn f_b(&self, rho: &Vec3) -> Vec3 {
+        let w = &self.w_p;
+        self.gravity_b + self.c_bp * (self.dw_p.cross(rho) + w.cross(&w.cross(rho)))
+    }
+
+    /// Inertial rate in B axes, rad/s, as [`TableState::w_ib`].
+    #[inline]
+    pub fn w_ib(&self) -> Vec3 {
+        self.c_bp * self.w_p + self.earth_rate_b
     }
 }
 

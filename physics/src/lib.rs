@@ -12,7 +12,8 @@ pub mod units;
 
 pub use effects::{EFFECTS, EffectId, EffectInfo, effect};
 pub use kinematics::{
-    AxisMotion, DEG, EARTH_RATE_RADPS, Geometry, STANDARD_GRAVITY, Site, TableState, rotation, skew,
+    AxisMotion, DEG, EARTH_RATE_RADPS, Geometry, STANDARD_GRAVITY, Site, Snapshot, TableState,
+    rotation, skew,
 };
 pub use model::{IdealOutputs, ImuErrors, ideal_outputs};
 

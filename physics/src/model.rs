@@ -66,20 +66,21 @@ pub fn ideal_outputs(
     site: &Site,
     lever_m: &Mat3,
 ) -> IdealOutputs {
-    let f_b0 = state.f_b(geo, site, &Vec3::zeros());
+    let snap = state.snapshot(geo, site);
+    let f_b0 = snap.f_b(&Vec3::zeros());
     let mut s = Vec3::zeros();
     for i in 0..3 {
         let r_i: Vec3 = lever_m.row(i).transpose();
         let f = if r_i == Vec3::zeros() {
             f_b0
         } else {
-            state.f_b(geo, site, &(geo.c_pb * r_i))
+            snap.f_b(&(geo.c_pb * r_i))
         };
         s[i] = f[i];
     }
     IdealOutputs {
         s,
-        w_ib_dps: state.w_ib(geo, site) / DEG,
+        w_ib_dps: snap.w_ib() / DEG,
         f_b0,
     }
 }

@@ -24,7 +24,7 @@ pub(crate) enum Where {
 /// Compensated output against the reference at every segment no fit used.
 pub(crate) fn verify(
     sel: &Selection,
-    data: &HashMap<usize, SegData>,
+    data: &BTreeMap<usize, SegData>,
     out: &Out,
     rec: &Recording,
 ) -> (Vec<VerificationPoint>, HashMap<String, Where>) {

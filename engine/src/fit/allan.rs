@@ -32,19 +32,34 @@ pub fn overlapping_adev(y: &[f64], dt: f64) -> Vec<(f64, f64, usize)> {
     out
 }
 
-/// Allan analysis of the block's gyros (kept samples treated as contiguous).
-pub(crate) fn analyse(block: &SegData, out: &mut Out) -> Option<AllanCurve> {
+/// The three gyro curves of the block (kept samples treated as contiguous), computed side
+/// by side: the costly part of the Allan analysis, free of `Out` so that it can run while
+/// the fits do.
+pub(crate) type Curves = Vec<Vec<(f64, f64, usize)>>;
+
+pub(crate) fn curves(block: &SegData) -> Curves {
+    use rayon::prelude::*;
     let dt = super::stats::median_step(&block.t);
+    (0..3)
+        .into_par_iter()
+        .map(|ax| {
+            let y: Vec<f64> = block.gyro[ax]
+                .iter()
+                .zip(&block.keep_g)
+                .filter(|p| *p.1)
+                .map(|p| *p.0)
+                .collect();
+            overlapping_adev(&y, dt)
+        })
+        .collect()
+}
+
+/// Allan analysis of the block's gyros from its `curves`: angle random walk at tau = 1 s,
+/// bias instability.
+pub(crate) fn analyse(block: &SegData, curves: &Curves, out: &mut Out) -> Option<AllanCurve> {
     let mut taus = Vec::new();
     let mut adev: [Vec<f64>; 3] = Default::default();
-    for ax in 0..3 {
-        let y: Vec<f64> = block.gyro[ax]
-            .iter()
-            .zip(&block.keep_g)
-            .filter(|p| *p.1)
-            .map(|p| *p.0)
-            .collect();
-        let curve = overlapping_adev(&y, dt);
+    for (ax, curve) in curves.iter().enumerate() {
         if curve.len() < 2 {
             return None;
         }

@@ -25,9 +25,9 @@ pub use repeat::analyze_runs;
 use crate::plan::{Outliers, Plan};
 use crate::recording::Recording;
 use crate::results::{self, Parameter, ResidualStats, Results, SyncReport};
-use prep::{PrepOptions, SegData};
+use prep::SegData;
 use ratecal_physics::{Mat3, Vec3};
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
 
 pub(crate) const AXES: [&str; 3] = ["x", "y", "z"];
 
@@ -112,49 +112,27 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
         table_step_s: stats::median_step(&rec.table.t),
         ..Default::default()
     };
-    // Segments are independent: prepare them on two threads, the longest alone.
+    // Segments are independent: prepared in parallel, longest first so that the work
+    // stealing balances; a long segment splits its own work too.
     let dur = |i: usize| rec.manifest.segments[i].t_end - rec.manifest.segments[i].t_start;
-    let total: f64 = sel.prep.iter().map(|p| dur(p.0)).sum();
-    let (mut first, mut second) = (Vec::new(), Vec::new());
-    let mut acc = 0.0;
     let mut order = sel.prep.clone();
     order.sort_by(|a, b| dur(b.0).total_cmp(&dur(a.0)));
-    for p in order {
-        if acc < total / 2.0 {
-            acc += dur(p.0);
-            first.push(p);
-        } else {
-            second.push(p);
-        }
-    }
-    let work = |list: &[(usize, PrepOptions)]| {
-        let mut sync = SyncReport::default();
-        let mut warnings = Vec::new();
-        let done: Vec<(usize, SegData)> = list
-            .iter()
+    let done: Vec<(usize, SegData, SyncReport, Vec<String>)> = {
+        use rayon::prelude::*;
+        order
+            .par_iter()
             .map(|&(i, po)| {
-                (
-                    i,
-                    prep::prepare(
-                        rec,
-                        &rec.manifest.segments[i],
-                        &geos[i],
-                        po,
-                        &mut sync,
-                        &mut warnings,
-                    ),
-                )
+                let mut sync = SyncReport::default();
+                let mut warnings = Vec::new();
+                let seg = &rec.manifest.segments[i];
+                let d = prep::prepare(rec, seg, &geos[i], po, &mut sync, &mut warnings);
+                (i, d, sync, warnings)
             })
-            .collect();
-        (done, sync, warnings)
+            .collect()
     };
-    let (a, b) = std::thread::scope(|sc| {
-        let h = sc.spawn(|| work(&second));
-        (work(&first), h.join().expect("preparation thread"))
-    });
-    let mut data: HashMap<usize, SegData> = HashMap::new();
-    for (done, sy, w) in [a, b] {
-        data.extend(done);
+    let mut data: BTreeMap<usize, SegData> = BTreeMap::new();
+    for (i, d, sy, w) in done {
+        data.insert(i, d);
         sync.max_gap_s = sync.max_gap_s.max(sy.max_gap_s);
         sync.max_sync_error_s = sync.max_sync_error_s.max(sy.max_sync_error_s);
         sync.max_angle_error_deg = sync.max_angle_error_deg.max(sy.max_angle_error_deg);
@@ -162,59 +140,66 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
     }
     let get = |ix: &[usize]| ix.iter().filter_map(|i| data.get(i)).collect::<Vec<_>>();
 
-    if let Some((ix, full)) = &sel.accel {
-        let segs = get(ix);
-        if *full {
-            accel::fit_full(&segs, &mut out)
-        } else {
-            accel::fit_seed(&segs, &mut out)
-        }
-    }
-    let block = sel.gyro_bias.and_then(|i| data.get(&i));
-    if let Some((ix, axes)) = &sel.gyro_scale {
-        let segs = get(ix);
-        let mut scratch = Out::default();
-        let first = match block {
-            // A first bias for the scale fit: the block mean of output minus reference.
-            Some(b) => fallback_bias(&[b]),
-            None => fallback_bias(&segs),
-        };
-        let s = gyro::fit_scale(&segs, axes, first, &mut scratch);
-        let b = match block {
-            Some(b) => gyro::fit_bias(b, &s, &mut out),
-            None => {
-                out.warnings.push(
-                    "no static block for the gyro bias: bias taken from the rate points".into(),
-                );
-                first
+    // The Allan curves (the costly part of the noise analysis) run beside the fits.
+    let allan_block = sel.allan.and_then(|i| data.get(&i));
+    let (curves, ()) = rayon::join(
+        || allan_block.map(allan::curves),
+        || {
+            if let Some((ix, full)) = &sel.accel {
+                let segs = get(ix);
+                if *full {
+                    accel::fit_full(&segs, &mut out)
+                } else {
+                    accel::fit_seed(&segs, &mut out)
+                }
             }
-        };
-        gyro::fit_scale(&segs, axes, b, &mut out);
-    } else if let Some(b) = block {
-        let (bias, _) = gyro::fit_bias(b, &Vec3::zeros(), &mut out);
-        out.gyro_model = Some((Mat3::identity(), bias));
-    }
-    // The bias wanders: as a constant of the IMU over this run, its uncertainty holds the
-    // random walk over half the run, at the rate the segment means show.
-    if let (Some(_), Some(model)) = (block, &out.gyro_model) {
-        let all: Vec<&SegData> = data.values().collect();
-        let q2 = gyro::wander_q2(&all, model);
-        let half_run = (rec.imu.t[rec.imu.t.len() - 1] - rec.imu.t[0]) / 2.0;
-        for (ax, name) in AXES.iter().enumerate() {
-            if let Some(Parameter::Estimate { u, .. }) =
-                out.params.get_mut(&format!("gyro.bias.{name}"))
-            {
-                *u = (*u * *u + q2[ax] * half_run).sqrt();
+            let block = sel.gyro_bias.and_then(|i| data.get(&i));
+            if let Some((ix, axes)) = &sel.gyro_scale {
+                let segs = get(ix);
+                let mut scratch = Out::default();
+                let first = match block {
+                    // A first bias for the scale fit: the block mean of output minus reference.
+                    Some(b) => fallback_bias(&[b]),
+                    None => fallback_bias(&segs),
+                };
+                let s = gyro::fit_scale(&segs, axes, first, &mut scratch);
+                let b = match block {
+                    Some(b) => gyro::fit_bias(b, &s, &mut out),
+                    None => {
+                        out.warnings.push(
+                            "no static block for the gyro bias: bias taken from the rate points"
+                                .into(),
+                        );
+                        first
+                    }
+                };
+                gyro::fit_scale(&segs, axes, b, &mut out);
+            } else if let Some(b) = block {
+                let (bias, _) = gyro::fit_bias(b, &Vec3::zeros(), &mut out);
+                out.gyro_model = Some((Mat3::identity(), bias));
             }
-        }
-    }
-    if let Some(ix) = &sel.gyro_full {
-        gyro::fit_full(&get(ix), &mut out);
-    }
-    let allan = sel
-        .allan
-        .and_then(|i| data.get(&i))
-        .and_then(|b| allan::analyse(b, &mut out));
+            // The bias wanders: as a constant of the IMU over this run, its uncertainty holds the
+            // random walk over half the run, at the rate the segment means show.
+            if let (Some(_), Some(model)) = (block, &out.gyro_model) {
+                let all: Vec<&SegData> = data.values().collect();
+                let q2 = gyro::wander_q2(&all, model);
+                let half_run = (rec.imu.t[rec.imu.t.len() - 1] - rec.imu.t[0]) / 2.0;
+                for (ax, name) in AXES.iter().enumerate() {
+                    if let Some(Parameter::Estimate { u, .. }) =
+                        out.params.get_mut(&format!("gyro.bias.{name}"))
+                    {
+                        *u = (*u * *u + q2[ax] * half_run).sqrt();
+                    }
+                }
+            }
+            if let Some(ix) = &sel.gyro_full {
+                gyro::fit_full(&get(ix), &mut out);
+            }
+        },
+    );
+    let allan = allan_block
+        .zip(curves.as_ref())
+        .and_then(|(b, c)| allan::analyse(b, c, &mut out));
     let static_segs: Vec<&SegData> = get(&sel.temp_segments);
     let temp_done = match (&out.accel_model, &out.gyro_model) {
         (Some(a), Some(g)) if !static_segs.is_empty() => {

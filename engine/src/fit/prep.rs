@@ -98,11 +98,127 @@ pub(crate) fn prepare(
     let gyro: [Vec<f64>; 3] =
         std::array::from_fn(|k| imu.gyro[a..b].iter().map(|v| v[k]).collect());
     let temp = imu.temp.as_ref().map(|tc| tc[a..b].to_vec());
+    // The references of a long segment are computed in two halves side by side.
+    let refs = if n >= PARALLEL_MIN {
+        let (lo, hi) = t.split_at(n / 2);
+        let (mut a, b) = rayon::join(
+            || references(rec, seg.kind, geo, lo),
+            || references(rec, seg.kind, geo, hi),
+        );
+        a.append(b);
+        a
+    } else {
+        references(rec, seg.kind, geo, &t)
+    };
+    sync.max_gap_s = sync.max_gap_s.max(refs.sync.max_gap_s);
+    sync.max_sync_error_s = sync.max_sync_error_s.max(refs.sync.max_sync_error_s);
+    sync.max_angle_error_deg = sync.max_angle_error_deg.max(refs.sync.max_angle_error_deg);
+    let (so, si) = refs.angle_sums;
+    let (f_ref, w_ref) = (refs.f_ref, refs.w_ref);
+    let mut d = SegData {
+        id: seg.id.clone(),
+        kind: seg.kind,
+        t,
+        accel,
+        gyro,
+        temp,
+        f_ref,
+        w_ref,
+        keep_a: vec![true; n],
+        keep_g: vec![true; n],
+        mean_angles_deg: (so / n as f64, si / n as f64),
+    };
+    if let Some(rule) = opts.outliers {
+        // Each sensor's three channels in turn (a sample removed on one axis is out of
+        // the next axis's statistics); the two sensors side by side.
+        let chain = |out: &[Vec<f64>; 3], refs: &[Vec<f64>; 3], keep: &mut Vec<bool>| {
+            for k in 0..3 {
+                let r: Vec<f64> = out[k].iter().zip(&refs[k]).map(|(o, r)| o - r).collect();
+                flag_outliers(&r, rule, keep);
+            }
+        };
+        let (mut keep_a, mut keep_g) =
+            (std::mem::take(&mut d.keep_a), std::mem::take(&mut d.keep_g));
+        rayon::join(
+            || chain(&d.accel, &d.f_ref, &mut keep_a),
+            || chain(&d.gyro, &d.w_ref, &mut keep_g),
+        );
+        (d.keep_a, d.keep_g) = (keep_a, keep_g);
+    }
+    if let Some((order, cutoff)) = opts.lowpass {
+        let fs = 1.0 / super::stats::median_step(&d.t);
+        if cutoff >= fs / 2.0 {
+            warnings.push(format!(
+                "segment {}: low-pass cutoff {cutoff} Hz is at or above the Nyquist frequency ({:.1} Hz); not filtered",
+                d.id,
+                fs / 2.0
+            ));
+        } else if let Some(sos) = butter(order, cutoff, fs) {
+            use rayon::prelude::*;
+            // Outliers are replaced by interpolation before filtering, and stay excluded.
+            let (keep_a, keep_g) = (&d.keep_a, &d.keep_g);
+            d.accel
+                .par_iter_mut()
+                .map(|x| (x, keep_a))
+                .chain(d.gyro.par_iter_mut().map(|x| (x, keep_g)))
+                .for_each(|(x, keep)| {
+                    fill_removed(x, keep);
+                    *x = filtfilt(&sos, x);
+                });
+        } else {
+            warnings.push(format!("segment {}: Butterworth order {order} at {cutoff} Hz could not be designed; not filtered", d.id));
+        }
+    }
+    d
+}
+
+/// Segments at least this long are split over threads.
+const PARALLEL_MIN: usize = 20_000;
+
+/// References for a run of IMU stamps, with what the synchronisation saw.
+struct Refs {
+    f_ref: [Vec<f64>; 3],
+    w_ref: [Vec<f64>; 3],
+    sync: SyncReport,
+    /// Sums of the interpolated feedback angles (outer, inner), deg.
+    angle_sums: (f64, f64),
+}
+
+impl Refs {
+    fn append(&mut self, o: Refs) {
+        for k in 0..3 {
+            self.f_ref[k].extend(&o.f_ref[k]);
+            self.w_ref[k].extend(&o.w_ref[k]);
+        }
+        self.sync.max_gap_s = self.sync.max_gap_s.max(o.sync.max_gap_s);
+        self.sync.max_sync_error_s = self.sync.max_sync_error_s.max(o.sync.max_sync_error_s);
+        self.sync.max_angle_error_deg = self
+            .sync
+            .max_angle_error_deg
+            .max(o.sync.max_angle_error_deg);
+        self.angle_sums.0 += o.angle_sums.0;
+        self.angle_sums.1 += o.angle_sums.1;
+    }
+}
+
+/// Table feedback interpolated onto the stamps `t`, and the references through the
+/// kinematics of ratecal_physics.
+fn references(rec: &Recording, kind: SegmentKind, geo: &Geometry, t: &[f64]) -> Refs {
+    let n = t.len();
     let site: Site = rec.manifest.station.site;
+    let mut sync = SyncReport::default();
     let mut f_ref: [Vec<f64>; 3] = std::array::from_fn(|_| Vec::with_capacity(n));
     let mut w_ref: [Vec<f64>; 3] = std::array::from_fn(|_| Vec::with_capacity(n));
     let (mut so, mut si) = (0.0, 0.0);
     let tab = &rec.table;
+    if n == 0 {
+        return Refs {
+            f_ref,
+            w_ref,
+            sync,
+            angle_sums: (so, si),
+        };
+    }
     let mut j = tab.t.partition_point(|&x| x <= t[0]).saturating_sub(1);
     // Table state at feedback sample `j` plus a fraction `w` of the step to `j + 1`,
     // through the kinematics of ratecal_physics: (specific force m/s^2, rate deg/s).
@@ -122,17 +238,15 @@ pub(crate) fn prepare(
                 accel: rate_derivative(&tab.t, &tab.inner_rate, j) * DEG,
             },
         };
-        (
-            state.f_b(geo, &site, &Vec3::zeros()),
-            state.w_ib(geo, &site) / DEG,
-        )
+        let snap = state.snapshot(geo, &site);
+        (snap.f_b(&Vec3::zeros()), snap.w_ib() / DEG)
     };
     let mut cache = (
         usize::MAX,
         (Vec3::zeros(), Vec3::zeros()),
         (Vec3::zeros(), Vec3::zeros()),
     );
-    for &ti in &t {
+    for &ti in t {
         while j + 2 < tab.t.len() && tab.t[j + 1] <= ti {
             j += 1;
         }
@@ -149,7 +263,7 @@ pub(crate) fn prepare(
         sync.max_angle_error_deg = sync.max_angle_error_deg.max(gap * gap / 8.0 * max_acc);
         so += tab.outer[j] + w * unwrap(tab.outer[j + 1] - tab.outer[j]);
         si += tab.inner[j] + w * unwrap(tab.inner[j + 1] - tab.inner[j]);
-        let (f, wi) = if seg.kind == SegmentKind::Static {
+        let (f, wi) = if kind == SegmentKind::Static {
             // At rest the references hardly change between two feedback samples: evaluate
             // the kinematics on the feedback samples and interpolate (half the work of
             // evaluating it at every IMU stamp, same answer to well below the noise).
@@ -172,48 +286,12 @@ pub(crate) fn prepare(
             w_ref[k].push(wi[k]);
         }
     }
-    let mut d = SegData {
-        id: seg.id.clone(),
-        kind: seg.kind,
-        t,
-        accel,
-        gyro,
-        temp,
+    Refs {
         f_ref,
         w_ref,
-        keep_a: vec![true; n],
-        keep_g: vec![true; n],
-        mean_angles_deg: (so / n as f64, si / n as f64),
-    };
-    if let Some(rule) = opts.outliers {
-        for k in 0..3 {
-            let ra: Vec<f64> = (0..n).map(|i| d.accel[k][i] - d.f_ref[k][i]).collect();
-            flag_outliers(&ra, rule, &mut d.keep_a);
-            let rg: Vec<f64> = (0..n).map(|i| d.gyro[k][i] - d.w_ref[k][i]).collect();
-            flag_outliers(&rg, rule, &mut d.keep_g);
-        }
+        sync,
+        angle_sums: (so, si),
     }
-    if let Some((order, cutoff)) = opts.lowpass {
-        let fs = 1.0 / super::stats::median_step(&d.t);
-        if cutoff >= fs / 2.0 {
-            warnings.push(format!(
-                "segment {}: low-pass cutoff {cutoff} Hz is at or above the Nyquist frequency ({:.1} Hz); not filtered",
-                d.id,
-                fs / 2.0
-            ));
-        } else if let Some(sos) = butter(order, cutoff, fs) {
-            for k in 0..3 {
-                // Outliers are replaced by interpolation before filtering, and stay excluded.
-                fill_removed(&mut d.accel[k], &d.keep_a);
-                fill_removed(&mut d.gyro[k], &d.keep_g);
-                d.accel[k] = filtfilt(&sos, &d.accel[k]);
-                d.gyro[k] = filtfilt(&sos, &d.gyro[k]);
-            }
-        } else {
-            warnings.push(format!("segment {}: Butterworth order {order} at {cutoff} Hz could not be designed; not filtered", d.id));
-        }
-    }
-    d
 }
 
 /// Shortest signed angle step, deg (feedback may wrap at 360).

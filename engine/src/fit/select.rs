@@ -5,7 +5,7 @@ use super::prep::{PrepOptions, SegData};
 use crate::plan::{FitModel, Plan, segment_matches};
 use crate::recording::{Recording, SegmentKind};
 use crate::results::{AmbientStats, EnvironmentInfo, ModelInfo, RecordingInfo, SegmentUse};
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 
 /// The analysis plan for one recording.
 #[derive(Debug, Default, Clone)]
@@ -50,7 +50,7 @@ impl Selection {
     }
 
     /// The segment table of the results.
-    pub(crate) fn uses(&self, rec: &Recording, data: &HashMap<usize, SegData>) -> Vec<SegmentUse> {
+    pub(crate) fn uses(&self, rec: &Recording, data: &BTreeMap<usize, SegData>) -> Vec<SegmentUse> {
         rec.manifest
             .segments
             .iter()
