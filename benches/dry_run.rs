@@ -59,7 +59,7 @@ fn manifest(st: &Station) -> Manifest {
 /// One dry run; returns the simulated duration, s.
 fn dry_run(plan: &Plan, st: &Station, dir: &std::path::Path) -> f64 {
     let rt = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
+        .enable_time()
         .start_paused(true)
         .build()
         .unwrap();

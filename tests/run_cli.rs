@@ -237,3 +237,61 @@ fn standard_procedure_dry_run_passes() {
     );
     assert!(tmp.path().join("std/results.json").exists());
 }
+
+/// Ctrl-C (SIGINT) in the middle of a dry run: the run stops on the abort path, exit 4,
+/// and the recording holds every sample up to the stop, readable as it is.
+#[test]
+fn ctrl_c_aborts_with_4_and_keeps_the_recording() {
+    if Command::new("kill").arg("-l").output().is_err() {
+        println!("skipped: no kill program");
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let proc_dir = concat!(env!("CARGO_MANIFEST_DIR"), "/procedures/imu-2d-standard");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_ratecal"))
+        .args(["run", proc_dir, "--dry-run", "--out", "cut"])
+        .current_dir(tmp.path())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let imu = tmp.path().join("cut/imu.csv");
+    let t0 = std::time::Instant::now();
+    // Wait for the first rows on disk (the run is under way), then interrupt.
+    while std::fs::metadata(&imu).map_or(0, |m| m.len()) < 10_000 {
+        assert!(t0.elapsed().as_secs() < 60, "the run never started writing");
+        if child.try_wait().unwrap().is_some() {
+            println!("skipped: the dry run ended before it could be interrupted");
+            return;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let out = child.wait_with_output().unwrap();
+    let m = manifest(&tmp.path().join("cut"));
+    let run = m.run.as_ref().unwrap();
+    if out.status.code() == Some(0) {
+        // Finished between the check and the signal: nothing to interrupt any more.
+        println!("skipped: the dry run completed before the signal arrived");
+        return;
+    }
+    assert_eq!(out.status.code(), Some(4), "{}", text(&out));
+    assert_eq!(run.status, "aborted");
+    assert!(
+        run.abort.as_ref().unwrap().rule.contains("Ctrl-C"),
+        "{:?}",
+        run.abort
+    );
+    let rec = ratecal_engine::recording::read(&tmp.path().join("cut")).unwrap();
+    // Every sample up to the stop is on disk: the IMU stream reaches the abort time.
+    let t_abort = run.abort.as_ref().unwrap().t;
+    let last = rec.imu.t[rec.imu.t.len() - 1];
+    assert!(
+        last >= t_abort - 0.1,
+        "imu ends at {last} s, abort at {t_abort} s"
+    );
+}

@@ -81,9 +81,21 @@ fn run(args: Args) -> Result<ExitCode, Report> {
     opts.cancel = Some(cancel.clone());
     let mut bar = progress::Bar::new(plan.estimated_duration_s, simulated);
 
-    // A simulated station runs on the paused (virtual) clock; hardware in real time.
+    // Ctrl-C (and SIGTERM) take the abort path: the table is brought to a safe stop and
+    // every sample so far is kept. The handler is a thread of its own, so that a simulated
+    // run needs no IO driver.
+    let flag = cancel.clone();
+    if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)) {
+        eprintln!("warning: Ctrl-C will not stop the run cleanly: {e}");
+    }
+    // A simulated station runs on the paused (virtual) clock with only the timer (each
+    // control tick would otherwise poll the IO driver); hardware in real time with IO.
     let mut builder = tokio::runtime::Builder::new_current_thread();
-    builder.enable_all().start_paused(simulated);
+    if simulated {
+        builder.enable_time().start_paused(true);
+    } else {
+        builder.enable_all();
+    }
     let rt = builder
         .build()
         .map_err(|e| miette::miette!("cannot start the runtime: {e}"))?;
@@ -92,11 +104,6 @@ fn run(args: Args) -> Result<ExitCode, Report> {
         // Built inside the runtime: the simulator's clock starts on the (paused) run clock.
         let (mut table, mut imu) = ratecal_drivers::build(&station, seed)
             .map_err(|e| miette::miette!("cannot start the station: {e}"))?;
-        tokio::spawn(async move {
-            if tokio::signal::ctrl_c().await.is_ok() {
-                cancel.store(true, Ordering::Relaxed);
-            }
-        });
         Ok::<_, Report>(
             execute(
                 &plan,

@@ -26,7 +26,12 @@ enum Msg {
 }
 
 /// Batches in flight before `write_*` waits: bounds memory if the disk is slow.
-const QUEUE: usize = 256;
+const QUEUE: usize = 64;
+
+/// Rows gathered before they go to the writer thread (fewer wake-ups than one message per
+/// control tick); every checkpoint, `finish` and drop sends what is gathered.
+const BATCH_IMU: usize = 512;
+const BATCH_TABLE: usize = 64;
 
 /// Writes a recording folder incrementally. Sample times handed in are already on the
 /// recording's clock (0 at the start of the run). Samples the format cannot hold are
@@ -42,6 +47,8 @@ pub struct RecordingWriter {
     journal: File,
     columns: Columns,
     manifest: Manifest,
+    pending_imu: Vec<ImuSample>,
+    pending_table: Vec<TableSample>,
 }
 
 fn writer_thread(mut st: Streams, rx: mpsc::Receiver<Msg>) -> u64 {
@@ -99,6 +106,8 @@ impl RecordingWriter {
             journal,
             columns,
             manifest,
+            pending_imu: Vec::with_capacity(BATCH_IMU),
+            pending_table: Vec::with_capacity(BATCH_TABLE),
         })
     }
 
@@ -199,23 +208,39 @@ impl RecordingWriter {
 
     /// Appends IMU samples (times on the recording clock).
     pub fn write_imu(&mut self, samples: &[ImuSample]) -> io::Result<()> {
-        if samples.is_empty() {
-            return Ok(());
+        self.pending_imu.extend_from_slice(samples);
+        if self.pending_imu.len() >= BATCH_IMU {
+            self.send_pending()?;
         }
-        self.send(Msg::Imu(samples.to_vec()))
+        Ok(())
     }
 
     /// Appends table feedback samples (times on the recording clock).
     pub fn write_table(&mut self, samples: &[TableSample]) -> io::Result<()> {
-        if samples.is_empty() {
-            return Ok(());
+        self.pending_table.extend_from_slice(samples);
+        if self.pending_table.len() >= BATCH_TABLE {
+            self.send_pending()?;
         }
-        self.send(Msg::Table(samples.to_vec()))
+        Ok(())
+    }
+
+    /// Hands the gathered rows to the writer thread.
+    fn send_pending(&mut self) -> io::Result<()> {
+        if !self.pending_imu.is_empty() {
+            let v = std::mem::replace(&mut self.pending_imu, Vec::with_capacity(BATCH_IMU));
+            self.send(Msg::Imu(v))?;
+        }
+        if !self.pending_table.is_empty() {
+            let v = std::mem::replace(&mut self.pending_table, Vec::with_capacity(BATCH_TABLE));
+            self.send(Msg::Table(v))?;
+        }
+        Ok(())
     }
 
     /// Samples dropped because the format could not hold them; closes the streams (call
     /// after [`RecordingWriter::finish`]).
     pub fn close(mut self) -> u64 {
+        let _ = self.send_pending();
         self.tx = None;
         self.thread.take().and_then(|t| t.join().ok()).unwrap_or(0)
     }
@@ -232,6 +257,7 @@ impl RecordingWriter {
     /// Flushes both streams to the OS and rewrites the manifest atomically
     /// (`manifest.yaml.tmp` then rename).
     pub fn checkpoint(&mut self) -> io::Result<()> {
+        self.send_pending()?;
         let (tx, rx) = mpsc::channel();
         self.send(Msg::Sync(tx))?;
         rx.recv().map_err(|_| gone())??;
@@ -245,6 +271,7 @@ impl RecordingWriter {
     /// sets `run.ended`, and writes the final manifest.
     pub fn finish(&mut self) -> io::Result<()> {
         self.journal.flush()?;
+        self.send_pending()?;
         let (tx, rx) = mpsc::channel();
         self.send(Msg::Hashes(tx))?;
         let (imu, table) = rx.recv().map_err(|_| gone())??;
@@ -260,6 +287,7 @@ impl RecordingWriter {
 impl Drop for RecordingWriter {
     fn drop(&mut self) {
         // Lets the writer thread drain what it holds and close the files.
+        let _ = self.send_pending();
         self.tx = None;
         if let Some(t) = self.thread.take() {
             let _ = t.join();

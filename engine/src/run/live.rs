@@ -109,10 +109,44 @@ impl Drift {
     }
 }
 
+/// IMU signals are watched as means over blocks of this length, s: a 10 Hz reading, like
+/// an operator's display, so that a fluctuation limit means the same whatever the IMU's
+/// sample rate (raw peak-to-peak of white noise grows with the bandwidth).
+pub(crate) const IMU_BLOCK_S: f64 = 0.1;
+
+/// One block of IMU samples: sums per channel (a NaN sample makes the mean NaN).
+#[derive(Debug, Clone, Copy)]
+struct Block {
+    index: i64,
+    first_t: f64,
+    last_t: f64,
+    n: u32,
+    sum: [f64; 7],
+}
+
+impl Block {
+    fn new(index: i64, row: &ImuRow) -> Self {
+        Block {
+            index,
+            first_t: row.t,
+            last_t: row.t,
+            n: 1,
+            sum: row.v,
+        }
+    }
+
+    fn mean(&self, k: usize) -> f64 {
+        self.sum[k] / f64::from(self.n)
+    }
+}
+
 /// Recent samples of both streams.
 #[derive(Debug)]
 pub(crate) struct Live {
-    imu: VecDeque<ImuRow>,
+    /// Completed IMU blocks, oldest first.
+    imu: VecDeque<Block>,
+    /// The block being filled.
+    current: Option<Block>,
     table: VecDeque<TableRow>,
     keep_s: f64,
     drift: Drift,
@@ -123,6 +157,7 @@ impl Live {
     pub fn new(longest_window_s: f64) -> Self {
         Live {
             imu: VecDeque::new(),
+            current: None,
             table: VecDeque::new(),
             keep_s: longest_window_s + 2.0,
             drift: Drift::default(),
@@ -130,7 +165,23 @@ impl Live {
     }
 
     pub fn push_imu(&mut self, row: ImuRow) {
-        self.imu.push_back(row);
+        // Blocks are aligned on the stream clock; the small offset keeps a stamp that is a
+        // multiple of the block length (0.30000000000000004) in its own block.
+        let index = ((row.t + 1e-9) / IMU_BLOCK_S).floor() as i64;
+        match &mut self.current {
+            Some(b) if b.index == index => {
+                b.n += 1;
+                b.last_t = row.t;
+                for (s, v) in b.sum.iter_mut().zip(row.v) {
+                    *s += v;
+                }
+            }
+            cur => {
+                if let Some(done) = cur.replace(Block::new(index, &row)) {
+                    self.imu.push_back(done);
+                }
+            }
+        }
     }
 
     /// Adds a table row, filling in the ambient drift estimate; returns the row as stored.
@@ -143,7 +194,7 @@ impl Live {
     /// Drops what is older than the window.
     pub fn trim(&mut self, now: f64) {
         let cut = now - self.keep_s;
-        while self.imu.front().is_some_and(|r| r.t < cut) {
+        while self.imu.front().is_some_and(|b| b.first_t < cut) {
             self.imu.pop_front();
         }
         while self.table.front().is_some_and(|r| r.t < cut) {
@@ -157,7 +208,8 @@ impl Live {
     }
 
     /// Peak-to-peak per channel of a signal over `[from, to]`, `None` with fewer than two
-    /// samples; a NaN sample makes the channel's value NaN (never stable).
+    /// samples; a NaN sample makes the channel's value NaN (never stable). IMU signals are
+    /// taken as the means of the completed `IMU_BLOCK_S` blocks inside the window.
     pub fn peak_to_peak(&self, signal: Signal, from: f64, to: f64) -> Option<Vec<f64>> {
         let (src, ch) = channels(signal);
         let mut lo = vec![f64::INFINITY; ch.len()];
@@ -179,9 +231,9 @@ impl Live {
                 .imu
                 .iter()
                 .rev()
-                .skip_while(|r| r.t > to)
-                .take_while(|r| r.t >= from)
-                .for_each(|r| visit(&r.v)),
+                .skip_while(|b| b.last_t > to)
+                .take_while(|b| b.first_t >= from)
+                .for_each(|b| visit(&std::array::from_fn::<f64, 7, _>(|k| b.mean(k)))),
             Source::Table => self
                 .table
                 .iter()
@@ -271,5 +323,47 @@ mod tests {
         let p = l.peak_to_peak(Signal::Accel, 3.0, 9.9).unwrap();
         assert_eq!(p, vec![0.0, 0.0, 0.0]);
         assert!(l.peak_to_peak(Signal::ImuTemperature, 3.0, 9.9).unwrap()[0].is_nan());
+    }
+
+    /// White noise of one density read at 100 Hz and at 1 kHz: the raw peak-to-peak grows
+    /// about sqrt(10) = 3.2 times, the watched fluctuation (0.1 s means) stays the same.
+    #[test]
+    fn fluctuation_does_not_depend_on_the_sample_rate() {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand::rngs::ChaCha8Rng::seed_from_u64(7);
+        let density = 2e-5; // per sqrt(Hz)
+        let mut reading = |fs: f64| {
+            let sigma = density * (fs / 2.0).sqrt();
+            let mut l = Live::new(5.0);
+            let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+            let n = (10.0 * fs) as usize;
+            for k in 0..n {
+                let x: f64 = sigma * rng.sample::<f64, _>(rand_distr::StandardNormal);
+                let t = k as f64 / fs;
+                if t >= 4.0 {
+                    (lo, hi) = (lo.min(x), hi.max(x));
+                }
+                l.push_imu(ImuRow {
+                    t,
+                    v: [x, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+                });
+            }
+            let p = l.peak_to_peak(Signal::Accel, 4.0, 9.95).unwrap()[0];
+            (p, hi - lo)
+        };
+        // Averaged over repeats: a single peak-to-peak is itself a noisy number.
+        let (mut w100, mut w1k, mut r100, mut r1k) = (0.0, 0.0, 0.0, 0.0);
+        for _ in 0..20 {
+            let (p, r) = reading(100.0);
+            (w100, r100) = (w100 + p, r100 + r);
+            let (p, r) = reading(1000.0);
+            (w1k, r1k) = (w1k + p, r1k + r);
+        }
+        assert!(r1k / r100 > 2.5, "raw ratio {}", r1k / r100);
+        assert!(
+            (w1k / w100 - 1.0).abs() < 0.25,
+            "watched ratio {}",
+            w1k / w100
+        );
     }
 }
