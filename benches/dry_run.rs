@@ -45,6 +45,7 @@ fn manifest(st: &Station) -> Manifest {
             table: TableAxes {
                 outer_axis: [0.0, -1.0, 0.0],
                 inner_axis: [1.0, 0.0, 0.0],
+                model: None,
             },
             mount: None,
         },

@@ -18,6 +18,7 @@ fn manifest(files: &[(&str, &str)]) -> Manifest {
             table: TableAxes {
                 outer_axis: [0.0, -1.0, 0.0],
                 inner_axis: [1.0, 0.0, 0.0],
+                model: None,
             },
             mount: None,
         },

@@ -57,12 +57,15 @@ pub struct ManifestStation {
 }
 
 /// Outer and inner axis unit vectors (lab frame, ENU).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TableAxes {
     /// `a_o`.
     pub outer_axis: [f64; 3],
     /// `a_i` at outer angle 0.
     pub inner_axis: [f64; 3],
+    /// The table's make and model (free-form; the spec ignores unknown keys).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model: Option<String>,
 }
 
 /// `mount: { rotation: [[...],[...],[...]] }`: `C_PB` row-major.

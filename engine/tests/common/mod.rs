@@ -329,6 +329,7 @@ pub fn manifest(name: &str) -> Manifest {
             table: TableAxes {
                 outer_axis: [0.0, -1.0, 0.0],
                 inner_axis: [1.0, 0.0, 0.0],
+                model: None,
             },
             mount: None,
         },

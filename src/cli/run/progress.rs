@@ -8,6 +8,8 @@ use std::io::IsTerminal;
 pub struct Bar {
     bar: Option<ProgressBar>,
     simulated: bool,
+    /// Last whole second shown (the bar moves once a second of run time, not every tick).
+    shown: Option<u64>,
 }
 
 impl Bar {
@@ -24,7 +26,11 @@ impl Bar {
             b.set_style(style);
             b
         });
-        Bar { bar, simulated }
+        Bar {
+            bar,
+            simulated,
+            shown: None,
+        }
     }
 
     /// Removes the bar.
@@ -43,6 +49,10 @@ impl Progress for Bar {
     }
 
     fn time(&mut self, t_s: f64) {
+        if self.shown == Some(t_s as u64) {
+            return;
+        }
+        self.shown = Some(t_s as u64);
         if let Some(b) = &self.bar {
             b.set_position(t_s as u64);
             let total = b.length().unwrap_or(0);

@@ -111,6 +111,7 @@ pub fn manifest(st: &LoadedStation, proc_: &LoadedProcedure, facts: &RunFacts) -
             table: TableAxes {
                 outer_axis: [g.outer_axis[0], g.outer_axis[1], g.outer_axis[2]],
                 inner_axis: [g.inner_axis[0], g.inner_axis[1], g.inner_axis[2]],
+                model: Some(info.table_model.clone()),
             },
             mount: Some(Mount { rotation }),
         },
