@@ -72,3 +72,50 @@ fn input_and_usage_errors() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("manifest.yaml"));
     assert_eq!(analyze(&[]).status.code(), Some(2));
 }
+
+/// A threshold the recording cannot meet: results are still written, the check says
+/// fail, the exit code is 3; the procedure is identified by its canonical hash.
+#[test]
+fn failed_check_exits_three_and_names_the_procedure_hash() {
+    let Some(ex) = example() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let std_text = std::fs::read_to_string("procedures/imu-2d-standard/1.0.0.rcal").unwrap();
+    let strict = std_text.replace(
+        "accept gyro.residual.std <= 0.1 deg/s",
+        "accept gyro.residual.std <= 0.000001 deg/s",
+    );
+    assert_ne!(strict, std_text, "the standard procedure's limit moved");
+    let proc_file = tmp.path().join("strict.rcal");
+    std::fs::write(&proc_file, &strict).unwrap();
+    let out = tmp.path().join("results.json");
+    let o = analyze(&[
+        ex.to_str().unwrap(),
+        "--procedure",
+        proc_file.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(3),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out).unwrap()).unwrap();
+    let fails: Vec<_> = v["acceptance"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|a| a["verdict"] == "fail")
+        .collect();
+    assert_eq!(fails.len(), 1, "{fails:?}");
+    assert!(
+        fails[0]["name"]
+            .as_str()
+            .unwrap()
+            .contains("gyro.residual.std")
+    );
+    let want = ratecal_grammar::canonical(&strict).unwrap().sha256;
+    assert_eq!(v["model"]["procedure"]["sha256"], want.as_str());
+}

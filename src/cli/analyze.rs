@@ -32,8 +32,9 @@ pub struct Args {
 
 /// Runs the subcommand.
 pub fn main(args: Args) -> ExitCode {
-    let plan = match args.procedure.as_deref().map(load_plan).transpose() {
-        Ok(p) => p,
+    let (plan, sha256) = match args.procedure.as_deref().map(load_plan).transpose() {
+        Ok(Some((p, h))) => (Some(p), h),
+        Ok(None) => (None, None),
         Err(()) => return ExitCode::from(1),
     };
     let mut runs = Vec::with_capacity(args.runs.len());
@@ -47,7 +48,11 @@ pub fn main(args: Args) -> ExitCode {
         }
     }
     let plan = plan.or_else(|| default_plan(&runs[0].1));
-    let results = fit::analyze_runs(&runs, plan.as_ref(), &Options::default());
+    let mut results = fit::analyze_runs(&runs, plan.as_ref(), &Options::default());
+    // The procedure given on the command line is identified by its own canonical hash.
+    if let (Some(h), Some(p)) = (sha256, results.model.procedure.as_mut()) {
+        p.sha256 = h;
+    }
     let json = results.to_json();
     match &args.out {
         Some(path) => {
@@ -66,13 +71,15 @@ pub fn main(args: Args) -> ExitCode {
     }
 }
 
-/// Loads and checks the procedure (a file, a folder's newest version, `folder@version`);
-/// a checked plan serialized as JSON is accepted too. Diagnostics go to standard error.
-fn load_plan(arg: &std::path::Path) -> Result<Plan, ()> {
+/// Loads and checks the procedure (a file, a folder's newest version, `folder@version`)
+/// with the SHA-256 of its canonical text; a checked plan serialized as JSON is accepted
+/// too (no hash then). Diagnostics go to standard error.
+fn load_plan(arg: &std::path::Path) -> Result<(Plan, Option<String>), ()> {
     if arg.extension().is_some_and(|e| e == "json") {
         let text = std::fs::read_to_string(arg)
             .map_err(|e| eprintln!("error: cannot read {}: {e}", arg.display()))?;
         return serde_json::from_str(&text)
+            .map(|p| (p, None))
             .map_err(|e| eprintln!("error: {}: not a checked plan: {e}", arg.display()));
     }
     let file = procedure::read(&arg.display().to_string()).map_err(|d| procedure::report(&d))?;
@@ -84,7 +91,10 @@ fn load_plan(arg: &std::path::Path) -> Result<Plan, ()> {
     ) {
         Ok(checked) => {
             checked.warnings.iter().for_each(procedure::report);
-            Ok(checked.plan)
+            let sha256 = ratecal_grammar::canonical(&file.text)
+                .ok()
+                .map(|c| c.sha256);
+            Ok((checked.plan, sha256))
         }
         Err(diags) => {
             diags.iter().for_each(procedure::report);

@@ -102,10 +102,18 @@ pub(crate) fn select(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Se
     match plan.filter(|p| !p.fits.is_empty()) {
         Some(plan) => {
             sel.model.selection = "procedure".into();
+            // The recording names the procedure it ran, with its hash: the same one here.
+            let sha256 = rec
+                .manifest
+                .procedure
+                .as_ref()
+                .filter(|p| p.name == plan.name && p.version == plan.version)
+                .map(|p| p.sha256.clone())
+                .unwrap_or_default();
             sel.model.procedure = Some(crate::recording::ProcedureRef {
                 name: plan.name.clone(),
                 version: plan.version.clone(),
-                sha256: String::new(),
+                sha256,
             });
             for f in &plan.fits {
                 let ix: Vec<usize> = (0..segs.len())
