@@ -8,7 +8,12 @@ use crate::results::{AllanCurve, Parameter};
 /// Overlapping Allan deviation of `y` sampled every `dt`, at octave cluster sizes
 /// `m = 1, 2, 4, ...` up to a quarter of the series: `(tau, adev, clusters)`.
 pub fn overlapping_adev(y: &[f64], dt: f64) -> Vec<(f64, f64, usize)> {
-    let n = y.len();
+    adev_of(y.iter().copied(), y.len(), dt)
+}
+
+/// The same over the `n` values of an iterator (no copy of the series is kept: only the
+/// integrated angle, which the estimator needs).
+fn adev_of(y: impl Iterator<Item = f64>, n: usize, dt: f64) -> Vec<(f64, f64, usize)> {
     let mut theta = Vec::with_capacity(n + 1);
     theta.push(0.0);
     let mut acc = 0.0;
@@ -16,6 +21,7 @@ pub fn overlapping_adev(y: &[f64], dt: f64) -> Vec<(f64, f64, usize)> {
         acc += v * dt;
         theta.push(acc);
     }
+    let n = theta.len() - 1;
     let mut out = Vec::new();
     let mut m = 1;
     while 4 * m <= n {
@@ -32,24 +38,22 @@ pub fn overlapping_adev(y: &[f64], dt: f64) -> Vec<(f64, f64, usize)> {
     out
 }
 
-/// The three gyro curves of the block (kept samples treated as contiguous), computed side
-/// by side: the costly part of the Allan analysis, free of `Out` so that it can run while
-/// the fits do.
+/// The three gyro curves of the block (kept samples treated as contiguous): the costly
+/// part of the Allan analysis, free of `Out` so that it can run while the fits do. One
+/// axis at a time, so that a long 1 kHz block holds one integrated series, not three.
 pub(crate) type Curves = Vec<Vec<(f64, f64, usize)>>;
 
 pub(crate) fn curves(block: &SegData) -> Curves {
-    use rayon::prelude::*;
     let dt = super::stats::median_step(&block.t);
+    let n = block.keep_g.iter().filter(|k| **k).count();
     (0..3)
-        .into_par_iter()
         .map(|ax| {
-            let y: Vec<f64> = block.gyro[ax]
+            let kept = block.gyro[ax]
                 .iter()
                 .zip(&block.keep_g)
                 .filter(|p| *p.1)
-                .map(|p| *p.0)
-                .collect();
-            overlapping_adev(&y, dt)
+                .map(|p| *p.0);
+            adev_of(kept, n, dt)
         })
         .collect()
 }

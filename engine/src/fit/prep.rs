@@ -99,22 +99,43 @@ pub(crate) fn prepare(
         std::array::from_fn(|k| imu.gyro[a..b].iter().map(|v| v[k]).collect());
     let temp = imu.temp.as_ref().map(|tc| tc[a..b].to_vec());
     // The references of a long segment are computed in two halves side by side.
-    let refs = if n >= PARALLEL_MIN {
-        let (lo, hi) = t.split_at(n / 2);
-        let (mut a, b) = rayon::join(
-            || references(rec, seg.kind, geo, lo),
-            || references(rec, seg.kind, geo, hi),
-        );
-        a.append(b);
-        a
-    } else {
-        references(rec, seg.kind, geo, &t)
+    let mut f_ref: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; n]);
+    let mut w_ref: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; n]);
+    let refs = {
+        let [f0, f1, f2] = &mut f_ref;
+        let [w0, w1, w2] = &mut w_ref;
+        if n >= PARALLEL_MIN {
+            // Each half fills its own part of the same arrays.
+            let h = n / 2;
+            let (f0, f0b) = f0.split_at_mut(h);
+            let (f1, f1b) = f1.split_at_mut(h);
+            let (f2, f2b) = f2.split_at_mut(h);
+            let (w0, w0b) = w0.split_at_mut(h);
+            let (w1, w1b) = w1.split_at_mut(h);
+            let (w2, w2b) = w2.split_at_mut(h);
+            let (mut a, b) = rayon::join(
+                || references(rec, seg.kind, geo, &t[..h], [f0, f1, f2], [w0, w1, w2]),
+                || {
+                    references(
+                        rec,
+                        seg.kind,
+                        geo,
+                        &t[h..],
+                        [f0b, f1b, f2b],
+                        [w0b, w1b, w2b],
+                    )
+                },
+            );
+            a.merge(&b);
+            a
+        } else {
+            references(rec, seg.kind, geo, &t, [f0, f1, f2], [w0, w1, w2])
+        }
     };
     sync.max_gap_s = sync.max_gap_s.max(refs.sync.max_gap_s);
     sync.max_sync_error_s = sync.max_sync_error_s.max(refs.sync.max_sync_error_s);
     sync.max_angle_error_deg = sync.max_angle_error_deg.max(refs.sync.max_angle_error_deg);
     let (so, si) = refs.angle_sums;
-    let (f_ref, w_ref) = (refs.f_ref, refs.w_ref);
     let mut d = SegData {
         id: seg.id.clone(),
         kind: seg.kind,
@@ -175,21 +196,15 @@ pub(crate) fn prepare(
 /// Segments at least this long are split over threads.
 const PARALLEL_MIN: usize = 20_000;
 
-/// References for a run of IMU stamps, with what the synchronisation saw.
+/// What the synchronisation of a run of IMU stamps saw.
 struct Refs {
-    f_ref: [Vec<f64>; 3],
-    w_ref: [Vec<f64>; 3],
     sync: SyncReport,
     /// Sums of the interpolated feedback angles (outer, inner), deg.
     angle_sums: (f64, f64),
 }
 
 impl Refs {
-    fn append(&mut self, o: Refs) {
-        for k in 0..3 {
-            self.f_ref[k].extend(&o.f_ref[k]);
-            self.w_ref[k].extend(&o.w_ref[k]);
-        }
+    fn merge(&mut self, o: &Refs) {
         self.sync.max_gap_s = self.sync.max_gap_s.max(o.sync.max_gap_s);
         self.sync.max_sync_error_s = self.sync.max_sync_error_s.max(o.sync.max_sync_error_s);
         self.sync.max_angle_error_deg = self
@@ -202,19 +217,21 @@ impl Refs {
 }
 
 /// Table feedback interpolated onto the stamps `t`, and the references through the
-/// kinematics of ratecal_physics.
-fn references(rec: &Recording, kind: SegmentKind, geo: &Geometry, t: &[f64]) -> Refs {
-    let n = t.len();
+/// kinematics of ratecal_physics, written into `f_ref` and `w_ref` (as long as `t`).
+fn references(
+    rec: &Recording,
+    kind: SegmentKind,
+    geo: &Geometry,
+    t: &[f64],
+    f_ref: [&mut [f64]; 3],
+    w_ref: [&mut [f64]; 3],
+) -> Refs {
     let site: Site = rec.manifest.station.site;
     let mut sync = SyncReport::default();
-    let mut f_ref: [Vec<f64>; 3] = std::array::from_fn(|_| Vec::with_capacity(n));
-    let mut w_ref: [Vec<f64>; 3] = std::array::from_fn(|_| Vec::with_capacity(n));
     let (mut so, mut si) = (0.0, 0.0);
     let tab = &rec.table;
-    if n == 0 {
+    if t.is_empty() {
         return Refs {
-            f_ref,
-            w_ref,
             sync,
             angle_sums: (so, si),
         };
@@ -246,7 +263,7 @@ fn references(rec: &Recording, kind: SegmentKind, geo: &Geometry, t: &[f64]) -> 
         (Vec3::zeros(), Vec3::zeros()),
         (Vec3::zeros(), Vec3::zeros()),
     );
-    for &ti in t {
+    for (i, &ti) in t.iter().enumerate() {
         while j + 2 < tab.t.len() && tab.t[j + 1] <= ti {
             j += 1;
         }
@@ -282,13 +299,11 @@ fn references(rec: &Recording, kind: SegmentKind, geo: &Geometry, t: &[f64]) -> 
             refs_at(j, w)
         };
         for k in 0..3 {
-            f_ref[k].push(f[k]);
-            w_ref[k].push(wi[k]);
+            f_ref[k][i] = f[k];
+            w_ref[k][i] = wi[k];
         }
     }
     Refs {
-        f_ref,
-        w_ref,
         sync,
         angle_sums: (so, si),
     }
