@@ -105,7 +105,7 @@ async fn standard_procedure_dry_run_is_fast_and_analysable() {
             .collect();
         assert!(idx.len() >= 999, "{} samples in {}", idx.len(), s.id);
         for (c, w) in want.iter().enumerate() {
-            let mean = idx.iter().map(|&k| rec.imu.accel[k][c]).sum::<f64>() / idx.len() as f64;
+            let mean = idx.iter().map(|&k| rec.imu.accel[c][k]).sum::<f64>() / idx.len() as f64;
             assert!(
                 (mean - w).abs() < 0.01 * g,
                 "{} axis {c}: {mean} vs {w}",

@@ -54,7 +54,7 @@ fn point(
     s: &SegData,
     sensor: &str,
     model: &(Mat3, Vec3),
-    o: &[Vec<f64>; 3],
+    o: &[std::borrow::Cow<[f64]>; 3],
     r: &[Vec<f64>; 3],
     keep: &[bool],
     unit: &str,

@@ -44,7 +44,7 @@ fn adev_of(y: impl Iterator<Item = f64>, n: usize, dt: f64) -> Vec<(f64, f64, us
 pub(crate) type Curves = Vec<Vec<(f64, f64, usize)>>;
 
 pub(crate) fn curves(block: &SegData) -> Curves {
-    let dt = super::stats::median_step(&block.t);
+    let dt = super::stats::median_step(block.t);
     let n = block.keep_g.iter().filter(|k| **k).count();
     (0..3)
         .map(|ax| {

@@ -81,7 +81,7 @@ pub(crate) fn residual_stats(
     keep: &[bool],
     unit: &str,
 ) -> ResidualStats {
-    let (mean, std, slope) = stats::mean_std_slope(&s.t, r, keep);
+    let (mean, std, slope) = stats::mean_std_slope(s.t, r, keep);
     ResidualStats {
         segment: s.id.clone(),
         sensor: sensor.into(),

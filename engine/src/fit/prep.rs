@@ -6,22 +6,24 @@ use crate::plan::Outliers;
 use crate::recording::{Recording, Segment, SegmentKind};
 use crate::results::SyncReport;
 use ratecal_physics::{AxisMotion, DEG, Geometry, Mat3, Site, TableState, Vec3};
+use std::borrow::Cow;
 
-/// One segment's IMU samples with their references, ready for the fits.
+/// One segment's IMU samples with their references, ready for the fits. The samples are
+/// the recording's own (borrowed); only a filtered channel is a copy.
 #[derive(Debug, Clone)]
-pub(crate) struct SegData {
+pub(crate) struct SegData<'a> {
     /// Segment id.
     pub id: String,
     /// Kind.
     pub kind: SegmentKind,
     /// IMU stamps.
-    pub t: Vec<f64>,
+    pub t: &'a [f64],
     /// Accelerometer outputs per axis, m/s^2 (filtered if asked).
-    pub accel: [Vec<f64>; 3],
+    pub accel: [Cow<'a, [f64]>; 3],
     /// Gyro outputs per axis, deg/s (filtered if asked).
-    pub gyro: [Vec<f64>; 3],
+    pub gyro: [Cow<'a, [f64]>; 3],
     /// IMU temperature, degC.
-    pub temp: Option<Vec<f64>>,
+    pub temp: Option<&'a [f64]>,
     /// Specific-force reference at the IMU reference point, body axes, m/s^2.
     pub f_ref: [Vec<f64>; 3],
     /// Inertial-rate reference (table motion and Earth rate), body axes, deg/s.
@@ -34,7 +36,7 @@ pub(crate) struct SegData {
     pub mean_angles_deg: (f64, f64),
 }
 
-impl SegData {
+impl SegData<'_> {
     /// Samples removed from either sensor.
     pub(crate) fn outliers(&self) -> usize {
         self.keep_a
@@ -80,24 +82,22 @@ pub(crate) fn geometries(rec: &Recording) -> Vec<Geometry> {
 }
 
 /// Builds a segment's data; `warnings` collects what could not be done as asked.
-pub(crate) fn prepare(
-    rec: &Recording,
+pub(crate) fn prepare<'a>(
+    rec: &'a Recording,
     seg: &Segment,
     geo: &Geometry,
     opts: PrepOptions,
     sync: &mut SyncReport,
     warnings: &mut Vec<String>,
-) -> SegData {
+) -> SegData<'a> {
     let imu = &rec.imu;
     let a = imu.t.partition_point(|&t| t < seg.t_start);
     let b = imu.t.partition_point(|&t| t <= seg.t_end);
-    let t = imu.t[a..b].to_vec();
+    let t = &imu.t[a..b];
     let n = t.len();
-    let accel: [Vec<f64>; 3] =
-        std::array::from_fn(|k| imu.accel[a..b].iter().map(|v| v[k]).collect());
-    let gyro: [Vec<f64>; 3] =
-        std::array::from_fn(|k| imu.gyro[a..b].iter().map(|v| v[k]).collect());
-    let temp = imu.temp.as_ref().map(|tc| tc[a..b].to_vec());
+    let accel = std::array::from_fn(|k| Cow::Borrowed(&imu.accel[k][a..b]));
+    let gyro = std::array::from_fn(|k| Cow::Borrowed(&imu.gyro[k][a..b]));
+    let temp = imu.temp.as_ref().map(|tc| &tc[a..b]);
     // The references of a long segment are computed in two halves side by side.
     let mut f_ref: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; n]);
     let mut w_ref: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; n]);
@@ -129,7 +129,7 @@ pub(crate) fn prepare(
             a.merge(&b);
             a
         } else {
-            references(rec, seg.kind, geo, &t, [f0, f1, f2], [w0, w1, w2])
+            references(rec, seg.kind, geo, t, [f0, f1, f2], [w0, w1, w2])
         }
     };
     sync.max_gap_s = sync.max_gap_s.max(refs.sync.max_gap_s);
@@ -152,9 +152,11 @@ pub(crate) fn prepare(
     if let Some(rule) = opts.outliers {
         // Each sensor's three channels in turn (a sample removed on one axis is out of
         // the next axis's statistics); the two sensors side by side.
-        let chain = |out: &[Vec<f64>; 3], refs: &[Vec<f64>; 3], keep: &mut Vec<bool>| {
+        let chain = |out: &[Cow<[f64]>; 3], refs: &[Vec<f64>; 3], keep: &mut Vec<bool>| {
+            let mut r = Vec::with_capacity(n);
             for k in 0..3 {
-                let r: Vec<f64> = out[k].iter().zip(&refs[k]).map(|(o, r)| o - r).collect();
+                r.clear();
+                r.extend(out[k].iter().zip(&refs[k]).map(|(o, r)| o - r));
                 flag_outliers(&r, rule, keep);
             }
         };
@@ -167,7 +169,7 @@ pub(crate) fn prepare(
         (d.keep_a, d.keep_g) = (keep_a, keep_g);
     }
     if let Some((order, cutoff)) = opts.lowpass {
-        let fs = 1.0 / super::stats::median_step(&d.t);
+        let fs = 1.0 / super::stats::median_step(d.t);
         if cutoff >= fs / 2.0 {
             warnings.push(format!(
                 "segment {}: low-pass cutoff {cutoff} Hz is at or above the Nyquist frequency ({:.1} Hz); not filtered",
@@ -183,8 +185,10 @@ pub(crate) fn prepare(
                 .map(|x| (x, keep_a))
                 .chain(d.gyro.par_iter_mut().map(|x| (x, keep_g)))
                 .for_each(|(x, keep)| {
-                    fill_removed(x, keep);
-                    *x = filtfilt(&sos, x);
+                    let mut v = x.to_vec();
+                    fill_removed(&mut v, keep);
+                    filtfilt_in_place(&sos, &mut v);
+                    *x = Cow::Owned(v);
                 });
         } else {
             warnings.push(format!("segment {}: Butterworth order {order} at {cutoff} Hz could not be designed; not filtered", d.id));
@@ -411,24 +415,22 @@ fn butter(order: u32, cutoff: f64, fs: f64) -> Option<iir_filters::sos::Sos> {
 /// Zero-phase filtering: forward then backward, each pass started in the steady state of
 /// its first sample (subtracting it is exact for a unity-DC-gain low-pass), so the edges
 /// do not ring.
-pub(crate) fn filtfilt(sos: &iir_filters::sos::Sos, x: &[f64]) -> Vec<f64> {
+pub(crate) fn filtfilt_in_place(sos: &iir_filters::sos::Sos, y: &mut [f64]) {
     use iir_filters::filter::{DirectForm2Transposed, Filter};
-    if x.is_empty() {
-        return Vec::new();
+    if y.is_empty() {
+        return;
     }
-    let pass = |x: &mut Vec<f64>| {
+    let pass = |x: &mut [f64]| {
         let x0 = x[0];
         let mut f = DirectForm2Transposed::new(sos);
         for v in x.iter_mut() {
             *v = x0 + f.filter(*v - x0);
         }
     };
-    let mut y = x.to_vec();
-    pass(&mut y);
+    pass(y);
     y.reverse();
-    pass(&mut y);
+    pass(y);
     y.reverse();
-    y
 }
 
 #[cfg(test)]
@@ -458,7 +460,8 @@ mod tests {
         let x: Vec<f64> = (0..2000)
             .map(|i| (2.0 * std::f64::consts::PI * 0.5 * i as f64 / fs).sin())
             .collect();
-        let y = filtfilt(&sos, &x);
+        let mut y = x.clone();
+        filtfilt_in_place(&sos, &mut y);
         // A 0.5 Hz sine passes a 5 Hz low-pass with gain ~1 and, forward-backward, zero lag.
         let err = x[200..1800]
             .iter()

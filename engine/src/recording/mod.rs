@@ -199,15 +199,16 @@ pub struct AbortRecord {
     pub values: String,
 }
 
-/// The IMU stream, columnar.
+/// The IMU stream, one vector per column: the analysis borrows a segment's channels as
+/// slices instead of copying them.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ImuStream {
     /// Time stamps, s.
     pub t: Vec<f64>,
-    /// Accelerometer outputs, m/s^2.
-    pub accel: Vec<[f64; 3]>,
-    /// Gyro outputs, deg/s.
-    pub gyro: Vec<[f64; 3]>,
+    /// Accelerometer outputs per axis (x, y, z), m/s^2.
+    pub accel: [Vec<f64>; 3],
+    /// Gyro outputs per axis (x, y, z), deg/s.
+    pub gyro: [Vec<f64>; 3],
     /// IMU internal temperature, degC (optional column).
     pub temp: Option<Vec<f64>>,
 }

@@ -55,16 +55,24 @@ impl RowSink for ImuStream {
     #[inline]
     fn push(&mut self, r: &[f64; MAX_SLOTS]) {
         self.t.push(r[0]);
-        self.accel.push([r[1], r[2], r[3]]);
-        self.gyro.push([r[4], r[5], r[6]]);
+        for k in 0..3 {
+            self.accel[k].push(r[1 + k]);
+            self.gyro[k].push(r[4 + k]);
+        }
         if let Some(tc) = &mut self.temp {
             tc.push(r[7]);
         }
     }
     fn append(&mut self, o: Self) {
         self.t.extend(o.t);
-        self.accel.extend(o.accel);
-        self.gyro.extend(o.gyro);
+        for (a, b) in self
+            .accel
+            .iter_mut()
+            .chain(&mut self.gyro)
+            .zip(o.accel.into_iter().chain(o.gyro))
+        {
+            a.extend(b);
+        }
         if let (Some(a), Some(b)) = (&mut self.temp, o.temp) {
             a.extend(b);
         }
@@ -133,13 +141,32 @@ fn fast_streams(
     let (table_names, table_start, table_len) = head(table_path)?;
     let imu_layout = layout(&imu_names, &IMU_COLS, &["temp"], imu_start);
     let table_layout = layout(&table_names, &TABLE_COLS, &["ambient"], table_start);
-    let new_imu = |temp: bool| ImuStream {
-        temp: temp.then(Vec::new),
-        ..Default::default()
+    // Columns are sized once from the line density, so that they neither grow by doubling
+    // nor move when the second part is appended to the first (at 1 kHz that is hundreds of
+    // megabytes).
+    let imu_density = scan::line_density(imu_path, imu_start, imu_len);
+    let imu_rows = |from: u64| scan::rows_for(imu_density, imu_len - from);
+    let new_imu = |temp: bool, rows: usize| {
+        let col = || Vec::with_capacity(rows);
+        ImuStream {
+            t: col(),
+            accel: [col(), col(), col()],
+            gyro: [col(), col(), col()],
+            temp: temp.then(col),
+        }
     };
-    let new_table = |amb: bool| TableStream {
-        ambient: amb.then(Vec::new),
-        ..Default::default()
+    let table_density = scan::line_density(table_path, table_start, table_len);
+    let table_rows = scan::rows_for(table_density, table_len - table_start);
+    let new_table = |amb: bool| {
+        let col = || Vec::with_capacity(table_rows);
+        TableStream {
+            t: col(),
+            outer: col(),
+            inner: col(),
+            outer_rate: col(),
+            inner_rate: col(),
+            ambient: amb.then(col),
+        }
     };
     let table_bytes = if table_layout.is_some() {
         table_len - table_start
@@ -153,7 +180,7 @@ fn fast_streams(
     let (first, second) = std::thread::scope(|s| {
         let h = s.spawn(|| {
             let imu = imu_layout.as_ref().and_then(|(l, temp)| {
-                let mut part = new_imu(*temp);
+                let mut part = new_imu(*temp, imu_rows(mid));
                 scan::scan_range(imu_path, l, mid, imu_len, &mut part)
                     .ok()
                     .map(|_| part)
@@ -167,7 +194,8 @@ fn fast_streams(
             (imu, table)
         });
         let first = imu_layout.as_ref().and_then(|(l, temp)| {
-            let mut part = new_imu(*temp);
+            // The first part holds the whole stream once the second is appended.
+            let mut part = new_imu(*temp, imu_rows(imu_start));
             scan::scan_range(imu_path, l, imu_start, mid, &mut part)
                 .ok()
                 .map(|_| part)
@@ -241,14 +269,10 @@ fn exact(path: &Path, required: &[&str], optional: &[&str]) -> Result<Columns, R
 fn parse_imu(path: &Path) -> Result<ImuStream, RecordingError> {
     let Columns { mut cols } = exact(path, &IMU_COLS, &["temp"])?;
     let mut take = |k: usize| cols[k].take().expect("required column");
-    let t = take(0);
-    let (ax, ay, az, gx, gy, gz) = (take(1), take(2), take(3), take(4), take(5), take(6));
-    let accel = (0..t.len()).map(|i| [ax[i], ay[i], az[i]]).collect();
-    let gyro = (0..t.len()).map(|i| [gx[i], gy[i], gz[i]]).collect();
     Ok(ImuStream {
-        t,
-        accel,
-        gyro,
+        t: take(0),
+        accel: [take(1), take(2), take(3)],
+        gyro: [take(4), take(5), take(6)],
         temp: cols[7].take(),
     })
 }
