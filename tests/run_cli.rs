@@ -215,6 +215,53 @@ fn station_fault_aborts_with_4_and_resume_completes() {
     assert_eq!(code(&ratecal(&["run", "--resume", "r"], tmp.path())), 1);
 }
 
+/// A procedure whose settle time comes from a lab file: the run folder keeps a copy of the
+/// import, and `--resume` checks against that copy even after the lab file has gone.
+#[test]
+fn imports_are_kept_in_the_run_folder_and_resume_uses_them() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(tmp.path().join("procs")).unwrap();
+    std::fs::create_dir_all(tmp.path().join("lab")).unwrap();
+    let limits = "param settle_min = 5 s\n";
+    std::fs::write(tmp.path().join("lab/limits.rcal"), limits).unwrap();
+    let with_import = format!(
+        "import \"../lab/limits.rcal\"\n\n{}",
+        MINI.replace("at least 5 s", "at least settle_min")
+    );
+    std::fs::write(tmp.path().join("procs/p.rcal"), with_import).unwrap();
+    let fault = "faults: [ { temperature_excursion: { at: 36 s, delta: 4 degC, ramp: 1 s, duration: 600 s } } ]";
+    std::fs::write(tmp.path().join("st.yaml"), station_with(fault)).unwrap();
+    let args = [
+        "run",
+        "procs/p.rcal",
+        "--station",
+        "st.yaml",
+        "--dry-run",
+        "--out",
+        "r",
+    ];
+    let o = ratecal(&args, tmp.path());
+    assert_eq!(code(&o), 4, "{}", text(&o));
+    let dir = tmp.path().join("r");
+    let copy = dir.join("imports/^/lab/limits.rcal");
+    assert_eq!(std::fs::read_to_string(&copy).unwrap(), limits);
+
+    // The lab file is gone by the time the run resumes.
+    std::fs::remove_file(tmp.path().join("lab/limits.rcal")).unwrap();
+    std::fs::write(dir.join("station.yaml"), station_with("faults: []")).unwrap();
+    let o = ratecal(&["run", "--resume", "r"], tmp.path());
+    assert!(matches!(code(&o), 0 | 3), "{}", text(&o));
+    assert_eq!(manifest(&dir).run.as_ref().unwrap().status, "completed");
+
+    // A new run from the lab's files, now without the import, names what it lacks.
+    let o = ratecal(
+        &["run", "procs/p.rcal", "--dry-run", "--out", "r2"],
+        tmp.path(),
+    );
+    assert_eq!(code(&o), 1, "{}", text(&o));
+    assert!(text(&o).contains("limits.rcal"), "{}", text(&o));
+}
+
 #[test]
 fn standard_procedure_dry_run_passes() {
     let tmp = tempfile::tempdir().unwrap();

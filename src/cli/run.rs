@@ -4,6 +4,7 @@
 //! 2 usage.
 
 mod check;
+mod imports;
 mod progress;
 mod setup;
 
@@ -126,7 +127,7 @@ fn run(args: Args) -> Result<ExitCode, Report> {
 fn prepare_new(args: &Args) -> Result<Prepared, Report> {
     let st = setup::station(args.station.as_deref(), args.dry_run)?;
     let proc_path = setup::procedure_file(args.procedure.as_deref().unwrap_or(Path::new(".")))?;
-    let pr = setup::procedure(&proc_path, &st.station)?;
+    let pr = setup::procedure(&proc_path, &st.station, None)?;
     let dir = args
         .out
         .clone()
@@ -142,6 +143,7 @@ fn prepare_new(args: &Args) -> Result<Prepared, Report> {
         |e: std::io::Error| miette::miette!("cannot write the run folder {}: {e}", dir.display());
     std::fs::create_dir_all(&dir).map_err(io)?;
     std::fs::write(dir.join("procedure.rcal"), &pr.text).map_err(io)?;
+    pr.imports.save(&dir).map_err(io)?;
     std::fs::write(dir.join("station.yaml"), &st.yaml).map_err(io)?;
     let facts = setup::RunFacts {
         dir: &dir,
@@ -190,7 +192,7 @@ fn prepare_resume(dir: &Path) -> Result<Prepared, Report> {
         .and_then(|r| r.seed)
         .unwrap_or(1);
     let st = setup::station(Some(&dir.join("station.yaml")), dry_run)?;
-    let pr = setup::procedure(&dir.join("procedure.rcal"), &st.station)?;
+    let pr = setup::procedure(&dir.join("procedure.rcal"), &st.station, Some(dir))?;
     let m = writer.manifest_mut();
     m.segments.truncate(point.segments);
     if let Some(run) = m.run.as_mut() {

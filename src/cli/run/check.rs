@@ -1,21 +1,26 @@
 //! The one place `ratecal run` turns procedure text into a plan: parse, canonical hash,
 //! check against the station's limits (the same check as `ratecal check --station`).
 
-use crate::cli::procedure::{self, FsSources};
+use crate::cli::procedure;
 use miette::Report;
 use ratecal_drivers::Station;
-use ratecal_engine::check::{CheckOptions, check_text};
+use ratecal_engine::check::{CheckOptions, Sources, check_text};
 use ratecal_engine::plan::Plan;
 use std::path::Path;
 
-/// Parses and checks a procedure; returns the plan and the SHA-256 of its canonical text.
-/// Every diagnostic is printed; the error only summarises.
-pub fn plan(path: &Path, text: &str, station: &Station) -> Result<(Plan, String), Report> {
+/// Parses and checks a procedure (its imports read through `sources`); returns the plan and
+/// the SHA-256 of its canonical text. Every diagnostic is printed; the error only summarises.
+pub fn plan(
+    path: &Path,
+    text: &str,
+    station: &Station,
+    sources: &dyn Sources,
+) -> Result<(Plan, String), Report> {
     let name = path.display().to_string();
     let opts = CheckOptions {
         station: Some(crate::cli::check::station_limits(station)),
     };
-    match check_text(&name, text, &FsSources, &opts) {
+    match check_text(&name, text, sources, &opts) {
         Ok(checked) => {
             checked.warnings.iter().for_each(procedure::report);
             let canon = ratecal_grammar::canonical(text).map_err(|d| {

@@ -11,6 +11,8 @@ use ratecal_engine::recording::{
 };
 use std::path::{Path, PathBuf};
 
+use super::imports::Imports;
+
 /// A station and the text it came from.
 pub struct LoadedStation {
     /// Parsed station.
@@ -50,6 +52,8 @@ pub struct LoadedProcedure {
     pub text: String,
     /// SHA-256 of the canonical text.
     pub sha256: String,
+    /// The files it imports (copied into the run folder).
+    pub imports: Imports,
 }
 
 /// Finds the procedure file: a file, a procedure folder (its newest version) or
@@ -61,13 +65,28 @@ pub fn procedure_file(arg: &Path) -> Result<PathBuf, Report> {
     })
 }
 
-/// Reads, hashes and checks a procedure against the station's limits.
-pub fn procedure(path: &Path, station: &Station) -> Result<LoadedProcedure, Report> {
+/// Reads, hashes and checks a procedure against the station's limits; its imports come
+/// from the lab's files, or with `run_dir` from that run folder's copies.
+pub fn procedure(
+    path: &Path,
+    station: &Station,
+    run_dir: Option<&Path>,
+) -> Result<LoadedProcedure, Report> {
     let text = std::fs::read_to_string(path)
         .into_diagnostic()
         .wrap_err_with(|| format!("cannot read procedure {}", path.display()))?;
-    let (plan, sha256) = super::check::plan(path, &text, station)?;
-    Ok(LoadedProcedure { plan, text, sha256 })
+    let name = path.display().to_string();
+    let imports = match run_dir {
+        Some(dir) => Imports::from_run(dir, &name),
+        None => Imports::from_files(&name),
+    };
+    let (plan, sha256) = super::check::plan(path, &text, station, &imports)?;
+    Ok(LoadedProcedure {
+        plan,
+        text,
+        sha256,
+        imports,
+    })
 }
 
 /// `runs/<procedure>-<UTC timestamp>` (with `-2`, `-3`... if taken).
