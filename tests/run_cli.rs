@@ -209,6 +209,12 @@ fn station_fault_aborts_with_4_and_resume_completes() {
     );
     assert_eq!(m.run.as_ref().unwrap().status, "completed");
     assert!(m.segments[2].t_start > abort.t);
+    // The resumed part ran with the fixed station: the manifest names it, the journal
+    // keeps the change, and the folder verifies.
+    let journal = std::fs::read_to_string(dir.join("journal.jsonl")).unwrap();
+    assert!(journal.contains("station.yaml changed before the resume"));
+    let o = ratecal(&["verify", "r"], tmp.path());
+    assert_eq!(code(&o), 0, "{}", text(&o));
     // One recording, time increasing through the resume; it reads back.
     ratecal_engine::recording::read(&dir).unwrap();
     // Nothing left to resume.
@@ -252,6 +258,18 @@ fn imports_are_kept_in_the_run_folder_and_resume_uses_them() {
     let o = ratecal(&["run", "--resume", "r"], tmp.path());
     assert!(matches!(code(&o), 0 | 3), "{}", text(&o));
     assert_eq!(manifest(&dir).run.as_ref().unwrap().status, "completed");
+
+    // The copy is part of what `verify` checks.
+    let o = ratecal(&["verify", "r"], tmp.path());
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    std::fs::write(&copy, "param settle_min = 1 s\n").unwrap();
+    let o = ratecal(&["verify", "r"], tmp.path());
+    assert_eq!(code(&o), 1, "{}", text(&o));
+    assert!(
+        text(&o).contains("imports/^/lab/limits.rcal"),
+        "{}",
+        text(&o)
+    );
 
     // A new run from the lab's files, now without the import, names what it lacks.
     let o = ratecal(

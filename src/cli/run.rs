@@ -9,8 +9,11 @@ mod progress;
 mod setup;
 
 use miette::Report;
+use ratecal_engine::recording::sha256_hex;
 use ratecal_engine::recording::{Columns, RecordingWriter};
-use ratecal_engine::run::{RunOptions, RunOutcome, RunStatus, execute, resume_point};
+use ratecal_engine::run::{
+    JournalEntry, JournalEvent, RunOptions, RunOutcome, RunSink, RunStatus, execute, resume_point,
+};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -192,16 +195,39 @@ fn prepare_resume(dir: &Path) -> Result<Prepared, Report> {
         .and_then(|r| r.seed)
         .unwrap_or(1);
     let st = setup::station(Some(&dir.join("station.yaml")), dry_run)?;
+    let station_sha = sha256_hex(st.yaml.as_bytes());
     let pr = setup::procedure(&dir.join("procedure.rcal"), &st.station, Some(dir))?;
+    let mut changed_station = None;
     let m = writer.manifest_mut();
     m.segments.truncate(point.segments);
     if let Some(run) = m.run.as_mut() {
         run.status = "running".into();
         run.abort = None;
         run.ended = None;
-        run.files_sha256.clear();
+        // An operator may fix the station file before resuming (a fault rehearsal, a
+        // repaired table): the resumed part runs with the new file, the journal keeps both.
+        if let Some(old) = run.station_sha256.replace(station_sha.clone())
+            && old != station_sha
+        {
+            changed_station = Some((old, station_sha.clone()));
+        }
+        // The data files are hashed again when the run ends; the import copies stand.
+        run.files_sha256
+            .retain(|name, _| name.starts_with(&format!("{}/", imports::IMPORTS_DIR)));
     }
     writer.checkpoint().map_err(io)?;
+    if let Some((old, new)) = changed_station {
+        eprintln!("station.yaml changed since the interrupted part: the rest runs with it");
+        let entry = JournalEntry {
+            t: last_t.unwrap_or(0.0),
+            step: None,
+            event: JournalEvent::Warning {
+                rule: "station.yaml changed before the resume".into(),
+                values: format!("sha256 {old} -> {new}"),
+            },
+        };
+        writer.journal(&entry).map_err(io)?;
+    }
     let opts = RunOptions {
         start_step: point.next_step,
         resume_segments: point.segments,

@@ -8,8 +8,9 @@
 
 use crate::cli::procedure::FsSources;
 use ratecal_engine::check::Sources;
+use ratecal_engine::recording::sha256_hex;
 use std::cell::RefCell;
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::path::{Component, Path, PathBuf};
 
 /// The folder of a run that holds the imported files.
@@ -53,10 +54,20 @@ impl Imports {
         }
     }
 
+    /// SHA-256 of each saved copy, by its path in the run folder (`imports/^/lab/l.rcal`),
+    /// for the manifest's `run.files_sha256`, which `ratecal verify` checks.
+    pub fn hashes(&self) -> BTreeMap<String, String> {
+        self.loaded
+            .borrow()
+            .iter()
+            .map(|(rel, text)| (run_path(rel), sha256_hex(text.as_bytes())))
+            .collect()
+    }
+
     /// Writes a copy of every import loaded so far into `run_dir/imports/`.
     pub fn save(&self, run_dir: &Path) -> std::io::Result<()> {
         for (rel, text) in self.loaded.borrow().iter() {
-            let path = run_dir.join(IMPORTS_DIR).join(encode(rel));
+            let path = run_dir.join(run_path(rel));
             if let Some(parent) = path.parent() {
                 std::fs::create_dir_all(parent)?;
             }
@@ -99,6 +110,16 @@ impl Sources for Imports {
         self.loaded.borrow_mut().push((rel, text.clone()));
         Ok((display, text))
     }
+}
+
+/// Where the copy of the import at `rel` (relative to the procedure) goes in a run folder,
+/// `/`-separated on every platform.
+fn run_path(rel: &Path) -> String {
+    let parts: Vec<_> = encode(rel)
+        .components()
+        .map(|c| c.as_os_str().to_string_lossy().into_owned())
+        .collect();
+    format!("{IMPORTS_DIR}/{}", parts.join("/"))
 }
 
 /// `a/./b/../c` -> `a/c`; a `..` that climbs above the start is kept.

@@ -168,7 +168,8 @@ pub fn manifest(st: &LoadedStation, proc_: &LoadedProcedure, facts: &RunFacts) -
             operator: facts.operator.clone(),
             seed: facts.dry_run.then_some(facts.seed),
             station_sha256: Some(sha256_hex(st.yaml.as_bytes())),
-            files_sha256: Default::default(),
+            // The import copies are hashed now; the data files when the run ends.
+            files_sha256: proc_.imports.hashes(),
         }),
     }
 }
