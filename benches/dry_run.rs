@@ -84,6 +84,17 @@ fn dry_run(plan: &Plan, st: &Station, dir: &std::path::Path) -> f64 {
     })
 }
 
+/// The process's peak resident memory so far (Linux `VmHWM`), as printed by the kernel.
+fn peak_memory() -> String {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find_map(|l| l.strip_prefix("VmHWM:").map(|v| v.trim().to_string()))
+        })
+        .unwrap_or_else(|| "unknown (no /proc/self/status)".into())
+}
+
 fn bench(c: &mut Criterion) {
     let plan = standard_plan();
     let st = station_1khz();
@@ -92,8 +103,9 @@ fn bench(c: &mut Criterion) {
     let simulated = dry_run(&plan, &st, dir.path());
     let wall = t0.elapsed().as_secs_f64();
     eprintln!(
-        "standard procedure, IMU 1 kHz: {simulated:.0} s simulated in {wall:.2} s ({:.0}x real time)",
-        simulated / wall
+        "standard procedure, IMU 1 kHz: {simulated:.0} s simulated in {wall:.2} s ({:.0}x real time), peak memory {}",
+        simulated / wall,
+        peak_memory()
     );
     let mut g = c.benchmark_group("dry_run");
     g.sample_size(10);
