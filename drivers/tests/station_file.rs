@@ -138,3 +138,79 @@ fn describe_gives_the_manifest_facts() {
     assert!((env.vibration_g.unwrap() - 0.002).abs() < 1e-15);
     assert!(info.simulated);
 }
+
+/// Values the loader fuzzing (`station_garbage.rs`) found accepted although the simulated
+/// station then panicked or put out NaN; each is now refused where it is written.
+#[test]
+fn fuzzed_values_are_located() {
+    for (from, to, needle) in [
+        // A quantity past f64's range was infinite: NaN gyro outputs.
+        (
+            "gyro_bias_random_walk: 1e-6 deg/s/rts",
+            "gyro_bias_random_walk: 1e400 deg/s/rts",
+            "out of range",
+        ),
+        // NaN slipped through the orthonormality test.
+        (
+            "rotation: [[1, 0, 0], [0, 1, 0], [0, 0, 1]]",
+            "rotation: [[.nan, 0, 0], [0, 1, 0], [0, 0, 1]]",
+            "orthonormal",
+        ),
+        // Bare numbers took .nan and .inf; gravity 0 divided the g-sensitivity by zero.
+        ("latitude_deg: 55.70", "latitude_deg: .nan", "finite"),
+        ("gravity_mps2: 9.8156", "gravity_mps2: 0", "positive"),
+        (
+            "  effects: {}",
+            "  effects: { gyro_misalignment: { xy_mrad: .inf } }",
+            "finite",
+        ),
+        // A servo at 1e-300 Hz: wn^2 underflows to 0, NaN angles.
+        (
+            "natural_frequency: 5 Hz",
+            "natural_frequency: 1e-300 Hz",
+            "between 0.001 Hz and 1000 kHz",
+        ),
+        // 1e300 Hz: the first read asked for usize::MAX + 1 samples (overflow panic).
+        (
+            "sample_rate: 100 Hz",
+            "sample_rate: 1e300 Hz",
+            "between 0.001 Hz and 1000 kHz",
+        ),
+        (
+            "feedback_rate: 50 Hz",
+            "feedback_rate: 5e-324 Hz",
+            "between",
+        ),
+        // damping^2 overflowed: NaN angles.
+        ("damping: 0.6", "damping: 1e300", "at most 100"),
+        // The motion evaluated at -1e297 s: s^2 overflowed, NaN outputs.
+        (
+            "  effects: {}",
+            "  effects: { time_offset: { tau_ms: 1e300 } }",
+            "within a minute",
+        ),
+    ] {
+        let line = DEFAULT_STATION_YAML
+            .lines()
+            .position(|l| l.contains(from))
+            .unwrap()
+            + 1;
+        let err = Station::from_yaml(&with(from, to), "lab.yaml").unwrap_err();
+        let shown = render(&err);
+        assert_eq!(err.line, Some(line), "{shown}");
+        assert!(
+            shown.contains(needle) && shown.contains(&format!("lab.yaml:{line}:")),
+            "{shown}"
+        );
+    }
+}
+
+/// After a bare CR the parser's span pointed at the end of the text while its line and
+/// column were right: the snippet now shows where the message says.
+#[test]
+fn errors_after_a_bare_cr_are_located_where_the_message_says() {
+    let err = Station::from_yaml("\r{\0", "lab.yaml").unwrap_err();
+    let shown = render(&err);
+    assert_eq!((err.line, err.column), (Some(2), Some(2)), "{shown}");
+    assert!(shown.contains("lab.yaml:2:2"), "{shown}");
+}

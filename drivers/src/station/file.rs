@@ -4,7 +4,7 @@
 
 use super::quantity::{
     Accel, AccelDensity, Angle, Freq, Pressure, Rate, RateDensity, RateWalk, Ratio, Rotation, Temp,
-    TempDelta, TempRate, Time, UnitVec, fraction, positive,
+    TempDelta, TempRate, Time, UnitVec, damping, finite, fraction, frequency, positive,
 };
 use serde::{Deserialize, Serialize};
 
@@ -40,8 +40,10 @@ pub struct Station {
 #[serde(deny_unknown_fields)]
 pub struct SiteSpec {
     /// Geodetic latitude, deg.
+    #[serde(deserialize_with = "finite")]
     pub latitude_deg: f64,
-    /// Local gravity, m/s^2.
+    /// Local gravity, m/s^2 (the g-sensitivity is given per g: it divides by it).
+    #[serde(deserialize_with = "positive")]
     pub gravity_mps2: f64,
 }
 
@@ -88,10 +90,10 @@ pub enum ImuDriverSpec {
 #[serde(deny_unknown_fields)]
 pub struct SettlingSpec {
     /// Natural frequency of the servo loop.
-    #[serde(deserialize_with = "positive")]
+    #[serde(deserialize_with = "frequency")]
     pub natural_frequency: Freq,
-    /// Damping ratio (0 < damping; below 1 overshoots).
-    #[serde(deserialize_with = "positive")]
+    /// Damping ratio (0 < damping <= 100; below 1 overshoots).
+    #[serde(deserialize_with = "damping")]
     pub damping: f64,
     /// Fraction of the commanded acceleration fed forward, 0 to 1: the rest makes the
     /// tracking lag while accelerating and the overshoot after a move.
@@ -142,7 +144,7 @@ pub struct TableSpec {
     #[serde(default)]
     pub settling: SettlingSpec,
     /// Feedback sample rate.
-    #[serde(deserialize_with = "positive")]
+    #[serde(deserialize_with = "frequency")]
     pub feedback_rate: Freq,
 }
 
@@ -182,7 +184,7 @@ pub struct ImuSpec {
     #[serde(default)]
     pub grade: String,
     /// Output sample rate.
-    #[serde(deserialize_with = "positive")]
+    #[serde(deserialize_with = "frequency")]
     pub sample_rate: Freq,
     /// Accelerometer range (outputs saturate there).
     #[serde(deserialize_with = "positive")]
@@ -265,7 +267,7 @@ macro_rules! params {
         pub struct $name {
             $(
                 #[doc = concat!("`", stringify!($field), "` (see spec/physics.md).")]
-                #[serde(default)]
+                #[serde(default, deserialize_with = "finite")]
                 pub $field: f64,
             )*
         }
@@ -275,9 +277,28 @@ macro_rules! params {
 params!(
     /// `lever_arm`: `r<i><j>_mm` = j-component of accelerometer i's sensing point, mm.
     LeverArmSpec { rxx_mm, rxy_mm, rxz_mm, ryx_mm, ryy_mm, ryz_mm, rzx_mm, rzy_mm, rzz_mm });
-params!(
-    /// `time_offset`: the sample stamped t measured the motion at t - tau.
-    TimeOffsetSpec { tau_ms });
+/// `time_offset`: the sample stamped t measured the motion at t - tau.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeOffsetSpec {
+    /// `tau_ms` (see spec/physics.md), at most a minute either way.
+    #[serde(default, deserialize_with = "time_offset_ms")]
+    pub tau_ms: f64,
+}
+
+/// `deserialize_with` helper for `tau_ms`: within a minute either way (an offset of 1e300
+/// ms evaluates the motion at 1e297 s, where `s^2` overflows: NaN outputs).
+fn time_offset_ms<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    let v = finite(d)?;
+    if v.abs() <= 60_000.0 {
+        Ok(v)
+    } else {
+        Err(serde::de::Error::custom(format!(
+            "must be within a minute either way (-60000 to 60000 ms), found {}",
+            super::quantity::shown(v)
+        )))
+    }
+}
 params!(
     /// Misalignment: `<i><j>_mrad` = K[i][j] * 1000.
     MisalignmentSpec { xy_mrad, xz_mrad, yx_mrad, yz_mrad, zx_mrad, zy_mrad });

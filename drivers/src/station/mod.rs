@@ -154,14 +154,18 @@ fn located(err: &serde_saphyr::Error, text: &str, file_name: &str) -> StationErr
         Some(l) if l.line() > 0 => (Some(l.line() as usize), Some(l.column() as usize)),
         _ => (None, None),
     };
-    let offset = loc
-        .as_ref()
-        .and_then(|l| {
-            l.span()
-                .byte_offset()
-                .map(|o| (o as usize, l.span().byte_len().unwrap_or(1) as usize))
-        })
-        .or_else(|| line.zip(column).map(|(l, c)| (offset_of(text, l, c), 1)));
+    // Line and column are the parser's own count; its span's byte offset does not always
+    // agree with them (after a bare CR, at some scanner errors), so it is used only when
+    // it points where they do.
+    let offset = line.zip(column).map(|(l, c)| {
+        let at = offset_of(text, l, c);
+        let len = loc
+            .as_ref()
+            .filter(|l| l.span().byte_offset().map(|o| o as usize) == Some(at))
+            .and_then(|l| l.span().byte_len())
+            .unwrap_or(1) as usize;
+        (at, len)
+    });
     let message = message_of(err);
     let help = help_for(&message);
     let label = if message.contains("unknown field") {
@@ -223,11 +227,24 @@ fn help_for(message: &str) -> String {
     HELP.into()
 }
 
+/// Byte offset of 1-based `line` and character `column`, lines broken as YAML breaks
+/// them (LF, CRLF or a bare CR, as miette counts them too).
 fn offset_of(text: &str, line: usize, column: usize) -> usize {
-    let start: usize = text
-        .split_inclusive('\n')
-        .take(line.saturating_sub(1))
-        .map(str::len)
-        .sum();
-    (start + column.saturating_sub(1)).min(text.len())
+    let b = text.as_bytes();
+    let mut start = 0;
+    for _ in 1..line {
+        match b[start..].iter().position(|&c| c == b'\n' || c == b'\r') {
+            Some(p) => {
+                start += p + 1;
+                if b[start - 1] == b'\r' && b.get(start) == Some(&b'\n') {
+                    start += 1;
+                }
+            }
+            None => return text.len(),
+        }
+    }
+    text[start..]
+        .char_indices()
+        .nth(column.saturating_sub(1))
+        .map_or(text.len(), |(i, _)| start + i)
 }

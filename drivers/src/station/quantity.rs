@@ -32,6 +32,12 @@ fn parse(text: &str, dim: Dim, form: Form, example: &str) -> Result<f64, String>
             article(dim)
         ));
     };
+    if !value.is_finite() {
+        return Err(format!(
+            "`{text}` is out of range (expected {}, e.g. \"{example}\")",
+            article(dim)
+        ));
+    }
     if got == Dim::Number {
         if value == 0.0 {
             return Ok(0.0);
@@ -109,6 +115,69 @@ pub fn positive<'de, D: Deserializer<'de>, T: Deserialize<'de> + Value>(
     }
 }
 
+/// A number for a message: plain, or in exponent form when very large or small.
+pub fn shown(v: f64) -> String {
+    if v != 0.0 && !(1e-6..1e9).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
+/// Lowest and highest frequency a station file may give (Hz): below, sample times and
+/// the servo's response leave the range of `f64` (1e-300 Hz: a period of 1e300 s, NaN
+/// angles); above, the simulated station would generate samples without end.
+pub const FREQ_RANGE_HZ: (f64, f64) = (1e-3, 1e6);
+
+/// `deserialize_with` helper: a frequency within `FREQ_RANGE_HZ`.
+pub fn frequency<'de, D: Deserializer<'de>>(d: D) -> Result<Freq, D::Error> {
+    let v = Freq::deserialize(d)?;
+    let (lo, hi) = FREQ_RANGE_HZ;
+    if (lo..=hi).contains(&v.0) {
+        Ok(v)
+    } else if v.0.is_nan() || v.0 <= 0.0 {
+        Err(de::Error::custom(format!(
+            "must be positive, found {}",
+            shown(v.0)
+        )))
+    } else {
+        Err(de::Error::custom(format!(
+            "must be between 0.001 Hz and 1000 kHz, found {} Hz",
+            shown(v.0)
+        )))
+    }
+}
+
+/// `deserialize_with` helper: a servo damping ratio, above 0 and at most 100 (beyond, the
+/// loop's slow root `wn (zeta - sqrt(zeta^2 - 1))` is lost to cancellation, and past
+/// 1e154 `zeta^2` overflows: NaN angles).
+pub fn damping<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    let v = f64::deserialize(d)?;
+    if v.is_nan() || v <= 0.0 {
+        Err(de::Error::custom(format!("must be positive, found {v}")))
+    } else if v > 100.0 {
+        Err(de::Error::custom(format!(
+            "must be at most 100 (below 1 overshoots), found {}",
+            shown(v)
+        )))
+    } else {
+        Ok(v)
+    }
+}
+
+/// `deserialize_with` helper: a plain number that is finite (not `.nan`, not `.inf`).
+pub fn finite<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    let v = f64::deserialize(d)?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(de::Error::custom(format!(
+            "must be a finite number, found {}",
+            shown(v)
+        )))
+    }
+}
+
 /// `deserialize_with` helper: a plain number from 0 to 1.
 pub fn fraction<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     let v = f64::deserialize(d)?;
@@ -145,6 +214,12 @@ pub struct Rotation(pub [[f64; 3]; 3]);
 impl<'de> Deserialize<'de> for Rotation {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         let r = <[[f64; 3]; 3]>::deserialize(d)?;
+        if !r.iter().flatten().all(|x| x.is_finite()) {
+            // (A NaN would slip through the orthonormality test below: max() skips it.)
+            return Err(de::Error::custom(
+                "a mount rotation must be orthonormal with determinant +1 (finite numbers)",
+            ));
+        }
         let m = ratecal_physics::Mat3::from_fn(|i, j| r[i][j]);
         let err = (m.transpose() * m - ratecal_physics::Mat3::identity())
             .abs()

@@ -240,7 +240,13 @@ fn references(
             angle_sums: (so, si),
         };
     }
-    let mut j = tab.t.partition_point(|&x| x <= t[0]).saturating_sub(1);
+    // The step `j`..`j + 1` holding t[0]; the last step for a stamp at or past the last
+    // feedback sample (a segment may end half a step after the table stream).
+    let mut j = tab
+        .t
+        .partition_point(|&x| x <= t[0])
+        .saturating_sub(1)
+        .min(tab.t.len().saturating_sub(2));
     // Table state at feedback sample `j` plus a fraction `w` of the step to `j + 1`,
     // through the kinematics of ratecal_physics: (specific force m/s^2, rate deg/s).
     let refs_at = |j: usize, w: f64| -> (Vec3, Vec3) {

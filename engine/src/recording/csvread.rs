@@ -4,8 +4,8 @@
 // A refused recording is built once per read: the error's size costs nothing.
 #![allow(clippy::result_large_err)]
 
-use super::error::RecordingError;
-use miette::NamedSource;
+use super::error::{RecordingError, empty_stream, line_col_bytes};
+use miette::{NamedSource, SourceSpan};
 
 /// Columns of one CSV file, in the order they were asked for; `None` for an absent
 /// optional column.
@@ -30,9 +30,7 @@ pub(crate) fn read_columns(
     let src = || NamedSource::new(file, String::from_utf8_lossy(bytes).into_owned());
     let header_ok = rdr.read_byte_record(&mut rec).map_err(|e| io(file, e))?;
     if !header_ok {
-        return Err(RecordingError::EmptyStream {
-            file: file.to_string(),
-        });
+        return Err(empty_stream(file, bytes));
     }
     let names: Vec<String> = rec
         .iter()
@@ -53,7 +51,7 @@ pub(crate) fn read_columns(
                     required: required.join(", "),
                     found: names.join(", "),
                     src: src(),
-                    span: (0, header_len).into(),
+                    span: lossy_span(bytes, 0, header_len),
                 });
             }
         }
@@ -78,18 +76,18 @@ pub(crate) fn read_columns(
             {
                 continue; // blank line
             }
-            let start = pos.byte() as usize;
+            let start = record_start(bytes, pos);
             let end = bytes[start..]
                 .iter()
-                .position(|&b| b == b'\n')
+                .position(|&b| b == b'\n' || b == b'\r')
                 .map_or(bytes.len(), |p| start + p);
             return Err(RecordingError::RaggedRow {
                 file: file.to_string(),
-                line: pos.line(),
+                line: line_col_bytes(bytes, start).0,
                 found: rec.len(),
                 expected: width,
                 src: src(),
-                span: (start, end - start).into(),
+                span: lossy_span(bytes, start, end),
             });
         }
         for (k, i) in idx.iter().enumerate() {
@@ -98,15 +96,17 @@ pub(crate) fn read_columns(
             match parse_f64(cell) {
                 Some(v) => cols[k].as_mut().expect("present column").push(v),
                 None => {
-                    let (offset, column) = cell_offset(bytes, pos.byte() as usize, i);
+                    let start = record_start(bytes, pos);
+                    let (offset, column) = cell_offset(bytes, start, i);
+                    let end = (offset + cell.len().max(1)).min(bytes.len());
                     return Err(RecordingError::NotANumber {
                         file: file.to_string(),
-                        line: pos.line(),
+                        line: line_col_bytes(bytes, start).0,
                         column,
                         name: names[i].clone(),
                         cell: String::from_utf8_lossy(cell).into_owned(),
                         src: src(),
-                        span: (offset, cell.len().max(1)).into(),
+                        span: lossy_span(bytes, offset, end),
                     });
                 }
             }
@@ -120,6 +120,49 @@ fn io(file: &str, e: csv::Error) -> RecordingError {
         file: file.to_string(),
         message: e.to_string(),
     }
+}
+
+/// Where the record at `pos` starts. After a CRLF the csv crate puts a record's start on
+/// the LF (and counts its line one short): the row starts after it.
+fn record_start(bytes: &[u8], pos: &csv::Position) -> usize {
+    let start = (pos.byte() as usize).min(bytes.len());
+    if bytes.get(start) == Some(&b'\n') && start > 0 && bytes[start - 1] == b'\r' {
+        start + 1
+    } else {
+        start
+    }
+}
+
+/// Byte offset where data row `row` starts (0-based, after the header, blank lines not
+/// counted), rows split as the exact reader splits them; the end of `bytes` past the last.
+pub(crate) fn row_start(bytes: &[u8], row: usize) -> usize {
+    let mut rdr = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .from_reader(bytes);
+    let mut rec = csv::ByteRecord::new();
+    let mut seen = 0;
+    let mut header = true;
+    while let Ok(true) = rdr.read_byte_record(&mut rec) {
+        let blank = rec.len() == 1 && rec[0].iter().all(u8::is_ascii_whitespace);
+        if std::mem::take(&mut header) || blank {
+            continue;
+        }
+        if seen == row {
+            let pos = rec.position().expect("csv records carry positions");
+            return record_start(bytes, pos);
+        }
+        seen += 1;
+    }
+    bytes.len()
+}
+
+/// The span of `bytes[start..end]` in the text the diagnostics show (`bytes` made valid
+/// UTF-8: an invalid byte there takes the three of U+FFFD).
+pub(crate) fn lossy_span(bytes: &[u8], start: usize, end: usize) -> SourceSpan {
+    let at = |o: usize| String::from_utf8_lossy(&bytes[..o.min(bytes.len())]).len();
+    let (s, e) = (at(start), at(end.max(start)));
+    (s, e - s).into()
 }
 
 /// Byte offset and 1-based character column of field `field` of the line starting at `start`.
@@ -162,9 +205,10 @@ fn fast(b: &[u8]) -> Option<f64> {
     let mut mant: u64 = 0;
     let mut i = 0;
     // Integer part, then fraction; every digit counts towards the 19 that fit a u64
-    // (leading zeros too: rare, and the exact fallback handles them).
+    // (leading zeros too: rare, and the exact fallback handles them). Past 19 it wraps, and
+    // the count sends the cell to the fallback.
     while i < b.len() && b[i].is_ascii_digit() {
-        mant = mant.wrapping_mul(10) + u64::from(b[i] - b'0');
+        mant = mant.wrapping_mul(10).wrapping_add(u64::from(b[i] - b'0'));
         i += 1;
     }
     let int_digits = i;
@@ -173,7 +217,7 @@ fn fast(b: &[u8]) -> Option<f64> {
         i += 1;
         let s = i;
         while i < b.len() && b[i].is_ascii_digit() {
-            mant = mant.wrapping_mul(10) + u64::from(b[i] - b'0');
+            mant = mant.wrapping_mul(10).wrapping_add(u64::from(b[i] - b'0'));
             i += 1;
         }
         frac = i - s;
@@ -254,6 +298,21 @@ mod tests {
         }
         for s in ["", "-", "abc", "1.2.3", "1e", "nan", "inf", "1,5", "--1"] {
             assert!(parse_f64(s.as_bytes()).is_none(), "{s}");
+        }
+    }
+
+    /// More digits than a u64 holds: the mantissa wraps (debug builds used to panic on
+    /// the overflowing add) and the exact fallback converts.
+    #[test]
+    fn long_digit_strings_fall_back() {
+        for s in [
+            "99999999999999999999999999999999999999999",
+            "18446744073709551616",
+            "0.99999999999999999999999999999999999999999",
+            "-7777777777777777777777777777777.77777777777777777777777777777",
+        ] {
+            let want: f64 = s.parse().unwrap();
+            assert_eq!(parse_f64(s.as_bytes()), Some(want), "{s}");
         }
     }
 }

@@ -117,8 +117,8 @@ pub enum RecordingError {
         span: SourceSpan,
     },
 
-    /// A stream without any sample.
-    #[error("{file}: no samples")]
+    /// A stream with fewer than two samples.
+    #[error("{file}:{line}:{column}: no samples")]
     #[diagnostic(
         code(recording::empty_stream),
         help("{file} needs a header line and at least two samples")
@@ -126,6 +126,16 @@ pub enum RecordingError {
     EmptyStream {
         /// File name.
         file: String,
+        /// Line where the samples end, 1-based.
+        line: u64,
+        /// Column, 1-based.
+        column: u64,
+        /// File text.
+        #[source_code]
+        src: NamedSource<String>,
+        /// The end of the file's text.
+        #[label("the samples end here")]
+        span: SourceSpan,
     },
 
     /// manifest.yaml is not valid YAML or does not have the manifest's shape.
@@ -232,14 +242,61 @@ pub enum RecordingError {
     },
 }
 
-/// 1-based line and column of a byte offset.
+/// A stream with fewer than two samples, located where its text ends.
+pub(crate) fn empty_stream(file: &str, bytes: &[u8]) -> RecordingError {
+    let text = String::from_utf8_lossy(bytes).into_owned();
+    let end = text.trim_end().len();
+    let (line, column) = line_col(&text, end);
+    RecordingError::EmptyStream {
+        file: file.to_string(),
+        line,
+        column,
+        src: NamedSource::new(file, text),
+        span: (end, 0).into(),
+    }
+}
+
+/// Byte offset of 1-based `line` and character `column` of a YAML text, lines broken as
+/// YAML (and miette) break them: LF, CRLF or a bare CR.
+pub(crate) fn yaml_offset(text: &str, line: u64, column: u64) -> usize {
+    let b = text.as_bytes();
+    let mut start = 0;
+    for _ in 1..line {
+        match b[start..].iter().position(|&c| c == b'\n' || c == b'\r') {
+            Some(p) => {
+                start += p + 1;
+                if b[start - 1] == b'\r' && b.get(start) == Some(&b'\n') {
+                    start += 1;
+                }
+            }
+            None => return text.len(),
+        }
+    }
+    text[start..]
+        .char_indices()
+        .nth(column.saturating_sub(1) as usize)
+        .map_or(text.len(), |(i, _)| start + i)
+}
+
+/// 1-based line and column of a byte offset, lines broken at LF, CRLF or a bare CR (as
+/// YAML, the csv crate and miette's snippets break them); the column counts characters.
 pub(crate) fn line_col(text: &str, offset: usize) -> (u64, u64) {
-    let before = &text.as_bytes()[..offset.min(text.len())];
-    let line = before.iter().filter(|&&b| b == b'\n').count() as u64 + 1;
-    let start = before
-        .iter()
-        .rposition(|&b| b == b'\n')
-        .map_or(0, |p| p + 1);
-    let column = String::from_utf8_lossy(&before[start..]).chars().count() as u64 + 1;
+    let (line, column) = line_col_bytes(text.as_bytes(), offset);
+    (line, column as u64)
+}
+
+/// `line_col` of raw bytes (invalid UTF-8 counts one character a byte).
+pub(crate) fn line_col_bytes(bytes: &[u8], offset: usize) -> (u64, usize) {
+    let before = &bytes[..offset.min(bytes.len())];
+    let mut line = 1;
+    let mut start = 0;
+    for (i, &b) in before.iter().enumerate() {
+        let lone_cr = b == b'\r' && bytes.get(i + 1) != Some(&b'\n');
+        if b == b'\n' || lone_cr {
+            line += 1;
+            start = i + 1;
+        }
+    }
+    let column = String::from_utf8_lossy(&before[start..]).chars().count() + 1;
     (line, column)
 }

@@ -3,8 +3,8 @@
 // A refused recording is built once per read: the error's size costs nothing.
 #![allow(clippy::result_large_err)]
 
-use super::csvread::{Columns, cell_offset, read_columns};
-use super::error::{RecordingError, line_col};
+use super::csvread::{Columns, cell_offset, lossy_span, read_columns, row_start};
+use super::error::{RecordingError, empty_stream, line_col, line_col_bytes, yaml_offset};
 use super::scan::{self, Layout, MAX_SLOTS, RowSink, SKIP};
 use super::{FORMAT, ImuStream, Manifest, Recording, TableStream};
 use miette::NamedSource;
@@ -214,12 +214,18 @@ fn fast_streams(
 pub fn parse_manifest(file: &str, text: &str) -> Result<Manifest, RecordingError> {
     let manifest: Manifest = serde_saphyr::from_str(text).map_err(|e| {
         let (offset, len, line, column) = match e.location() {
-            Some(loc) => {
-                let off = loc.span().byte_offset().unwrap_or(0) as usize;
-                let len = loc.span().byte_len().unwrap_or(1) as usize;
+            // The parser's line and column locate the error; its span's byte offset is
+            // absent at some scanner errors (the snippet then showed line 1), so it is
+            // used only when it points where they do.
+            Some(loc) if loc.line() > 0 => {
+                let off = yaml_offset(text, loc.line(), loc.column());
+                let len = match loc.span().byte_offset() {
+                    Some(o) if o as usize == off => loc.span().byte_len().unwrap_or(1) as usize,
+                    _ => 1,
+                };
                 (off, len, loc.line(), loc.column())
             }
-            None => (0, 0, 1, 1),
+            _ => (0, 0, 1, 1),
         };
         let message = e.to_string();
         let message = message.lines().next().unwrap_or("invalid manifest");
@@ -295,17 +301,18 @@ fn parse_table(path: &Path) -> Result<TableStream, RecordingError> {
 fn check_time(path: &Path, t: &[f64]) -> Result<(), RecordingError> {
     let file = path.display().to_string();
     if t.len() < 2 {
-        return Err(RecordingError::EmptyStream { file });
+        let bytes = std::fs::read(path).map_err(|e| io_error(path, e))?;
+        return Err(empty_stream(&file, &bytes));
     }
     let Some(k) = t.windows(2).position(|w| w[1] <= w[0]) else {
         return Ok(());
     };
     let bytes = std::fs::read(path).map_err(|e| io_error(path, e))?;
     let start = row_start(&bytes, k + 1);
-    let line = bytes[..start].iter().filter(|&&b| b == b'\n').count() as u64 + 1;
+    let line = line_col_bytes(&bytes, start).0;
     let header = &bytes[..bytes
         .iter()
-        .position(|&b| b == b'\n')
+        .position(|&b| b == b'\n' || b == b'\r')
         .unwrap_or(bytes.len())];
     let field = header
         .split(|&b| b == b',')
@@ -314,7 +321,7 @@ fn check_time(path: &Path, t: &[f64]) -> Result<(), RecordingError> {
     let (offset, column) = cell_offset(&bytes, start, field);
     let len = bytes[offset..]
         .iter()
-        .position(|&b| b == b',' || b == b'\n')
+        .position(|&b| b == b',' || b == b'\n' || b == b'\r')
         .unwrap_or(1)
         .max(1);
     Err(RecordingError::TimeNotIncreasing {
@@ -324,31 +331,8 @@ fn check_time(path: &Path, t: &[f64]) -> Result<(), RecordingError> {
         t: t[k + 1],
         prev: t[k],
         src: NamedSource::new(file, String::from_utf8_lossy(&bytes).into_owned()),
-        span: (offset, len).into(),
+        span: lossy_span(&bytes, offset, offset + len),
     })
-}
-
-/// Byte offset where data row `row` (0-based, blank lines not counted) starts.
-fn row_start(bytes: &[u8], row: usize) -> usize {
-    let mut seen = 0;
-    let mut pos = bytes
-        .iter()
-        .position(|&b| b == b'\n')
-        .map_or(bytes.len(), |p| p + 1);
-    while pos < bytes.len() {
-        let end = bytes[pos..]
-            .iter()
-            .position(|&b| b == b'\n')
-            .map_or(bytes.len(), |p| pos + p);
-        if !bytes[pos..end].iter().all(u8::is_ascii_whitespace) {
-            if seen == row {
-                return pos;
-            }
-            seen += 1;
-        }
-        pos = end + 1;
-    }
-    bytes.len()
 }
 
 fn check_segments(
