@@ -212,3 +212,54 @@ fn err_unknown_format() {
     let m = MANIFEST.replace("ratecal-recording/1", "ratecal-recording/9");
     insta::assert_snapshot!(err(&m, &imu_text(), &table_text()));
 }
+
+#[test]
+fn err_gravity_not_the_earths() {
+    let m = MANIFEST.replace("gravity_mps2: 9.8156", "gravity_mps2: .nan");
+    insta::assert_snapshot!(err(&m, &imu_text(), &table_text()));
+}
+
+#[test]
+fn err_axis_not_a_unit_vector() {
+    let m = MANIFEST.replace("inner_axis: [1, 0, 0]", "inner_axis: [1, 0, 1]");
+    insta::assert_snapshot!(err(&m, &imu_text(), &table_text()));
+}
+
+#[test]
+fn err_segment_mount_is_a_reflection() {
+    let m = MANIFEST.replace(
+        "rate_dps: 10.0,",
+        "rate_dps: 10.0, mount: { rotation: [[1, 0, 0], [0, 1, 0], [0, 0, -1]] },",
+    );
+    insta::assert_snapshot!(err(&m, &imu_text(), &table_text()));
+}
+
+#[test]
+fn err_segment_rate_not_finite() {
+    let m = MANIFEST.replace("rate_dps: 10.0", "rate_dps: .inf");
+    insta::assert_snapshot!(err(&m, &imu_text(), &table_text()));
+}
+
+/// A spreadsheet program's byte-order mark before the header reads like no mark, on the
+/// fast path and on the exact one (a quoted cell).
+#[test]
+fn a_byte_order_mark_before_the_header_is_no_column() {
+    let plain = tempfile::tempdir().unwrap();
+    small(plain.path(), MANIFEST, &imu_text(), &table_text());
+    let want = recording::read(plain.path()).unwrap();
+    for imu in [
+        format!("\u{feff}{}", imu_text()),
+        format!("\u{feff}{}", imu_text().replace(",0.02,", ",\"0.02\",")),
+    ] {
+        let tmp = tempfile::tempdir().unwrap();
+        small(
+            tmp.path(),
+            MANIFEST,
+            &imu,
+            &format!("\u{feff}{}", table_text()),
+        );
+        let rec = recording::read(tmp.path()).unwrap();
+        assert_eq!(rec.imu, want.imu);
+        assert_eq!(rec.table, want.table);
+    }
+}

@@ -32,10 +32,7 @@ pub(crate) fn read_columns(
     if !header_ok {
         return Err(empty_stream(file, bytes));
     }
-    let names: Vec<String> = rec
-        .iter()
-        .map(|f| String::from_utf8_lossy(f).trim().to_string())
-        .collect();
+    let names: Vec<String> = rec.iter().map(column_name).collect();
     let header_len = bytes
         .iter()
         .position(|&b| b == b'\n')
@@ -155,6 +152,16 @@ pub(crate) fn row_start(bytes: &[u8], row: usize) -> usize {
         seen += 1;
     }
     bytes.len()
+}
+
+/// A header cell as a column name: trimmed, without the byte-order mark that spreadsheet
+/// programs put before the first one.
+pub(crate) fn column_name(cell: &[u8]) -> String {
+    let name = String::from_utf8_lossy(cell);
+    name.trim()
+        .trim_start_matches('\u{feff}')
+        .trim()
+        .to_string()
 }
 
 /// The span of `bytes[start..end]` in the text the diagnostics show (`bytes` made valid

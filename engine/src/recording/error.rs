@@ -161,6 +161,30 @@ pub enum RecordingError {
         span: SourceSpan,
     },
 
+    /// A station value of the manifest that no table or site can have (a non-finite
+    /// number, a gravity off the Earth's, an axis that is not a unit vector, a mount that
+    /// is not a rotation): the analysis would turn it into NaN results.
+    #[error("{file}:{line}:{column}: {problem}")]
+    #[diagnostic(code(recording::station), help("{help}"))]
+    BadStation {
+        /// File name.
+        file: String,
+        /// Line.
+        line: u64,
+        /// Column.
+        column: u64,
+        /// What is wrong.
+        problem: String,
+        /// What would fix it.
+        help: String,
+        /// File text.
+        #[source_code]
+        src: NamedSource<String>,
+        /// The value.
+        #[label("{problem}")]
+        span: SourceSpan,
+    },
+
     /// A format tag this version does not read.
     #[error("{file}:{line}:{column}: unknown recording format `{found}`")]
     #[diagnostic(

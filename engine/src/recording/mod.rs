@@ -7,6 +7,7 @@ mod csvread;
 mod error;
 mod read;
 mod scan;
+mod validate;
 
 pub use error::RecordingError;
 pub use read::{parse_manifest, read};

@@ -262,6 +262,7 @@ pub fn parse_manifest(file: &str, text: &str) -> Result<Manifest, RecordingError
             span: (offset, manifest.format.len().max(1)).into(),
         });
     }
+    super::validate::manifest(file, text, &manifest)?;
     Ok(manifest)
 }
 
@@ -401,7 +402,7 @@ fn check_segments(
 }
 
 /// Byte offset of the start of the line that declares segment `id` (at or after `from`).
-fn find_segment(text: &str, id: &str, from: usize) -> usize {
+pub(crate) fn find_segment(text: &str, id: &str, from: usize) -> usize {
     let at = |needle: &str| text[from..].find(needle).map(|p| p + from);
     let hit = at(&format!("\"{id}\""))
         .or_else(|| at(&format!("'{id}'")))

@@ -7,7 +7,7 @@
 //! makes it give up, and the exact reader (`csvread`, the csv crate) reads the file again
 //! to accept it or to locate the problem.
 
-use super::csvread::parse_f64;
+use super::csvread::{column_name, parse_f64};
 use std::fs::File;
 use std::io::{Read, Seek, SeekFrom};
 use std::path::Path;
@@ -57,10 +57,7 @@ pub(crate) fn header(path: &Path) -> std::io::Result<(Vec<String>, u64)> {
     let len = buf.len() as u64;
     let line = buf.strip_suffix(b"\n").unwrap_or(&buf);
     let line = line.strip_suffix(b"\r").unwrap_or(line);
-    let names = String::from_utf8_lossy(line)
-        .split(',')
-        .map(|s| s.trim().to_string())
-        .collect();
+    let names = line.split(|&b| b == b',').map(column_name).collect();
     Ok((names, len))
 }
 

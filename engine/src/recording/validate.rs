@@ -1,0 +1,185 @@
+//! The manifest's station and segment numbers, checked for what no real station can have:
+//! a recording from another acquisition system with a NaN gravity or a mistyped axis is
+//! refused where the value is written, rather than analysed into NaN results.
+
+// A refused manifest is built once per read: the error's size costs nothing.
+#![allow(clippy::result_large_err)]
+
+use super::error::{RecordingError, line_col};
+use super::{Manifest, Mount};
+use miette::NamedSource;
+
+/// Tolerance on unit vectors and on the orthonormality of a mount.
+const UNIT_TOL: f64 = 1e-3;
+
+/// Checks the station block and each segment's numbers (`text` is the manifest's text,
+/// `file` its name).
+pub(crate) fn manifest(file: &str, text: &str, m: &Manifest) -> Result<(), RecordingError> {
+    let at = |key: &str, from: usize, problem: String, help: &str| {
+        let (offset, len) = locate(text, key, from);
+        let (line, column) = line_col(text, offset);
+        RecordingError::BadStation {
+            file: file.to_string(),
+            line,
+            column,
+            problem,
+            help: help.to_string(),
+            src: NamedSource::new(file, text.to_string()),
+            span: (offset, len).into(),
+        }
+    };
+    let station = text.find("station").unwrap_or(0);
+    let site = &m.station.site;
+    if !(site.latitude_deg.is_finite() && site.latitude_deg.abs() <= 90.0) {
+        return Err(at(
+            "latitude_deg",
+            station,
+            format!("latitude {} deg is not on the Earth", site.latitude_deg),
+            "the site's latitude in degrees, -90 .. 90, north positive",
+        ));
+    }
+    let g = site.gravity_mps2;
+    if !(g.is_finite() && (9.7..=9.9).contains(&g)) {
+        return Err(at(
+            "gravity_mps2",
+            station,
+            format!("gravity {g} m/s^2 is not the Earth's"),
+            "local gravity in m/s^2: on the Earth's surface it lies between 9.78 and 9.84",
+        ));
+    }
+    for (key, v) in [
+        ("outer_axis", m.station.table.outer_axis),
+        ("inner_axis", m.station.table.inner_axis),
+    ] {
+        let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if !(norm.is_finite() && (norm - 1.0).abs() <= UNIT_TOL) {
+            return Err(at(
+                key,
+                station,
+                format!("{key} {v:?} is not a unit vector (length {norm})"),
+                "a table axis is a unit vector in the lab frame (ENU), e.g. [0, -1, 0]",
+            ));
+        }
+    }
+    if let Some(problem) = m.station.mount.as_ref().and_then(not_a_rotation) {
+        return Err(at("rotation", station, problem, MOUNT_HELP));
+    }
+    let mut from = text.find("segments").unwrap_or(0);
+    for seg in &m.segments {
+        from = super::read::find_segment(text, &seg.id, from);
+        if let Some(problem) = seg.mount.as_ref().and_then(not_a_rotation) {
+            return Err(at("rotation", from, problem, MOUNT_HELP));
+        }
+        let numbers = [
+            ("rate_dps", seg.rate_dps),
+            ("amplitude_deg", seg.amplitude_deg),
+            ("period_s", seg.period_s),
+            ("center_deg", seg.center_deg),
+            ("pitch_deg", seg.pitch_deg),
+            ("roll_deg", seg.roll_deg),
+        ];
+        for (key, v) in numbers {
+            let Some(v) = v else { continue };
+            let positive = key != "period_s" || v > 0.0;
+            if !(v.is_finite() && positive) {
+                return Err(at(
+                    key,
+                    from,
+                    format!("segment `{}`: {key} {v} is not a value it can have", seg.id),
+                    "a finite number in the unit its name gives (period_s above 0)",
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+const MOUNT_HELP: &str =
+    "C_PB, row-major: a proper rotation (orthonormal rows, determinant +1), identity if absent";
+
+/// Why a mount matrix is not a proper rotation, if it is not.
+fn not_a_rotation(m: &Mount) -> Option<String> {
+    let r = &m.rotation;
+    if r.iter().flatten().any(|x| !x.is_finite()) {
+        return Some("the mount rotation holds a number that is not finite".into());
+    }
+    let dot = |i: usize, j: usize| (0..3).map(|k| r[i][k] * r[j][k]).sum::<f64>();
+    let worst = (0..3)
+        .flat_map(|i| (0..3).map(move |j| (i, j)))
+        .map(|(i, j)| (dot(i, j) - if i == j { 1.0 } else { 0.0 }).abs())
+        .fold(0.0, f64::max);
+    let det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1])
+        - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0])
+        + r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
+    if worst > UNIT_TOL {
+        Some(format!(
+            "the mount rotation is not orthonormal (off by {worst:.2e})"
+        ))
+    } else if det < 0.0 {
+        Some("the mount rotation is a reflection (determinant -1)".into())
+    } else {
+        None
+    }
+}
+
+/// Byte offset and length of `key` and its value at or after `from` (the whole text's
+/// start if the key is not written there).
+fn locate(text: &str, key: &str, from: usize) -> (usize, usize) {
+    let from = from.min(text.len());
+    let Some(start) = text[from..].find(key).map(|p| p + from) else {
+        return (from, 1);
+    };
+    let rest = &text[start + key.len()..];
+    let value = rest.trim_start_matches([':', ' ']);
+    let skipped = rest.len() - value.len();
+    let mut depth = 0i32;
+    let mut end = value.len();
+    for (i, c) in value.char_indices() {
+        match c {
+            '[' => depth += 1,
+            ']' => {
+                depth -= 1;
+                if depth == 0 {
+                    end = i + 1;
+                    break;
+                }
+            }
+            ',' | '}' | '\n' | '\r' if depth == 0 => {
+                end = i;
+                break;
+            }
+            _ => {}
+        }
+    }
+    (start, key.len() + skipped + value[..end].trim_end().len())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_key_is_located_with_its_value() {
+        let text = "site: { latitude_deg: 95, gravity_mps2: .nan }\nm: [[1, 0], [0, 1]], x";
+        let (o, l) = locate(text, "gravity_mps2", 0);
+        assert_eq!(&text[o..o + l], "gravity_mps2: .nan");
+        let (o, l) = locate(text, "m", 40);
+        assert_eq!(&text[o..o + l], "m: [[1, 0], [0, 1]]");
+        assert_eq!(locate(text, "absent", 3), (3, 1));
+    }
+
+    #[test]
+    fn rotations_proper_and_not() {
+        let m = |rotation| Mount { rotation };
+        let id = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        assert_eq!(not_a_rotation(&m(id)), None);
+        let yaw90 = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
+        assert_eq!(not_a_rotation(&m(yaw90)), None);
+        let mirror = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0]];
+        assert!(not_a_rotation(&m(mirror)).unwrap().contains("reflection"));
+        let scaled = [[1.01, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        assert!(not_a_rotation(&m(scaled)).unwrap().contains("orthonormal"));
+        let nan = [[f64::NAN, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        assert!(not_a_rotation(&m(nan)).unwrap().contains("finite"));
+    }
+}
