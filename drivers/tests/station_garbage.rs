@@ -451,17 +451,9 @@ fn apply(text: &str, m: &Mutation) -> String {
     String::from_utf8_lossy(&bytes).into_owned()
 }
 
-fn cases(default: u32) -> u32 {
-    std::env::var("PROPTEST_CASES")
-        .ok()
-        .and_then(|n| n.parse().ok())
-        .unwrap_or(default)
-}
-
 proptest! {
-    // PROPTEST_CASES=N runs longer.
+    // 256 cases; PROPTEST_CASES=N runs longer (proptest's default reads it).
     #![proptest_config(ProptestConfig {
-        cases: cases(256),
         failure_persistence: None,
         ..ProptestConfig::default()
     })]

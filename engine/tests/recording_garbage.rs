@@ -623,17 +623,9 @@ fn odd_valid() -> impl Strategy<Value = [Vec<u8>; 3]> {
         })
 }
 
-fn cases(default: u32) -> u32 {
-    std::env::var("PROPTEST_CASES")
-        .ok()
-        .and_then(|n| n.parse().ok())
-        .unwrap_or(default)
-}
-
 proptest! {
-    // PROPTEST_CASES=N runs longer.
+    // 256 cases; PROPTEST_CASES=N runs longer (proptest's default reads it).
     #![proptest_config(ProptestConfig {
-        cases: cases(256),
         failure_persistence: None,
         ..ProptestConfig::default()
     })]

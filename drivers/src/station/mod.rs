@@ -158,7 +158,7 @@ fn located(err: &serde_saphyr::Error, text: &str, file_name: &str) -> StationErr
     // agree with them (after a bare CR, at some scanner errors), so it is used only when
     // it points where they do.
     let offset = line.zip(column).map(|(l, c)| {
-        let at = offset_of(text, l, c);
+        let at = yaml_offset(text, l as u64, c as u64);
         let len = loc
             .as_ref()
             .filter(|l| l.span().byte_offset().map(|o| o as usize) == Some(at))
@@ -227,9 +227,10 @@ fn help_for(message: &str) -> String {
     HELP.into()
 }
 
-/// Byte offset of 1-based `line` and character `column`, lines broken as YAML breaks
-/// them (LF, CRLF or a bare CR, as miette counts them too).
-fn offset_of(text: &str, line: usize, column: usize) -> usize {
+/// Byte offset of 1-based `line` and character `column` in a YAML text, lines broken as
+/// YAML (and miette) break them: LF, CRLF or a bare CR. Turns the line and column that
+/// serde-saphyr reports into a span (station files here, recording manifests in the engine).
+pub fn yaml_offset(text: &str, line: u64, column: u64) -> usize {
     let b = text.as_bytes();
     let mut start = 0;
     for _ in 1..line {
@@ -245,6 +246,6 @@ fn offset_of(text: &str, line: usize, column: usize) -> usize {
     }
     text[start..]
         .char_indices()
-        .nth(column.saturating_sub(1))
+        .nth(column.saturating_sub(1) as usize)
         .map_or(text.len(), |(i, _)| start + i)
 }

@@ -280,28 +280,6 @@ pub(crate) fn empty_stream(file: &str, bytes: &[u8]) -> RecordingError {
     }
 }
 
-/// Byte offset of 1-based `line` and character `column` of a YAML text, lines broken as
-/// YAML (and miette) break them: LF, CRLF or a bare CR.
-pub(crate) fn yaml_offset(text: &str, line: u64, column: u64) -> usize {
-    let b = text.as_bytes();
-    let mut start = 0;
-    for _ in 1..line {
-        match b[start..].iter().position(|&c| c == b'\n' || c == b'\r') {
-            Some(p) => {
-                start += p + 1;
-                if b[start - 1] == b'\r' && b.get(start) == Some(&b'\n') {
-                    start += 1;
-                }
-            }
-            None => return text.len(),
-        }
-    }
-    text[start..]
-        .char_indices()
-        .nth(column.saturating_sub(1) as usize)
-        .map_or(text.len(), |(i, _)| start + i)
-}
-
 /// 1-based line and column of a byte offset, lines broken at LF, CRLF or a bare CR (as
 /// YAML, the csv crate and miette's snippets break them); the column counts characters.
 pub(crate) fn line_col(text: &str, offset: usize) -> (u64, u64) {

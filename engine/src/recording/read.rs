@@ -4,10 +4,11 @@
 #![allow(clippy::result_large_err)]
 
 use super::csvread::{Columns, cell_offset, lossy_span, read_columns, row_start};
-use super::error::{RecordingError, empty_stream, line_col, line_col_bytes, yaml_offset};
+use super::error::{RecordingError, empty_stream, line_col, line_col_bytes};
 use super::scan::{self, Layout, MAX_SLOTS, RowSink, SKIP};
 use super::{FORMAT, ImuStream, Manifest, Recording, TableStream};
 use miette::NamedSource;
+use ratecal_drivers::yaml_offset;
 use std::path::Path;
 
 const IMU_COLS: [&str; 7] = ["t", "ax", "ay", "az", "gx", "gy", "gz"];
