@@ -91,6 +91,23 @@ fn earth_rate_is_not_an_imu_defect() {
     assert!(err.help.contains("site physics"), "{}", render(&err));
 }
 
+/// The default station with `from` replaced by `to` is refused on the line of `from`, the
+/// report saying `needle` and naming `lab.yaml:LINE:`.
+fn assert_refused_at_its_line(from: &str, to: &str, needle: &str) {
+    let line = DEFAULT_STATION_YAML
+        .lines()
+        .position(|l| l.contains(from))
+        .unwrap()
+        + 1;
+    let err = Station::from_yaml(&with(from, to), "lab.yaml").unwrap_err();
+    let shown = render(&err);
+    assert_eq!(err.line, Some(line), "{shown}");
+    assert!(
+        shown.contains(needle) && shown.contains(&format!("lab.yaml:{line}:")),
+        "{shown}"
+    );
+}
+
 #[test]
 fn bad_values_are_located() {
     for (from, to, needle) in [
@@ -112,18 +129,7 @@ fn bad_values_are_located() {
             "temperature rate",
         ),
     ] {
-        let line = DEFAULT_STATION_YAML
-            .lines()
-            .position(|l| l.contains(from))
-            .unwrap()
-            + 1;
-        let err = Station::from_yaml(&with(from, to), "lab.yaml").unwrap_err();
-        let shown = render(&err);
-        assert_eq!(err.line, Some(line), "{shown}");
-        assert!(
-            shown.contains(needle) && shown.contains("lab.yaml:"),
-            "{shown}"
-        );
+        assert_refused_at_its_line(from, to, needle);
     }
 }
 
@@ -190,18 +196,7 @@ fn fuzzed_values_are_located() {
             "within a minute",
         ),
     ] {
-        let line = DEFAULT_STATION_YAML
-            .lines()
-            .position(|l| l.contains(from))
-            .unwrap()
-            + 1;
-        let err = Station::from_yaml(&with(from, to), "lab.yaml").unwrap_err();
-        let shown = render(&err);
-        assert_eq!(err.line, Some(line), "{shown}");
-        assert!(
-            shown.contains(needle) && shown.contains(&format!("lab.yaml:{line}:")),
-            "{shown}"
-        );
+        assert_refused_at_its_line(from, to, needle);
     }
 }
 
