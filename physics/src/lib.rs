@@ -6,11 +6,13 @@
 //! (which computes references from the table's feedback).
 
 mod effects;
+mod frames;
 mod kinematics;
 mod model;
 pub mod units;
 
 pub use effects::{EFFECTS, EffectId, EffectInfo, effect};
+pub use frames::{NotARotation, check_rotation};
 pub use kinematics::{
     AxisMotion, DEG, EARTH_RATE_RADPS, Geometry, STANDARD_GRAVITY, Site, Snapshot, TableState,
     rotation, skew,

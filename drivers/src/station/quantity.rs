@@ -214,20 +214,11 @@ pub struct Rotation(pub [[f64; 3]; 3]);
 impl<'de> Deserialize<'de> for Rotation {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         let r = <[[f64; 3]; 3]>::deserialize(d)?;
-        if !r.iter().flatten().all(|x| x.is_finite()) {
-            // (A NaN would slip through the orthonormality test below: max() skips it.)
-            return Err(de::Error::custom(
-                "a mount rotation must be orthonormal with determinant +1 (finite numbers)",
-            ));
-        }
         let m = ratecal_physics::Mat3::from_fn(|i, j| r[i][j]);
-        let err = (m.transpose() * m - ratecal_physics::Mat3::identity())
-            .abs()
-            .max();
-        if !err.is_finite() || err > 1e-6 || m.determinant() < 0.0 {
-            return Err(de::Error::custom(
-                "a mount rotation must be orthonormal with determinant +1",
-            ));
+        if let Err(why) = ratecal_physics::check_rotation(&m, 1e-6) {
+            return Err(de::Error::custom(format!(
+                "a mount rotation must be orthonormal with determinant +1; this one {why}"
+            )));
         }
         Ok(Rotation(r))
     }

@@ -8,6 +8,7 @@
 use super::error::{RecordingError, line_col};
 use super::{Manifest, Mount};
 use miette::NamedSource;
+use ratecal_physics::{Mat3, check_rotation};
 
 /// Tolerance on unit vectors and on the orthonormality of a mount.
 const UNIT_TOL: f64 = 1e-3;
@@ -99,27 +100,10 @@ const MOUNT_HELP: &str =
 
 /// Why a mount matrix is not a proper rotation, if it is not.
 fn not_a_rotation(m: &Mount) -> Option<String> {
-    let r = &m.rotation;
-    if r.iter().flatten().any(|x| !x.is_finite()) {
-        return Some("the mount rotation holds a number that is not finite".into());
-    }
-    let dot = |i: usize, j: usize| (0..3).map(|k| r[i][k] * r[j][k]).sum::<f64>();
-    let worst = (0..3)
-        .flat_map(|i| (0..3).map(move |j| (i, j)))
-        .map(|(i, j)| (dot(i, j) - if i == j { 1.0 } else { 0.0 }).abs())
-        .fold(0.0, f64::max);
-    let det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1])
-        - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0])
-        + r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
-    if worst > UNIT_TOL {
-        Some(format!(
-            "the mount rotation is not orthonormal (off by {worst:.2e})"
-        ))
-    } else if det < 0.0 {
-        Some("the mount rotation is a reflection (determinant -1)".into())
-    } else {
-        None
-    }
+    let r = Mat3::from_fn(|i, j| m.rotation[i][j]);
+    check_rotation(&r, UNIT_TOL)
+        .err()
+        .map(|why| format!("the mount rotation {why}"))
 }
 
 /// Byte offset and length of `key` and its value at or after `from` (the whole text's
