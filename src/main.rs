@@ -31,6 +31,8 @@ enum Command {
     Log(cli::log::Args),
     /// Check that a run folder was not altered since the run.
     Verify(cli::verify::Args),
+    /// Locate where a recording and the nominal model disagree and name the physics left out.
+    Explain(cli::explain::Args),
 }
 
 fn main() -> ExitCode {
@@ -44,5 +46,6 @@ fn main() -> ExitCode {
         Command::Diff(a) => cli::diff::main(a),
         Command::Log(a) => cli::log::main(a),
         Command::Verify(a) => cli::verify::main(a),
+        Command::Explain(a) => cli::explain::main(a),
     }
 }

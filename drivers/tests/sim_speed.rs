@@ -73,9 +73,10 @@ async fn standard_procedure_motion_at_1khz() {
 #[test]
 #[ignore = "timing; run in release"]
 fn physics_cost_per_call() {
-    use ratecal_physics::{AxisMotion, ImuErrors, TableState, ideal_outputs};
+    use ratecal_physics::{AxisMotion, ImuErrors, Signals, TableState};
     let s = Station::default_sim();
-    let (geo, site, e) = (s.geometry(), s.site(), ImuErrors::default());
+    let (geo, site) = (s.geometry(), s.site());
+    let model = ImuErrors::default().model(&site);
     let wall = Instant::now();
     let mut acc = 0.0;
     let n = 1_000_000;
@@ -88,11 +89,11 @@ fn physics_cost_per_call() {
             },
             inner: AxisMotion::default(),
         };
-        let out = ideal_outputs(&st, &geo, &site, &e.lever_m);
-        acc += e.apply(&out, 20.0).0.x;
+        let sig = Signals::new(&st.snapshot(&geo, &site), &site, 0.0);
+        acc += model.outputs(&sig).0.x;
     }
     println!(
-        "{:.0} ns per ideal_outputs + apply ({acc})",
+        "{:.0} ns per snapshot + model outputs ({acc})",
         wall.elapsed().as_secs_f64() / n as f64 * 1e9
     );
 }

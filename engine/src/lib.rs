@@ -5,6 +5,7 @@
 
 pub mod audit;
 pub mod check;
+pub mod explain;
 pub mod fit;
 pub mod plan;
 pub mod recording;

@@ -412,7 +412,7 @@ pub enum SettleItem {
     Limit(Limit),
 }
 
-/// `fit <sensor> [<model>] [(axes)] from <patterns> [using <name>] [{ preprocessing }]`.
+/// `fit <sensor> [<model>] [(axes)] [with <effects>] from <patterns> [using <name>] [{ preprocessing }]`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Fit {
     /// `accel`, `gyro`, `size_effect`...
@@ -421,6 +421,8 @@ pub struct Fit {
     pub model: Option<Ident>,
     /// Declared axes.
     pub axes: Option<Vec<Ident>>,
+    /// `with lever_arm, time_offset`: catalogue effects added to the model.
+    pub with: Vec<Ident>,
     /// Segment patterns.
     pub from: Vec<Spanned<String>>,
     /// `using gyro_bias`.

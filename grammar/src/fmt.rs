@@ -304,6 +304,10 @@ fn fit(w: &mut Writer, f: &Fit) {
         let a: Vec<&str> = axes.iter().map(|a| a.node.as_str()).collect();
         head.push_str(&format!(" ({})", a.join(", ")));
     }
+    if !f.with.is_empty() {
+        let w: Vec<&str> = f.with.iter().map(|e| e.node.as_str()).collect();
+        head.push_str(&format!(" with {}", w.join(", ")));
+    }
     let pats: Vec<&str> = f.from.iter().map(|p| p.node.as_str()).collect();
     head.push_str(&format!(" from {}", pats.join(", ")));
     if let Some(u) = &f.using {

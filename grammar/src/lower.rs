@@ -510,6 +510,7 @@ fn fit(it: pest::iterators::Pairs<Rule>, _sp: Span) -> Fit {
     let mut sensor = None;
     let mut model = None;
     let mut axes = None;
+    let mut with = Vec::new();
     let mut from = Vec::new();
     let mut using = None;
     let mut options = None;
@@ -518,6 +519,7 @@ fn fit(it: pest::iterators::Pairs<Rule>, _sp: Span) -> Fit {
             Rule::ident if sensor.is_none() => sensor = Some(text(c)),
             Rule::ident => model = Some(text(c)),
             Rule::fit_axes => axes = Some(c.into_inner().map(text).collect()),
+            Rule::fit_with => with = c.into_inner().map(text).collect(),
             Rule::from_list => from = c.into_inner().map(text).collect(),
             Rule::pattern => using = Some(text(c)),
             _ => options = Some(block(c, Rule::fit_opt, fit_opt)),
@@ -527,6 +529,7 @@ fn fit(it: pest::iterators::Pairs<Rule>, _sp: Span) -> Fit {
         sensor: sensor.expect("fit sensor"),
         model,
         axes,
+        with,
         from,
         using,
         options,

@@ -158,6 +158,7 @@ impl TableState {
         let c_bl = (r_o * r_i * geo.c_pb).transpose();
         let rt_ao = r_i.transpose() * geo.outer_axis;
         Snapshot {
+            c_bl,
             c_bp: geo.c_pb.transpose(),
             w_p: rt_ao * self.outer.rate + geo.inner_axis * self.inner.rate,
             dw_p: dw_p(geo, &rt_ao, self),
@@ -176,6 +177,8 @@ fn dw_p(geo: &Geometry, rt_ao: &Vec3, s: &TableState) -> Vec3 {
 /// One table state's kinematics, rotations done: see [`TableState::snapshot`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Snapshot {
+    /// `C_LB^T`.
+    pub c_bl: Mat3,
     /// `C_PB^T`.
     pub c_bp: Mat3,
     /// `w_P`, rad/s.

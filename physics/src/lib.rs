@@ -5,19 +5,19 @@
 //! both the simulated station (which produces outputs from motion) and the analysis
 //! (which computes references from the table's feedback).
 
-mod effects;
+pub mod effects;
 mod frames;
 mod kinematics;
 mod model;
 pub mod units;
 
-pub use effects::{EFFECTS, EffectId, EffectInfo, effect};
+pub use effects::{Effect, ImuModel, REGISTRY, Sensor, Signals, effect};
 pub use frames::{NotARotation, check_rotation};
 pub use kinematics::{
     AxisMotion, DEG, EARTH_RATE_RADPS, Geometry, STANDARD_GRAVITY, Site, Snapshot, TableState,
     rotation, skew,
 };
-pub use model::{IdealOutputs, ImuErrors, ideal_outputs};
+pub use model::ImuErrors;
 
 /// 3-vector (f64).
 pub type Vec3 = nalgebra::Vector3<f64>;

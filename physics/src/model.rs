@@ -1,8 +1,9 @@
-//! The IMU measurement model (spec/physics.md, "The IMU measurement model"), noise-free.
-//! Noise, bias wander and the time offset belong to whoever produces samples (the
-//! simulator evaluates the motion at `t - tau`).
+//! The IMU's deterministic errors as a station states them (spec/physics.md, "The IMU
+//! measurement model"), and their translation into registry terms. The model itself (what
+//! each term adds) lives in the effect registry; this is only the truth's container.
 
-use crate::{DEG, Geometry, Mat3, Site, TableState, Vec3};
+use crate::effects::{ImuModel, Signals};
+use crate::{Geometry, Mat3, Site, TableState, Vec3};
 use serde::{Deserialize, Serialize};
 
 /// Deterministic error parameters of an IMU, in the spec's internal units.
@@ -28,6 +29,8 @@ pub struct ImuErrors {
     pub t_ref_c: f64,
     /// Gyro scale nonlinearity, ppm per deg/s: output gains `n_i w_i |w_i|`.
     pub gyro_nonlinearity: Vec3,
+    /// Time offset: the sample stamped t measured the motion at t - tau, s.
+    pub tau_s: f64,
 }
 
 impl Default for ImuErrors {
@@ -43,50 +46,51 @@ impl Default for ImuErrors {
             accel_thermal: Vec3::zeros(),
             t_ref_c: 20.0,
             gyro_nonlinearity: Vec3::zeros(),
+            tau_s: 0.0,
         }
     }
 }
 
-/// What ideal sensors read at one instant: specific force at each sensing point projected
-/// on its axis (m/s^2), inertial rate (deg/s), and specific force at the reference point.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct IdealOutputs {
-    /// `s_i = e_i . f_B(C_PB R_i)`, m/s^2.
-    pub s: Vec3,
-    /// `w_ib`, deg/s.
-    pub w_ib_dps: Vec3,
-    /// `f_B(0)`, m/s^2.
-    pub f_b0: Vec3,
-}
-
-/// Noise-free sensed quantities for a table state.
-pub fn ideal_outputs(
-    state: &TableState,
-    geo: &Geometry,
-    site: &Site,
-    lever_m: &Mat3,
-) -> IdealOutputs {
-    let snap = state.snapshot(geo, site);
-    let f_b0 = snap.f_b(&Vec3::zeros());
-    let mut s = Vec3::zeros();
-    for i in 0..3 {
-        let r_i: Vec3 = lever_m.row(i).transpose();
-        let f = if r_i == Vec3::zeros() {
-            f_b0
-        } else {
-            snap.f_b(&(geo.c_pb * r_i))
-        };
-        s[i] = f[i];
-    }
-    IdealOutputs {
-        s,
-        w_ib_dps: snap.w_ib() / DEG,
-        f_b0,
-    }
+fn offdiag(k: &Mat3) -> Vec<f64> {
+    [(0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1)]
+        .iter()
+        .map(|&(i, j)| k[(i, j)] * 1e3)
+        .collect()
 }
 
 impl ImuErrors {
-    /// Noise-free accelerometer (m/s^2) and gyro (deg/s) outputs at temperature `temp_c`.
+    /// These errors as registry terms at a site (the Earth's rate is one of them).
+    pub fn model(&self, site: &Site) -> ImuModel {
+        let mut m = ImuModel {
+            terms: Vec::new(),
+            t_ref_c: self.t_ref_c,
+        };
+        let v = |x: Vec3| x.iter().copied().collect::<Vec<f64>>();
+        let diag = |k: &Mat3| (0..3).map(|i| (k[(i, i)] - 1.0) * 1e6).collect::<Vec<f64>>();
+        m.push("accel_bias", v(self.b_a));
+        m.push("accel_scale", diag(&self.k_a));
+        m.push("gyro_bias", v(self.b_g));
+        m.push("gyro_scale", diag(&self.k_g));
+        m.push(
+            "earth_rate",
+            crate::effects::EarthRate::values(site.latitude_deg).to_vec(),
+        );
+        m.push("lever_arm", self.lever_m.transpose().iter().map(|x| x * 1e3).collect());
+        m.push("time_offset", vec![self.tau_s * 1e3]);
+        m.push("accel_misalignment", offdiag(&self.k_a));
+        m.push("gyro_misalignment", offdiag(&self.k_g));
+        m.push(
+            "g_sensitivity",
+            (self.g_sens.transpose() * site.gravity_mps2).iter().copied().collect(),
+        );
+        m.push("gyro_thermal_drift", v(self.gyro_thermal));
+        m.push("accel_thermal_drift", v(self.accel_thermal));
+        m.push("gyro_scale_nonlinearity", v(self.gyro_nonlinearity));
+        m
+    }
+
+    /// Noise-free accelerometer (m/s^2) and gyro (deg/s) outputs at temperature `temp_c`
+    /// for a table state (the motion itself, the time offset not applied).
     pub fn measure(
         &self,
         state: &TableState,
@@ -94,18 +98,8 @@ impl ImuErrors {
         site: &Site,
         temp_c: f64,
     ) -> (Vec3, Vec3) {
-        let ideal = ideal_outputs(state, geo, site, &self.lever_m);
-        self.apply(&ideal, temp_c)
-    }
-
-    /// Applies the error model to ideal sensed quantities.
-    pub fn apply(&self, ideal: &IdealOutputs, temp_c: f64) -> (Vec3, Vec3) {
-        let dt = temp_c - self.t_ref_c;
-        let a = self.k_a * ideal.s + self.b_a + self.accel_thermal * dt;
-        let w = ideal.w_ib_dps;
-        let nonlin = Vec3::from_fn(|i, _| self.gyro_nonlinearity[i] * 1e-6 * w[i] * w[i].abs());
-        let g =
-            self.k_g * w + self.b_g + self.gyro_thermal * dt + self.g_sens * ideal.f_b0 + nonlin;
-        (a, g)
+        let snap = state.snapshot(geo, site);
+        let s = Signals::new(&snap, site, temp_c - self.t_ref_c);
+        self.model(site).outputs(&s)
     }
 }

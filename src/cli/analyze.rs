@@ -74,7 +74,7 @@ pub fn main(args: Args) -> ExitCode {
 /// Loads and checks the procedure (a file, a folder's newest version, `folder@version`)
 /// with the SHA-256 of its canonical text; a checked plan serialized as JSON is accepted
 /// too (no hash then). Diagnostics go to standard error.
-fn load_plan(arg: &std::path::Path) -> Result<(Plan, Option<String>), ()> {
+pub(crate) fn load_plan(arg: &std::path::Path) -> Result<(Plan, Option<String>), ()> {
     if arg.extension().is_some_and(|e| e == "json") {
         let text = std::fs::read_to_string(arg)
             .map_err(|e| eprintln!("error: cannot read {}: {e}", arg.display()))?;

@@ -10,3 +10,13 @@ pub mod procedure;
 pub mod report;
 pub mod run;
 pub mod verify;
+pub mod explain;
+
+/// Writes to standard output; a closed pipe (`ratecal ... | head`) is not an error worth a
+/// panic: the caller ends quietly.
+pub fn print_out(s: &str) -> std::io::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    out.write_all(s.as_bytes())?;
+    out.flush()
+}

@@ -8,9 +8,7 @@ use async_trait::async_trait;
 use rand::rngs::ChaCha8Rng;
 use rand::{RngExt, SeedableRng};
 use rand_distr::StandardNormal;
-use ratecal_physics::{
-    AxisMotion, DEG, Geometry, IdealOutputs, ImuErrors, Mat3, Site, TableState, Vec3, ideal_outputs,
-};
+use ratecal_physics::{AxisMotion, DEG, Geometry, ImuModel, Mat3, Signals, Site, TableState, Vec3};
 
 /// The gyro bias wander is stepped at least this often (s); between steps it holds.
 const BIAS_STEP_S: f64 = 0.01;
@@ -19,7 +17,7 @@ const BIAS_STEP_S: f64 = 0.01;
 #[derive(Debug, Clone, Copy)]
 struct Cache {
     state: TableState,
-    ideal: IdealOutputs,
+    signals: Signals,
     temp: f64,
     outputs: (Vec3, Vec3),
 }
@@ -31,7 +29,8 @@ pub struct SimImu {
     info: ImuInfo,
     geo: Geometry,
     site: Site,
-    errors: ImuErrors,
+    /// The IMU's error model: registry terms (spec/physics.md), the Earth's rate among them.
+    model: ImuModel,
     tau: f64,
     next_k: u64,
     hints: [usize; 2],
@@ -66,6 +65,7 @@ impl SimImu {
         let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x1_0000_0000_1A1B);
         // Start the Gauss-Markov bias in its stationary distribution.
         let gm = [0; 3].map(|_| sigma_gm * rng.sample::<f64, _>(StandardNormal));
+        let model = station.imu_errors().model(&station.site());
         let dropouts = station
             .faults
             .iter()
@@ -89,8 +89,8 @@ impl SimImu {
             },
             geo: station.geometry(),
             site: station.site(),
-            errors: station.imu_errors(),
-            tau: station.time_offset_s(),
+            tau: model.delay_s(),
+            model,
             next_k: 0,
             hints: [0; 2],
             cache: None,
@@ -159,7 +159,9 @@ impl SimImu {
             let (a, g) = match &self.cache {
                 Some(c) if c.state == state && c.temp == temp => c.outputs,
                 Some(c) if c.state == state => {
-                    let outputs = self.errors.apply(&c.ideal, temp);
+                    let mut signals = c.signals;
+                    signals.dtemp_c = temp - self.model.t_ref_c;
+                    let outputs = self.model.outputs(&signals);
                     self.cache = Some(Cache {
                         temp,
                         outputs,
@@ -168,11 +170,12 @@ impl SimImu {
                     outputs
                 }
                 _ => {
-                    let ideal = ideal_outputs(&state, &self.geo, &self.site, &self.errors.lever_m);
-                    let outputs = self.errors.apply(&ideal, temp);
+                    let snap = state.snapshot(&self.geo, &self.site);
+                    let signals = Signals::new(&snap, &self.site, temp - self.model.t_ref_c);
+                    let outputs = self.model.outputs(&signals);
                     self.cache = Some(Cache {
                         state,
-                        ideal,
+                        signals,
                         temp,
                         outputs,
                     });

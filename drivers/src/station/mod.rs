@@ -123,6 +123,7 @@ impl Station {
             accel_thermal: axes(&fx.accel_thermal_drift),
             t_ref_c: self.temperature.reference.0,
             gyro_nonlinearity: axes(&fx.gyro_scale_nonlinearity),
+            tau_s: self.time_offset_s(),
         }
     }
 

@@ -489,6 +489,20 @@ impl Ck<'_> {
             }
             None => axes = (0..3).map(|i| (i, f.sensor.span)).collect(),
         }
+        for e in &f.with {
+            let known = ratecal_physics::effects::catalogue().any(|x| x.id() == e.node);
+            if !known {
+                let ids: Vec<&str> = ratecal_physics::effects::catalogue().map(|x| x.id()).collect();
+                self.err(
+                    Diagnostic::error(
+                        "check::unknown_effect",
+                        format!("unknown effect `{}`", e.node),
+                    )
+                    .label(e.span, "not an effect of the catalogue")
+                    .help(suggest(&e.node, &ids)),
+                );
+            }
+        }
         let (mut outliers, mut lowpass) = (None, None);
         for o in f.options.iter().flat_map(|b| &b.items) {
             match &o.node {
@@ -542,6 +556,7 @@ impl Ck<'_> {
             outliers,
             lowpass,
             using: f.using.as_ref().map(|u| u.node.clone()),
+            effects: f.with.iter().map(|e| e.node.clone()).collect(),
         });
         // Labels go on the fit's head (`fit accel bias_scale`), not its whole block.
         let head = f

@@ -12,14 +12,17 @@ mod accel;
 mod accept;
 mod allan;
 mod gyro;
+pub(crate) mod joint;
 mod lsq;
-mod prep;
+mod measured;
+pub(crate) mod prep;
 mod repeat;
 mod select;
 mod stats;
 mod temp;
 
 pub use allan::overlapping_adev;
+pub use measured::format_measured;
 pub use repeat::analyze_runs;
 
 use crate::plan::{Outliers, Plan};

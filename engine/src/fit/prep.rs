@@ -320,7 +320,7 @@ fn references(
 }
 
 /// Shortest signed angle step, deg (feedback may wrap at 360).
-fn unwrap(d: f64) -> f64 {
+pub(crate) fn unwrap(d: f64) -> f64 {
     d - 360.0 * (d / 360.0).round()
 }
 

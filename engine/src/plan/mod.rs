@@ -364,6 +364,9 @@ pub struct FitSpec {
     pub lowpass: Option<(u32, f64)>,
     /// `using gyro_bias`: segment (or fit step) whose result is held fixed.
     pub using: Option<String>,
+    /// `with lever_arm, ...`: catalogue effects (registry ids) added to the model.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub effects: Vec<String>,
 }
 
 /// Decision rule of an acceptance check.

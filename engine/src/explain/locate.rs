@@ -1,0 +1,86 @@
+//! Where a finding shows (segments, channels, spans, what the residual follows), and which
+//! other candidates the data cannot tell apart from it.
+
+use super::data::Data;
+use super::model::{Terms, fit};
+use super::output::Located;
+use super::select::Step;
+use crate::fit::joint::{CHANNELS, seg_rss};
+use crate::recording::Recording;
+
+/// Most entries reported per finding.
+const MOST: usize = 8;
+
+/// The segments and channels whose residual the effect reduced most, in units of the
+/// channel's noise (a reduction under 9, three standard deviations, is not listed unless
+/// nothing reaches it).
+pub(crate) fn locate(rec: &Recording, data: &Data, step: &Step) -> Vec<Located> {
+    let fx = data.layout.effects[step.effect];
+    let mut rows: Vec<(f64, Located)> = Vec::new();
+    for (i, acc) in data.accs.iter().enumerate() {
+        for c in 0..6 {
+            let sig = step.after.noise[c].sigma;
+            if sig <= 0.0 || acc.n == 0 {
+                continue;
+            }
+            let before = seg_rss(acc, &data.layout, c, &step.before.theta);
+            let after = seg_rss(acc, &data.layout, c, &step.after.theta);
+            let gain = (before - after) / (sig * sig);
+            if gain <= 0.0 {
+                continue;
+            }
+            let seg = &rec.manifest.segments[acc.seg];
+            rows.push((
+                gain,
+                Located {
+                    segment: seg.id.clone(),
+                    channel: CHANNELS[c].into(),
+                    t_start: seg.t_start,
+                    t_end: seg.t_end,
+                    rms_before: (before / acc.n as f64).sqrt(),
+                    rms_after: (after / acc.n as f64).sqrt(),
+                    correlates_with: fx.follows().into(),
+                    held_out: data.held.contains(&i),
+                },
+            ));
+        }
+    }
+    rows.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let strong = rows.iter().filter(|r| r.0 >= 9.0).count().max(1);
+    rows.into_iter()
+        .take(strong.min(MOST))
+        .map(|r| r.1)
+        .collect()
+}
+
+/// Candidates that, fitted beside `effect`, leave some of its parameters undetermined:
+/// their columns are (nearly) collinear with its own, so this recording cannot tell the
+/// two apart.
+pub(crate) fn confusions(data: &Data, terms: &Terms, effect: usize) -> Vec<String> {
+    let lay = &data.layout;
+    let work = data.working();
+    let (alone, un_alone) = fit(data, terms, &work, &work);
+    let _ = alone;
+    let mine: Vec<usize> = lay
+        .columns_of(effect)
+        .filter(|g| !un_alone.contains(g))
+        .collect();
+    let mut out = Vec::new();
+    for e in 0..lay.effects.len() {
+        if lay.effects[e].nominal() || terms.effects.contains(&e) {
+            continue;
+        }
+        let mut t = terms.clone();
+        t.effects.push(e);
+        let (f, un) = fit(data, &t, &work, &work);
+        let lost = mine.iter().any(|g| un.contains(g));
+        let tight = mine.iter().any(|&g| {
+            lay.columns_of(e)
+                .any(|h| f.estimated.contains(&h) && f.corr(g, h).abs() > 0.95)
+        });
+        if lost || tight {
+            out.push(lay.effects[e].id().to_string());
+        }
+    }
+    out
+}

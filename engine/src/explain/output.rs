@@ -1,0 +1,145 @@
+//! What explain reports: the `ratecal-explain/1` JSON (docs/explain.md), and its text form.
+
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// The format tag.
+pub const FORMAT: &str = "ratecal-explain/1";
+
+/// Residual RMS per sensor over every sample inside the segments considered.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Rms {
+    /// Accelerometers, m/s^2.
+    pub accel_mps2: f64,
+    /// Gyros, deg/s.
+    pub gyro_dps: f64,
+}
+
+/// The nominal model's figures.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Nominal {
+    /// Which model: `seed` (the standard's) or the procedure's name and version.
+    pub model: String,
+    /// Its terms.
+    pub terms: Vec<String>,
+    /// RMS over every segment of the recording.
+    pub rms: Rms,
+    /// RMS over the segments held out of the selection's fits.
+    pub holdout_rms: Rms,
+}
+
+/// Where an effect shows.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Located {
+    /// Segment id.
+    pub segment: String,
+    /// Channel, `ax` ... `gz`.
+    pub channel: String,
+    /// Time span of the segment, s.
+    pub t_start: f64,
+    /// End of the span, s.
+    pub t_end: f64,
+    /// Residual RMS there before the effect was modelled.
+    pub rms_before: f64,
+    /// After.
+    pub rms_after: f64,
+    /// What the residual follows there.
+    pub correlates_with: String,
+    /// Whether the segment was held out of the fit.
+    pub held_out: bool,
+}
+
+/// One parameter: an estimate, or what the motion lacked.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum ParamOut {
+    /// Estimated.
+    Estimate {
+        /// Value in the catalogue's unit.
+        value: f64,
+        /// Standard uncertainty.
+        u: f64,
+        /// Unit.
+        unit: String,
+    },
+    /// Not determined by this recording.
+    Unobservable {
+        /// Always false.
+        observable: bool,
+        /// The motion that would determine it.
+        needs: String,
+    },
+}
+
+/// Why explain believes a finding.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Evidence {
+    /// Wald statistic of the effect's parameters (honest covariance).
+    pub chi2: f64,
+    /// Its degrees of freedom.
+    pub dof: usize,
+    /// Probability of a statistic this large without the effect.
+    pub p_value: f64,
+    /// The selection's threshold on `p_value` at that step.
+    pub alpha: f64,
+    /// Held-out residual RMS before and after adding the effect.
+    pub holdout_rms_before: Rms,
+    /// After.
+    pub holdout_rms_after: Rms,
+    /// Candidates the data cannot tell apart from this one (collinear parameters).
+    pub not_separable_from: Vec<String>,
+}
+
+/// One effect the nominal model left out.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Finding {
+    /// Canonical id.
+    pub effect: String,
+    /// In an engineer's words.
+    pub explanation: String,
+    /// Where it shows.
+    pub located: Vec<Located>,
+    /// Its parameters.
+    pub parameters: BTreeMap<String, ParamOut>,
+    /// The statistics.
+    pub evidence: Evidence,
+    /// RMS over every segment once this effect (and those before it) is modelled.
+    pub rms_after: Rms,
+}
+
+/// The model with every finding.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Final {
+    /// Terms.
+    pub terms: Vec<String>,
+    /// RMS over every segment.
+    pub rms: Rms,
+    /// RMS over the held-out segments.
+    pub holdout_rms: Rms,
+    /// Noise floor per sensor (white noise of the residuals), for comparison.
+    pub noise_floor: Rms,
+}
+
+/// Everything explain says about a recording.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Explanation {
+    /// `ratecal-explain/1`.
+    pub format: String,
+    /// The recording's folder.
+    pub recording: String,
+    /// The nominal model.
+    pub nominal: Nominal,
+    /// Effects found, in the order they were selected.
+    pub findings: Vec<Finding>,
+    /// The final model.
+    #[serde(rename = "final")]
+    pub final_: Final,
+    /// Segments held out of every fit.
+    pub held_out: Vec<String>,
+    /// Candidates tried and not reported, with their last p-value.
+    pub rejected: BTreeMap<String, f64>,
+    /// How to adopt the findings: the effects to add to the procedure's fits.
+    pub adopt: Option<String>,
+    /// What could not be done as asked.
+    pub warnings: Vec<String>,
+}

@@ -1,0 +1,85 @@
+//! The text form of an explanation, for the terminal.
+
+use super::output::{Explanation, ParamOut, Rms};
+use crate::fit::format_measured;
+use std::fmt::Write;
+
+fn rms(r: &Rms) -> String {
+    format!("accel {:.3e} m/s^2, gyro {:.3e} deg/s", r.accel_mps2, r.gyro_dps)
+}
+
+/// Renders an explanation for a person.
+pub fn render_text(x: &Explanation) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "explain {}", x.recording);
+    let _ = writeln!(
+        s,
+        "nominal model ({}: {}): residual RMS {}",
+        x.nominal.model,
+        x.nominal.terms.join(", "),
+        rms(&x.nominal.rms)
+    );
+    if x.findings.is_empty() {
+        let _ = writeln!(s, "\nnothing found: the nominal model explains the recording to its noise");
+    }
+    for (k, f) in x.findings.iter().enumerate() {
+        let _ = writeln!(s, "\n{}. {}: {}", k + 1, f.effect, f.explanation);
+        let _ = writeln!(
+            s,
+            "   evidence: chi2 {:.1} on {} dof, p = {:.1e} (threshold {:.1e}); held-out RMS {} -> {}",
+            f.evidence.chi2,
+            f.evidence.dof,
+            f.evidence.p_value,
+            f.evidence.alpha,
+            rms(&f.evidence.holdout_rms_before),
+            rms(&f.evidence.holdout_rms_after)
+        );
+        if !f.evidence.not_separable_from.is_empty() {
+            let _ = writeln!(
+                s,
+                "   this recording cannot tell it apart from: {}",
+                f.evidence.not_separable_from.join(", ")
+            );
+        }
+        for l in &f.located {
+            let _ = writeln!(
+                s,
+                "   shows in {} {} ({:.1}-{:.1} s{}): RMS {:.3e} -> {:.3e}, follows {}",
+                l.segment,
+                l.channel,
+                l.t_start,
+                l.t_end,
+                if l.held_out { ", held out" } else { "" },
+                l.rms_before,
+                l.rms_after,
+                l.correlates_with
+            );
+        }
+        for (name, p) in &f.parameters {
+            match p {
+                ParamOut::Estimate { value, u, unit } => {
+                    let _ = writeln!(s, "   {name} = {}", format_measured(*value, *u, unit));
+                }
+                ParamOut::Unobservable { needs, .. } => {
+                    let _ = writeln!(s, "   {name}: not determined ({needs} to observe it)");
+                }
+            }
+        }
+        let _ = writeln!(s, "   residual RMS after: {}", rms(&f.rms_after));
+    }
+    let _ = writeln!(
+        s,
+        "\nfinal model: {}\n   RMS {} (held out: {}); noise floor {}",
+        x.final_.terms.join(", "),
+        rms(&x.final_.rms),
+        rms(&x.final_.holdout_rms),
+        rms(&x.final_.noise_floor)
+    );
+    if let Some(a) = &x.adopt {
+        let _ = writeln!(s, "to adopt: add `{a}` to the procedure's fit statements");
+    }
+    for w in &x.warnings {
+        let _ = writeln!(s, "warning: {w}");
+    }
+    s
+}

@@ -1,0 +1,186 @@
+//! One pass over a segment's samples: the kinematic signals at each IMU stamp (table
+//! feedback interpolated, through `ratecal_physics`), every effect's regressors, and per
+//! output channel the triangular factor of `[X y]` plus one-second block sums.
+
+use super::tri::Tri;
+use super::{CHANNELS, Layout, channel};
+use crate::fit::prep::unwrap;
+use crate::recording::Recording;
+use nalgebra::{DMatrix, DVector};
+use ratecal_physics::effects::{Partials, Sensor, Signals};
+use ratecal_physics::{AxisMotion, DEG, Geometry, Site, TableState};
+
+/// Length of the blocks kept for the noise analysis, s.
+pub(crate) const BLOCK_S: f64 = 1.0;
+
+/// Sums over one block of samples of one segment.
+#[derive(Debug, Clone)]
+pub(crate) struct Block {
+    /// Mean stamp, s.
+    pub t: f64,
+    /// Samples.
+    pub n: usize,
+    /// Per channel, the sum of each of its regressors.
+    pub sx: [Vec<f64>; 6],
+    /// Per channel, the sum of the observations.
+    pub sy: [f64; 6],
+}
+
+/// What a segment contributes to any fit.
+#[derive(Debug, Clone)]
+pub(crate) struct SegAcc {
+    /// Index of the segment in the manifest.
+    pub seg: usize,
+    /// Per channel, the factor of `[X y]` over the channel's columns.
+    pub r: [DMatrix<f64>; 6],
+    /// One-second blocks in time order.
+    pub blocks: Vec<Block>,
+    /// Samples.
+    pub n: usize,
+}
+
+/// The table state at each IMU stamp, from the feedback by linear interpolation; the
+/// angular acceleration is the slope of the interpolated rate (one feedback step: a wider
+/// difference would smear the start of the next motion into the end of a segment).
+pub(crate) fn state_at(rec: &Recording, j: &mut usize, t: f64) -> TableState {
+    let tab = &rec.table;
+    let last = tab.t.len().saturating_sub(2);
+    while *j < last && tab.t[*j + 1] <= t {
+        *j += 1;
+    }
+    let jj = (*j).min(last);
+    let (t0, t1) = (tab.t[jj], tab.t[jj + 1]);
+    let w = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
+    let lerp = |x: &[f64]| x[jj] + w * (x[jj + 1] - x[jj]);
+    let angle = |x: &[f64]| x[jj] + w * unwrap(x[jj + 1] - x[jj]);
+    let slope = |x: &[f64]| (x[jj + 1] - x[jj]) / (t1 - t0);
+    TableState {
+        outer: AxisMotion {
+            angle: angle(&tab.outer) * DEG,
+            rate: lerp(&tab.outer_rate) * DEG,
+            accel: slope(&tab.outer_rate) * DEG,
+        },
+        inner: AxisMotion {
+            angle: angle(&tab.inner) * DEG,
+            rate: lerp(&tab.inner_rate) * DEG,
+            accel: slope(&tab.inner_rate) * DEG,
+        },
+    }
+}
+
+/// Accumulates one segment. `t_ref_c` is the temperature the thermal terms refer to.
+pub(crate) fn accumulate(
+    rec: &Recording,
+    seg: usize,
+    geo: &Geometry,
+    layout: &Layout,
+    t_ref_c: f64,
+) -> SegAcc {
+    let s = &rec.manifest.segments[seg];
+    let site: Site = rec.manifest.station.site;
+    let imu = &rec.imu;
+    let a = imu.t.partition_point(|&t| t < s.t_start);
+    let b = imu.t.partition_point(|&t| t <= s.t_end);
+    let ncol = layout.cols.len();
+    let mut tris: Vec<Tri> = (0..6)
+        .map(|c| Tri::new(layout.by_channel[c].len() + 1))
+        .collect();
+    let mut parts = vec![Partials::default(); ncol];
+    let mut row: Vec<f64> = Vec::with_capacity(ncol + 1);
+    let mut blocks: Vec<Block> = Vec::new();
+    let new_block = |layout: &Layout| Block {
+        t: 0.0,
+        n: 0,
+        sx: std::array::from_fn(|c| vec![0.0; layout.by_channel[c].len()]),
+        sy: [0.0; 6],
+    };
+    let mut cur = new_block(layout);
+    let mut block_end = s.t_start + BLOCK_S;
+    let mut j = 0usize;
+    if rec.table.t.len() >= 2 {
+        j = rec
+            .table
+            .t
+            .partition_point(|&x| x <= imu.t.get(a).copied().unwrap_or(0.0))
+            .saturating_sub(1);
+    }
+    for i in a..b {
+        let t = imu.t[i];
+        if rec.table.t.len() < 2 {
+            break;
+        }
+        if t > block_end && cur.n > 0 {
+            cur.t /= cur.n as f64;
+            blocks.push(std::mem::replace(&mut cur, new_block(layout)));
+            block_end += BLOCK_S * ((t - block_end) / BLOCK_S).ceil().max(1.0);
+        }
+        let state = state_at(rec, &mut j, t);
+        let snap = state.snapshot(geo, &site);
+        let dtemp = imu.temp.as_ref().map_or(0.0, |tc| tc[i] - t_ref_c);
+        let sig = Signals::new(&snap, &site, if dtemp.is_finite() { dtemp } else { 0.0 });
+        for (e, fx) in layout.effects.iter().enumerate() {
+            fx.regressors(&sig, &mut parts[layout.columns_of(e)]);
+        }
+        let base_a = sig.f_b;
+        let base_g = sig.w_b_dps();
+        let out = [
+            imu.accel[0][i] - base_a.x,
+            imu.accel[1][i] - base_a.y,
+            imu.accel[2][i] - base_a.z,
+            imu.gyro[0][i] - base_g.x,
+            imu.gyro[1][i] - base_g.y,
+            imu.gyro[2][i] - base_g.z,
+        ];
+        if out.iter().any(|v| !v.is_finite()) {
+            continue;
+        }
+        for c in 0..6 {
+            let (sensor, ax) = channel(c);
+            row.clear();
+            for &g in &layout.by_channel[c] {
+                row.push(parts[g].of(sensor)[ax]);
+            }
+            row.push(out[c]);
+            tris[c].push(&row);
+            for (k, v) in row[..row.len() - 1].iter().enumerate() {
+                cur.sx[c][k] += v;
+            }
+            cur.sy[c] += out[c];
+        }
+        cur.t += t;
+        cur.n += 1;
+    }
+    if cur.n > 0 {
+        cur.t /= cur.n as f64;
+        blocks.push(cur);
+    }
+    let n = tris[0].n;
+    let mut it = tris.into_iter().map(Tri::finish);
+    SegAcc {
+        seg,
+        r: std::array::from_fn(|_| it.next().expect("six channels")),
+        blocks,
+        n,
+    }
+}
+
+/// Residual sum of squares of channel `c` of a segment for global coefficients `theta`
+/// (zero for columns outside the model): `|R [theta_c; -1]|^2`.
+pub(crate) fn seg_rss(acc: &SegAcc, layout: &Layout, c: usize, theta: &DVector<f64>) -> f64 {
+    let cols = &layout.by_channel[c];
+    let mut v = DVector::zeros(cols.len() + 1);
+    for (k, &g) in cols.iter().enumerate() {
+        v[k] = theta[g];
+    }
+    v[cols.len()] = -1.0;
+    (&acc.r[c] * v).norm_squared()
+}
+
+/// The sensor of a channel name, for messages.
+#[allow(dead_code)]
+pub(crate) fn sensor_of(name: &str) -> Option<Sensor> {
+    CHANNELS
+        .iter()
+        .position(|c| *c == name)
+        .map(|c| channel(c).0)
+}

@@ -1,0 +1,99 @@
+//! The noise of a fit's residuals, judged the way physics.md asks: white noise (with the
+//! correlation a low-pass filter leaves, from one-second block means) and a wandering
+//! bias (a random walk, from the growth of ten-second block-mean differences), so that
+//! slowly varying regressors are judged against the low-frequency noise.
+
+use super::accumulate::{Block, SegAcc};
+use nalgebra::{DMatrix, DVector};
+
+/// The noise model of one channel.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct ChannelNoise {
+    /// Residual standard deviation per sample.
+    pub sigma: f64,
+    /// Variance of a mean of n samples is `sigma^2 * phi / n` for white-like noise.
+    pub phi: f64,
+    /// Random-walk intensity of the residual, (unit^2) per second.
+    pub q: f64,
+}
+
+/// Residual mean of a block for coefficients `theta_c` (the channel's own columns).
+fn block_mean(b: &Block, c: usize, theta_c: &[f64]) -> f64 {
+    let mut s = b.sy[c];
+    for (x, th) in b.sx[c].iter().zip(theta_c) {
+        s -= x * th;
+    }
+    s / b.n as f64
+}
+
+/// Estimates the noise of channel `c` over the fitted segments.
+pub(crate) fn estimate(accs: &[&SegAcc], c: usize, theta_c: &[f64], sigma: f64) -> ChannelNoise {
+    // White-equivalent variance of a sample from adjacent one-second blocks.
+    let (mut num, mut den) = (0.0, 0.0);
+    // Random walk from ten-second groups.
+    let mut groups: Vec<(f64, f64, usize, f64)> = Vec::new(); // (segment-local order, t, n, mean)
+    let mut pairs = Vec::new();
+    for acc in accs {
+        let means: Vec<(f64, usize, f64)> = acc
+            .blocks
+            .iter()
+            .map(|b| (b.t, b.n, block_mean(b, c, theta_c)))
+            .collect();
+        for w in means.windows(2) {
+            let (n1, n2) = (w[0].1 as f64, w[1].1 as f64);
+            num += (w[1].2 - w[0].2).powi(2);
+            den += 1.0 / n1 + 1.0 / n2;
+        }
+        groups.clear();
+        for chunk in means.chunks(10) {
+            let n: usize = chunk.iter().map(|m| m.1).sum();
+            let t = chunk.iter().map(|m| m.0 * m.1 as f64).sum::<f64>() / n as f64;
+            let m = chunk.iter().map(|m| m.2 * m.1 as f64).sum::<f64>() / n as f64;
+            let span = chunk.len() as f64;
+            groups.push((span, t, n, m));
+        }
+        for w in groups.windows(2) {
+            pairs.push((w[0], w[1]));
+        }
+    }
+    let a = if den > 0.0 { num / den } else { sigma * sigma };
+    let phi = if sigma > 0.0 {
+        (a / (sigma * sigma)).max(1.0)
+    } else {
+        1.0
+    };
+    let a = sigma * sigma * phi;
+    let (mut qn, mut qd) = (0.0, 0.0);
+    for (g1, g2) in pairs {
+        let d2 = (g2.3 - g1.3).powi(2);
+        let white = a * (1.0 / g1.2 as f64 + 1.0 / g2.2 as f64);
+        let lag = (g2.1 - g1.1) - (g1.0 + g2.0) / 6.0;
+        if lag > 0.0 {
+            qn += d2 - white;
+            qd += lag;
+        }
+    }
+    let q = if qd > 0.0 { (qn / qd).max(0.0) } else { 0.0 };
+    ChannelNoise { sigma, phi, q }
+}
+
+/// `X^T Sigma_rw X / q` for a random walk starting at the first block: sums over the
+/// blocks in time order of the gap times the outer product of the regressor sums after it.
+pub(crate) fn random_walk_gram(accs: &[&SegAcc], c: usize, local: &[Option<usize>], p: usize) -> DMatrix<f64> {
+    let mut blocks: Vec<&Block> = accs.iter().flat_map(|a| a.blocks.iter()).collect();
+    blocks.sort_by(|a, b| a.t.total_cmp(&b.t));
+    let mut m = DMatrix::zeros(p, p);
+    let mut suffix = DVector::zeros(p);
+    // Walk backwards: suffix sums of the regressors after each gap.
+    for w in (1..blocks.len()).rev() {
+        let b = blocks[w];
+        for (k, x) in b.sx[c].iter().enumerate() {
+            if let Some(l) = local[k] {
+                suffix[l] += x;
+            }
+        }
+        let gap = b.t - blocks[w - 1].t;
+        m.ger(gap, &suffix, &suffix, 1.0);
+    }
+    m
+}

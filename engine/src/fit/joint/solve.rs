@@ -1,0 +1,267 @@
+//! Solving a model over a set of segments from the segments' triangular factors: the
+//! channels stacked with weights `1 / sigma^2`, a rank-revealing QR to find what the data
+//! cannot determine, back substitution, and the covariance with correlated noise.
+
+use super::accumulate::{SegAcc, seg_rss};
+use super::noise::{self, ChannelNoise};
+use super::tri::triangle;
+use super::{Layout, channel};
+use nalgebra::{DMatrix, DVector};
+use ratecal_physics::effects::Sensor;
+
+/// A model and the data to fit it to.
+#[derive(Debug, Clone)]
+pub(crate) struct FitRequest<'a> {
+    /// The layout the segments were accumulated with.
+    pub layout: &'a Layout,
+    /// Fitted columns (global indices).
+    pub cols: Vec<usize>,
+    /// Columns held at known values (subtracted from the observations).
+    pub fixed: Vec<(usize, f64)>,
+    /// Segments fitted for the accelerometers.
+    pub accel: Vec<&'a SegAcc>,
+    /// Segments fitted for the gyros.
+    pub gyro: Vec<&'a SegAcc>,
+}
+
+/// A solved model.
+#[derive(Debug, Clone)]
+pub(crate) struct Fit {
+    /// Global coefficients: estimates, fixed values, zero elsewhere.
+    pub theta: DVector<f64>,
+    /// Global covariance (zero rows for columns not estimated).
+    pub cov: DMatrix<f64>,
+    /// Columns asked for that the data cannot determine.
+    pub unobservable: Vec<usize>,
+    /// Estimated columns.
+    pub estimated: Vec<usize>,
+    /// Noise of each channel's residuals.
+    pub noise: [ChannelNoise; 6],
+    /// Residual sum of squares per channel over the fitted segments.
+    pub rss: [f64; 6],
+    /// Samples per channel.
+    pub n: [usize; 6],
+}
+
+impl Fit {
+    /// Standard uncertainty of column `g`.
+    pub(crate) fn u(&self, g: usize) -> f64 {
+        self.cov[(g, g)].max(0.0).sqrt()
+    }
+
+    /// Correlation of two columns.
+    pub(crate) fn corr(&self, a: usize, b: usize) -> f64 {
+        let d = (self.cov[(a, a)] * self.cov[(b, b)]).sqrt();
+        if d > 0.0 { self.cov[(a, b)] / d } else { 0.0 }
+    }
+}
+
+impl FitRequest<'_> {
+    fn segs(&self, c: usize) -> &[&SegAcc] {
+        match channel(c).0 {
+            Sensor::Accel => &self.accel,
+            Sensor::Gyro => &self.gyro,
+        }
+    }
+}
+
+/// The channel's factor over a set of segments.
+fn merged(segs: &[&SegAcc], c: usize, width: usize) -> DMatrix<f64> {
+    if segs.len() == 1 {
+        return segs[0].r[c].clone();
+    }
+    let rows: usize = segs.iter().map(|s| s.r[c].nrows()).sum();
+    let mut m = DMatrix::zeros(rows.max(width), width);
+    let mut at = 0;
+    for s in segs {
+        let k = s.r[c].nrows();
+        m.view_mut((at, 0), (k, width)).copy_from(&s.r[c]);
+        at += k;
+    }
+    triangle(m, width)
+}
+
+/// Solves the request. Columns that are not excited, or not separable from the others,
+/// are left out of the estimate and listed as unobservable.
+pub(crate) fn solve(req: &FitRequest) -> Fit {
+    let lay = req.layout;
+    let ncol = lay.cols.len();
+    let mut theta = DVector::zeros(ncol);
+    for &(g, v) in &req.fixed {
+        theta[g] = v;
+    }
+    // Per channel: the factor over the fitted segments, observations net of fixed terms.
+    let facs: Vec<DMatrix<f64>> = (0..6)
+        .map(|c| {
+            let w = lay.by_channel[c].len() + 1;
+            let mut f = merged(req.segs(c), c, w);
+            for (k, &g) in lay.by_channel[c].iter().enumerate() {
+                if theta[g] != 0.0 {
+                    let col = f.column(k) * theta[g];
+                    let mut y = f.column_mut(w - 1);
+                    y -= col;
+                }
+            }
+            f
+        })
+        .collect();
+    let n: [usize; 6] = std::array::from_fn(|c| req.segs(c).iter().map(|s| s.n).sum());
+    let mut cols: Vec<usize> = req.cols.clone();
+    cols.retain(|g| !req.fixed.iter().any(|f| f.0 == *g));
+    let mut unobservable = Vec::new();
+    // Weights: equal first, then 1 / sigma^2 from the first solution.
+    let mut w = [1.0f64; 6];
+    let mut noise = [ChannelNoise::default(); 6];
+    let mut rss = [0.0; 6];
+    let mut bread = DMatrix::zeros(0, 0);
+    for pass in 0..2 {
+        let stack = |cols: &[usize]| stacked(&facs, lay, cols, &w);
+        let mut r = stack(&cols);
+        let dropped = rank_deficient(&r, cols.len());
+        if !dropped.is_empty() {
+            for &d in dropped.iter().rev() {
+                unobservable.push(cols.remove(d));
+            }
+            r = stack(&cols);
+        }
+        let p = cols.len();
+        let rp = r.view((0, 0), (p, p)).clone_owned();
+        let z = r.view((0, p), (p, 1)).clone_owned();
+        let est: DVector<f64> = rp
+            .solve_upper_triangular(&z)
+            .map_or_else(|| DVector::zeros(p), |m| m.column(0).into_owned());
+        let inv = rp.solve_upper_triangular(&DMatrix::identity(p, p)).unwrap_or_else(|| DMatrix::zeros(p, p));
+        bread = &inv * inv.transpose();
+        let mut full = theta.clone();
+        for (l, &g) in cols.iter().enumerate() {
+            full[g] = est[l];
+        }
+        for c in 0..6 {
+            let k = lay.by_channel[c].len();
+            let mut v = DVector::zeros(k + 1);
+            for (i, &g) in lay.by_channel[c].iter().enumerate() {
+                if cols.contains(&g) {
+                    v[i] = full[g];
+                }
+            }
+            v[k] = -1.0;
+            rss[c] = (&facs[c] * v).norm_squared();
+            let pc = lay.by_channel[c].iter().filter(|g| cols.contains(g)).count();
+            let dof = n[c].saturating_sub(pc).max(1) as f64;
+            let sigma = (rss[c] / dof).sqrt();
+            let theta_c: Vec<f64> = lay.by_channel[c].iter().map(|&g| full[g]).collect();
+            noise[c] = noise::estimate(req.segs(c), c, &theta_c, sigma);
+            if pass == 0 {
+                w[c] = if sigma > 0.0 { 1.0 / (sigma * sigma) } else { 1.0 };
+            }
+        }
+        if pass == 1 {
+            theta = full;
+        }
+    }
+    // Sandwich: bread (in weighted units) around the white and random-walk parts.
+    let p = cols.len();
+    let mut meat = DMatrix::zeros(p, p);
+    for c in 0..6 {
+        if n[c] == 0 {
+            continue;
+        }
+        let local: Vec<Option<usize>> = lay.by_channel[c]
+            .iter()
+            .map(|g| cols.iter().position(|x| x == g))
+            .collect();
+        let k = local.len();
+        let xr = facs[c].view((0, 0), (k + 1, k)).clone_owned();
+        let mut xl = DMatrix::zeros(k + 1, p);
+        for (i, l) in local.iter().enumerate() {
+            if let Some(l) = l {
+                xl.set_column(*l, &xr.column(i));
+            }
+        }
+        let nz = &noise[c];
+        let white = nz.sigma * nz.sigma * nz.phi;
+        meat += (xl.transpose() * &xl) * (w[c] * w[c] * white);
+        if nz.q > 0.0 {
+            let m = noise::random_walk_gram(req.segs(c), c, &local, p);
+            meat += m * (w[c] * w[c] * nz.q);
+        }
+    }
+    let cov_l = &bread * meat * &bread;
+    let mut cov = DMatrix::zeros(ncol, ncol);
+    for (a, &ga) in cols.iter().enumerate() {
+        for (b, &gb) in cols.iter().enumerate() {
+            cov[(ga, gb)] = cov_l[(a, b)];
+        }
+    }
+    unobservable.sort_unstable();
+    Fit {
+        theta,
+        cov,
+        unobservable,
+        estimated: cols,
+        noise,
+        rss,
+        n,
+    }
+}
+
+/// The weighted stack of every channel's factor over `cols`, triangulated.
+fn stacked(facs: &[DMatrix<f64>], lay: &Layout, cols: &[usize], w: &[f64; 6]) -> DMatrix<f64> {
+    let p = cols.len();
+    let rows: usize = facs.iter().map(|f| f.nrows()).sum();
+    let mut m = DMatrix::zeros(rows.max(p + 1), p + 1);
+    let mut at = 0;
+    for c in 0..6 {
+        let f = &facs[c];
+        let k = lay.by_channel[c].len();
+        let s = w[c].sqrt();
+        for (i, g) in lay.by_channel[c].iter().enumerate() {
+            if let Some(l) = cols.iter().position(|x| x == g) {
+                for r in 0..f.nrows() {
+                    m[(at + r, l)] = f[(r, i)] * s;
+                }
+            }
+        }
+        for r in 0..f.nrows() {
+            m[(at + r, p)] = f[(r, k)] * s;
+        }
+        at += f.nrows();
+    }
+    triangle(m, p + 1)
+}
+
+/// Local indices of the columns of a factor that are zero or linearly dependent on the
+/// others (after scaling every column to unit norm), in ascending order.
+fn rank_deficient(r: &DMatrix<f64>, p: usize) -> Vec<usize> {
+    if p == 0 {
+        return Vec::new();
+    }
+    let rp = r.view((0, 0), (p, p)).clone_owned();
+    let norms: Vec<f64> = (0..p).map(|j| rp.column(j).norm()).collect();
+    let mut bad: Vec<usize> = (0..p).filter(|&j| !(norms[j] > 1e-300)).collect();
+    let good: Vec<usize> = (0..p).filter(|j| !bad.contains(j)).collect();
+    if !good.is_empty() {
+        let scaled = DMatrix::from_fn(p, good.len(), |i, j| rp[(i, good[j])] / norms[good[j]]);
+        let qr = scaled.col_piv_qr();
+        let rr = qr.r();
+        let mut order = DMatrix::from_fn(1, good.len(), |_, j| j as f64);
+        qr.p().permute_columns(&mut order);
+        let k = rr.nrows().min(rr.ncols());
+        for i in 0..good.len() {
+            let d = if i < k { rr[(i, i)].abs() } else { 0.0 };
+            if d < 1e-7 {
+                bad.push(good[order[(0, i)] as usize]);
+            }
+        }
+    }
+    bad.sort_unstable();
+    bad.dedup();
+    bad
+}
+
+/// Residual sum of squares of channel `c` over some segments for a fit's coefficients.
+pub(crate) fn rss_on(fit: &Fit, lay: &Layout, segs: &[&SegAcc], c: usize) -> (f64, usize) {
+    segs.iter().fold((0.0, 0), |(s, n), a| {
+        (s + seg_rss(a, lay, c, &fit.theta), n + a.n)
+    })
+}

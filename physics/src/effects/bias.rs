@@ -1,0 +1,72 @@
+//! The nominal biases: outputs at zero input.
+
+use super::{Effect, Param, Partials, Sensor, Signals, per_axis};
+
+/// A bias of one sensor triad.
+#[derive(Debug)]
+pub struct Bias {
+    sensor: Sensor,
+    params: &'static [Param],
+}
+
+const NEEDS: [&str; 3] = ["any data of the sensor"; 3];
+
+/// `accel_bias`: accelerometer outputs at zero input, m/s^2.
+pub static ACCEL_BIAS: Bias = Bias {
+    sensor: Sensor::Accel,
+    params: &per_axis!(Sensor::Accel, "m/s^2", NEEDS),
+};
+
+/// `gyro_bias`: gyro outputs at zero input, deg/s.
+pub static GYRO_BIAS: Bias = Bias {
+    sensor: Sensor::Gyro,
+    params: &per_axis!(Sensor::Gyro, "deg/s", NEEDS),
+};
+
+impl Effect for Bias {
+    fn id(&self) -> &'static str {
+        match self.sensor {
+            Sensor::Accel => "accel_bias",
+            Sensor::Gyro => "gyro_bias",
+        }
+    }
+
+    fn explanation(&self) -> &'static str {
+        match self.sensor {
+            Sensor::Accel => "each accelerometer reads a constant offset at zero input",
+            Sensor::Gyro => "each gyro reads a constant offset at zero input",
+        }
+    }
+
+    fn follows(&self) -> &'static str {
+        match self.sensor {
+            Sensor::Accel => "nothing: a constant",
+            Sensor::Gyro => "nothing: a constant",
+        }
+    }
+
+    fn params(&self) -> &'static [Param] {
+        self.params
+    }
+
+    fn nominal(&self) -> bool {
+        true
+    }
+
+    fn sensors(&self) -> &'static [Sensor] {
+        match self.sensor {
+            Sensor::Accel => &[Sensor::Accel],
+            Sensor::Gyro => &[Sensor::Gyro],
+        }
+    }
+
+    fn regressors(&self, _s: &Signals, out: &mut [Partials]) {
+        for (i, p) in out.iter_mut().enumerate() {
+            *p = Partials::default();
+            match self.sensor {
+                Sensor::Accel => p.accel[i] = 1.0,
+                Sensor::Gyro => p.gyro[i] = 1.0,
+            }
+        }
+    }
+}

@@ -1,0 +1,67 @@
+//! `g_sensitivity`: the gyro bias depends on specific force (`G`; `<i><j>_dps_per_g` =
+//! `G[i][j]` * g).
+
+use super::{Effect, Param, Partials, Sensor, Signals};
+
+/// The `g_sensitivity` effect.
+#[derive(Debug)]
+pub struct GSensitivity;
+
+/// The registry's instance.
+pub static G_SENSITIVITY: GSensitivity = GSensitivity;
+
+const fn p(name: &'static str, i: usize, needs: &'static str) -> Param {
+    Param {
+        name,
+        unit: "deg/s per g",
+        channel: Some((Sensor::Gyro, i)),
+        needs,
+    }
+}
+
+static PARAMS: [Param; 9] = [
+    p("xx_dps_per_g", 0, "attitudes with gravity along +X and -X"),
+    p("xy_dps_per_g", 0, "attitudes with gravity along +Y and -Y"),
+    p("xz_dps_per_g", 0, "attitudes with gravity along +Z and -Z"),
+    p("yx_dps_per_g", 1, "attitudes with gravity along +X and -X"),
+    p("yy_dps_per_g", 1, "attitudes with gravity along +Y and -Y"),
+    p("yz_dps_per_g", 1, "attitudes with gravity along +Z and -Z"),
+    p("zx_dps_per_g", 2, "attitudes with gravity along +X and -X"),
+    p("zy_dps_per_g", 2, "attitudes with gravity along +Y and -Y"),
+    p("zz_dps_per_g", 2, "attitudes with gravity along +Z and -Z"),
+];
+
+impl Effect for GSensitivity {
+    fn id(&self) -> &'static str {
+        "g_sensitivity"
+    }
+
+    fn explanation(&self) -> &'static str {
+        "the gyro bias depends on the specific force: it changes with the attitude relative to gravity"
+    }
+
+    fn follows(&self) -> &'static str {
+        "the attitude relative to gravity (specific force)"
+    }
+
+    fn params(&self) -> &'static [Param] {
+        &PARAMS
+    }
+
+    fn sensors(&self) -> &'static [Sensor] {
+        &[Sensor::Gyro]
+    }
+
+    fn regressors(&self, s: &Signals, out: &mut [Partials]) {
+        for i in 0..3 {
+            for j in 0..3 {
+                let mut v = crate::Vec3::zeros();
+                v[i] = s.f_b[j] / s.g;
+                out[3 * i + j] = Partials {
+                    gyro: v,
+                    ..Default::default()
+                };
+            }
+        }
+    }
+}

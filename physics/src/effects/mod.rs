@@ -1,0 +1,175 @@
+//! The effect registry: every term of the IMU measurement model (spec/physics.md), the
+//! nominal ones (bias, scale) and every catalogue effect, as one piece of code each.
+//!
+//! An effect knows its canonical id and parameters, explains itself in one line, gives
+//! its forward contribution (what the simulator adds to the ideal outputs) and its
+//! regressors (the partial derivatives of the six outputs with respect to its parameters),
+//! all from the same [`Signals`] of one instant. The simulator, the station loader, the
+//! checker, the analysis and explain read this one list: adding an effect is adding a
+//! file here and a line to [`REGISTRY`].
+
+mod bias;
+mod earth_rate;
+mod g_sensitivity;
+mod lever_arm;
+mod misalignment;
+mod model;
+mod nonlinearity;
+mod scale;
+mod signals;
+mod thermal;
+mod time_offset;
+
+pub use earth_rate::EarthRate;
+pub use misalignment::pair as misalignment_pair;
+pub use model::{ImuModel, Term};
+pub use signals::Signals;
+
+use crate::Vec3;
+
+/// Which sensor triad an output or a parameter belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Sensor {
+    /// Accelerometers, m/s^2.
+    Accel,
+    /// Gyroscopes, deg/s.
+    Gyro,
+}
+
+impl Sensor {
+    /// `accel` or `gyro`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Sensor::Accel => "accel",
+            Sensor::Gyro => "gyro",
+        }
+    }
+}
+
+/// One parameter of an effect, as physics.md names it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Param {
+    /// Canonical name, e.g. `rxz_mm`.
+    pub name: &'static str,
+    /// Unit as reported, e.g. `mm`.
+    pub unit: &'static str,
+    /// The output channels it acts on: `(sensor, axis)`; `None` for every axis of the
+    /// effect's sensors.
+    pub channel: Option<(Sensor, usize)>,
+    /// The motion that excites it, in an engineer's words ("rotate about Z").
+    pub needs: &'static str,
+}
+
+/// The six output channels' partial derivatives with respect to one parameter.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Partials {
+    /// d(accel outputs)/d(param), m/s^2 per parameter unit.
+    pub accel: Vec3,
+    /// d(gyro outputs)/d(param), deg/s per parameter unit.
+    pub gyro: Vec3,
+}
+
+impl Partials {
+    /// The partials of one sensor.
+    pub fn of(&self, s: Sensor) -> &Vec3 {
+        match s {
+            Sensor::Accel => &self.accel,
+            Sensor::Gyro => &self.gyro,
+        }
+    }
+}
+
+/// One term of the measurement model.
+pub trait Effect: Send + Sync + std::fmt::Debug {
+    /// Canonical id (`lever_arm`; the nominal terms are `accel_bias`, `gyro_scale`, ...).
+    fn id(&self) -> &'static str;
+    /// What physics it is, in one line an engineer reads in a report.
+    fn explanation(&self) -> &'static str;
+    /// What a residual that this term explains correlates with, for locating it.
+    fn follows(&self) -> &'static str;
+    /// Its parameters, in the catalogue's order.
+    fn params(&self) -> &'static [Param];
+    /// Whether it belongs to the nominal model (bias, scale) rather than the catalogue.
+    fn nominal(&self) -> bool {
+        false
+    }
+    /// Partial derivatives of the outputs with respect to each parameter at this instant,
+    /// written to `out` (as long as [`Effect::params`]).
+    fn regressors(&self, s: &Signals, out: &mut [Partials]);
+    /// What this term adds to the ideal outputs for these parameter values. The default is
+    /// linear in the parameters; effects that are not override it.
+    fn forward(&self, values: &[f64], s: &Signals) -> Partials {
+        let mut parts = [Partials::default(); 16];
+        let n = self.params().len();
+        self.regressors(s, &mut parts[..n]);
+        let mut out = Partials::default();
+        for (v, p) in values.iter().zip(&parts[..n]) {
+            out.accel += p.accel * *v;
+            out.gyro += p.gyro * *v;
+        }
+        out
+    }
+    /// How much later than the motion the samples are stamped, s (the time offset).
+    fn delay_s(&self, _values: &[f64]) -> f64 {
+        0.0
+    }
+    /// The sensors whose outputs it touches.
+    fn sensors(&self) -> &'static [Sensor];
+}
+
+/// Every effect, the nominal terms first, then the catalogue in physics.md's order.
+pub static REGISTRY: &[&dyn Effect] = &[
+    &bias::ACCEL_BIAS,
+    &scale::ACCEL_SCALE,
+    &bias::GYRO_BIAS,
+    &scale::GYRO_SCALE,
+    &earth_rate::EARTH_RATE,
+    &lever_arm::LEVER_ARM,
+    &time_offset::TIME_OFFSET,
+    &misalignment::ACCEL_MISALIGNMENT,
+    &misalignment::GYRO_MISALIGNMENT,
+    &g_sensitivity::G_SENSITIVITY,
+    &thermal::GYRO_THERMAL_DRIFT,
+    &thermal::ACCEL_THERMAL_DRIFT,
+    &nonlinearity::GYRO_SCALE_NONLINEARITY,
+];
+
+/// Looks an effect up by its canonical id.
+pub fn effect(id: &str) -> Option<&'static dyn Effect> {
+    REGISTRY.iter().copied().find(|e| e.id() == id)
+}
+
+/// The catalogue ids (every effect that is not a nominal term), in physics.md's order.
+pub fn catalogue() -> impl Iterator<Item = &'static dyn Effect> {
+    REGISTRY.iter().copied().filter(|e| !e.nominal())
+}
+
+/// Per-axis parameters `x`, `y`, `z` of one sensor, with a unit and what excites them.
+macro_rules! per_axis {
+    ($sensor:expr, $unit:expr, $needs:expr) => {
+        [
+            $crate::effects::Param {
+                name: "x",
+                unit: $unit,
+                channel: Some(($sensor, 0)),
+                needs: $needs[0],
+            },
+            $crate::effects::Param {
+                name: "y",
+                unit: $unit,
+                channel: Some(($sensor, 1)),
+                needs: $needs[1],
+            },
+            $crate::effects::Param {
+                name: "z",
+                unit: $unit,
+                channel: Some(($sensor, 2)),
+                needs: $needs[2],
+            },
+        ]
+    };
+}
+pub(crate) use per_axis;
+
+#[cfg(test)]
+mod tests;

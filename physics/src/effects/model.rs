@@ -1,0 +1,53 @@
+//! A measurement model as a list of registry terms with values: what the simulator
+//! applies to the ideal outputs.
+
+use super::{Effect, Signals};
+use crate::Vec3;
+
+/// One effect with its parameter values (in the catalogue's units).
+#[derive(Debug, Clone)]
+pub struct Term {
+    /// The effect.
+    pub effect: &'static dyn Effect,
+    /// One value per parameter.
+    pub values: Vec<f64>,
+}
+
+/// The IMU's deterministic behaviour: the ideal outputs plus every term's contribution.
+#[derive(Debug, Clone, Default)]
+pub struct ImuModel {
+    /// The terms, in any order (they add).
+    pub terms: Vec<Term>,
+    /// Reference temperature of the thermal terms, degC.
+    pub t_ref_c: f64,
+}
+
+impl ImuModel {
+    /// Adds a term when any of its values is not zero.
+    pub fn push(&mut self, id: &str, values: Vec<f64>) {
+        if values.iter().any(|v| *v != 0.0) {
+            let effect = super::effect(id).expect("a registry id");
+            assert_eq!(values.len(), effect.params().len(), "{id}: one value a parameter");
+            self.terms.push(Term { effect, values });
+        }
+    }
+
+    /// Noise-free accelerometer (m/s^2) and gyro (deg/s) outputs for these signals. The
+    /// ideal outputs are the specific force at the reference point and the body rate
+    /// relative to the lab; the Earth's rate, like everything else, is a term.
+    pub fn outputs(&self, s: &Signals) -> (Vec3, Vec3) {
+        let mut a = s.f_b;
+        let mut g = s.w_b_dps();
+        for t in &self.terms {
+            let p = t.effect.forward(&t.values, s);
+            a += p.accel;
+            g += p.gyro;
+        }
+        (a, g)
+    }
+
+    /// How long after the motion the samples are stamped, s.
+    pub fn delay_s(&self) -> f64 {
+        self.terms.iter().map(|t| t.effect.delay_s(&t.values)).sum()
+    }
+}

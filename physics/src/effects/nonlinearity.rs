@@ -1,0 +1,50 @@
+//! `gyro_scale_nonlinearity`: each gyro output gains `n_i w_i |w_i|` (ppm per deg/s).
+
+use super::{Effect, Param, Partials, Sensor, Signals, per_axis};
+
+/// The `gyro_scale_nonlinearity` effect.
+#[derive(Debug)]
+pub struct Nonlinearity;
+
+/// The registry's instance.
+pub static GYRO_SCALE_NONLINEARITY: Nonlinearity = Nonlinearity;
+
+static PARAMS: [Param; 3] = per_axis!(
+    Sensor::Gyro,
+    "ppm per deg/s",
+    [
+        "rate points of several magnitudes about X",
+        "rate points of several magnitudes about Y",
+        "rate points of several magnitudes about Z"
+    ]
+);
+
+impl Effect for Nonlinearity {
+    fn id(&self) -> &'static str {
+        "gyro_scale_nonlinearity"
+    }
+
+    fn explanation(&self) -> &'static str {
+        "the gyro scale factor changes with the rate: the output error grows with the square of the rate"
+    }
+
+    fn follows(&self) -> &'static str {
+        "the signed square of the rate"
+    }
+
+    fn params(&self) -> &'static [Param] {
+        &PARAMS
+    }
+
+    fn sensors(&self) -> &'static [Sensor] {
+        &[Sensor::Gyro]
+    }
+
+    fn regressors(&self, s: &Signals, out: &mut [Partials]) {
+        let w = s.w_ib_dps();
+        for (i, p) in out.iter_mut().enumerate() {
+            *p = Partials::default();
+            p.gyro[i] = 1e-6 * w[i] * w[i].abs();
+        }
+    }
+}

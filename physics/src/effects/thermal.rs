@@ -1,0 +1,66 @@
+//! `gyro_thermal_drift` and `accel_thermal_drift`: biases that follow the IMU's internal
+//! temperature, `b(T) = b0 + k (T - T_ref)`.
+
+use super::{Effect, Param, Partials, Sensor, Signals, per_axis};
+
+/// The thermal drift of one sensor triad's biases.
+#[derive(Debug)]
+pub struct ThermalDrift {
+    sensor: Sensor,
+    params: &'static [Param],
+}
+
+const NEEDS: [&str; 3] = ["a change of the IMU's temperature during the data"; 3];
+
+/// `gyro_thermal_drift`, deg/s per degC.
+pub static GYRO_THERMAL_DRIFT: ThermalDrift = ThermalDrift {
+    sensor: Sensor::Gyro,
+    params: &per_axis!(Sensor::Gyro, "deg/s per degC", NEEDS),
+};
+
+/// `accel_thermal_drift`, m/s^2 per degC.
+pub static ACCEL_THERMAL_DRIFT: ThermalDrift = ThermalDrift {
+    sensor: Sensor::Accel,
+    params: &per_axis!(Sensor::Accel, "m/s^2 per degC", NEEDS),
+};
+
+impl Effect for ThermalDrift {
+    fn id(&self) -> &'static str {
+        match self.sensor {
+            Sensor::Accel => "accel_thermal_drift",
+            Sensor::Gyro => "gyro_thermal_drift",
+        }
+    }
+
+    fn explanation(&self) -> &'static str {
+        match self.sensor {
+            Sensor::Accel => "the accelerometer biases follow the IMU's internal temperature",
+            Sensor::Gyro => "the gyro biases follow the IMU's internal temperature",
+        }
+    }
+
+    fn follows(&self) -> &'static str {
+        "the IMU temperature"
+    }
+
+    fn params(&self) -> &'static [Param] {
+        self.params
+    }
+
+    fn sensors(&self) -> &'static [Sensor] {
+        match self.sensor {
+            Sensor::Accel => &[Sensor::Accel],
+            Sensor::Gyro => &[Sensor::Gyro],
+        }
+    }
+
+    fn regressors(&self, s: &Signals, out: &mut [Partials]) {
+        for (i, p) in out.iter_mut().enumerate() {
+            *p = Partials::default();
+            match self.sensor {
+                Sensor::Accel => p.accel[i] = s.dtemp_c,
+                Sensor::Gyro => p.gyro[i] = s.dtemp_c,
+            }
+        }
+    }
+}
