@@ -57,12 +57,12 @@ pub(crate) fn p_value(chi2: f64, dof: usize) -> f64 {
     ChiSquared::new(dof as f64).map_or(1.0, |d| d.sf(chi2))
 }
 
-/// Wilson-Hilferty normal score of a chi-square statistic: comparable across degrees of
-/// freedom where p-values underflow.
-fn score(chi2: f64, dof: usize) -> f64 {
-    let k = dof as f64;
-    let a = 2.0 / (9.0 * k);
-    ((chi2 / k).cbrt() - (1.0 - a)) / a.sqrt()
+/// The drop of the Bayesian information criterion an effect brings: its statistic less
+/// `ln(n)` per parameter. Among significant candidates the one that explains most per
+/// parameter wins, so a general term (nine g-sensitivities) does not take the place of
+/// the physics it contains (the Earth's rate, two parameters).
+fn score(chi2: f64, dof: usize, n: usize) -> f64 {
+    chi2 - dof as f64 * (n.max(2) as f64).ln()
 }
 
 /// Held-out misfit in units of each channel's noise under `base`.
@@ -97,6 +97,7 @@ pub(crate) fn forward(
                 && !terms.fixed.iter().any(|f| f.0 == *e)
         })
         .collect();
+    let n: usize = work.iter().map(|&i| 6 * data.accs[i].n).sum();
     let mut steps = Vec::new();
     let mut last_p = std::collections::BTreeMap::new();
     loop {
@@ -124,7 +125,8 @@ pub(crate) fn forward(
             last_p.insert(lay.effects[c.0].id().to_string(), c.5);
             let held_ok = data.held.is_empty() || c.6 < base_hold;
             if c.4 > 0 && c.5 < a && held_ok {
-                let better = best.is_none_or(|b| score(c.3, c.4) > score(tried[b].3, tried[b].4));
+                let better = best
+                    .is_none_or(|b| score(c.3, c.4, n) > score(tried[b].3, tried[b].4, n));
                 if better {
                     best = Some(k);
                 }
