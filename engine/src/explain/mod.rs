@@ -89,6 +89,12 @@ pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Expla
         Some(s) => (s.after.clone(), ()),
         None => (fit(&data, &start, &work, &work).0, ()),
     };
+    if std::env::var_os("RATECAL_DEBUG_EXPLAIN").is_some() {
+        eprintln!("noise {:?}\nrejected {:?}", last.noise, rejected);
+        for st in &steps {
+            eprintln!("step {} chi2 {} dof {}", lay.effects[st.effect].id(), st.chi2, st.dof);
+        }
+    }
     let floor = |cs: std::ops::Range<usize>| {
         let v: Vec<f64> = cs.map(|c| last.noise[c].sigma.powi(2)).collect();
         (v.iter().sum::<f64>() / v.len() as f64).sqrt()

@@ -132,7 +132,27 @@ pub(crate) fn forward(
                 }
             }
         }
-        let Some(b) = best else { break };
+        let Some(mut b) = best else { break };
+        // Occam: a significant candidate with fewer parameters that the winner contains
+        // (fitted together, some of its columns are not separable from the winner's) is
+        // the physics; the winner only mimics it with more freedom.
+        let mut simpler: Vec<usize> = (0..tried.len())
+            .filter(|&k| {
+                let c = &tried[k];
+                c.4 > 0 && c.4 < tried[b].4 && c.5 < a && (data.held.is_empty() || c.6 < base_hold)
+            })
+            .collect();
+        simpler.sort_by_key(|&k| tried[k].4);
+        for k in simpler {
+            let mut t = terms.clone();
+            t.effects.push(tried[b].0);
+            t.effects.push(tried[k].0);
+            let (_, un) = fit(data, &t, &work, &work);
+            if lay.columns_of(tried[k].0).any(|g| un.contains(&g) && !tried[k].2.contains(&g)) {
+                b = k;
+                break;
+            }
+        }
         let (e, f, un, chi2, dof, p, _) = tried.into_iter().nth(b).expect("chosen");
         last_p.remove(lay.effects[e].id());
         terms.effects.push(e);

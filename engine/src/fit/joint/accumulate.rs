@@ -82,6 +82,23 @@ pub(crate) fn accumulate(
     let a = imu.t.partition_point(|&t| t < s.t_start);
     let b = imu.t.partition_point(|&t| t <= s.t_end);
     let ncol = layout.cols.len();
+    let at_rest = s.kind == crate::recording::SegmentKind::Static;
+    let steady = s.kind == crate::recording::SegmentKind::Rate;
+    let mean_rates = {
+        let tab = &rec.table;
+        let (lo, hi) = (
+            tab.t.partition_point(|&x| x < s.t_start),
+            tab.t.partition_point(|&x| x <= s.t_end),
+        );
+        let m = |r: &[f64]| {
+            if hi > lo {
+                r[lo..hi].iter().sum::<f64>() / (hi - lo) as f64 * DEG
+            } else {
+                0.0
+            }
+        };
+        (m(&tab.outer_rate), m(&tab.inner_rate))
+    };
     let mut tris: Vec<Tri> = (0..6)
         .map(|c| Tri::new(layout.by_channel[c].len() + 1))
         .collect();
@@ -114,7 +131,23 @@ pub(crate) fn accumulate(
             blocks.push(std::mem::replace(&mut cur, new_block(layout)));
             block_end += BLOCK_S * ((t - block_end) / BLOCK_S).ceil().max(1.0);
         }
-        let state = state_at(rec, &mut j, t);
+        let mut state = state_at(rec, &mut j, t);
+        if at_rest {
+            // A static segment is at rest: the feedback's rate ripple is the table's
+            // measurement noise, not motion the IMU felt.
+            for ax in [&mut state.outer, &mut state.inner] {
+                ax.rate = 0.0;
+                ax.accel = 0.0;
+            }
+        } else if steady {
+            // A rate segment turns at a constant rate: the feedback's ripple is measurement
+            // noise (differencing it would invent angular accelerations), so the rates are
+            // the segment's mean feedback rates.
+            state.outer.rate = mean_rates.0;
+            state.inner.rate = mean_rates.1;
+            state.outer.accel = 0.0;
+            state.inner.accel = 0.0;
+        }
         let snap = state.snapshot(geo, &site);
         let dtemp = imu.temp.as_ref().map_or(0.0, |tc| tc[i] - t_ref_c);
         let sig = Signals::new(&snap, &site, if dtemp.is_finite() { dtemp } else { 0.0 });

@@ -52,8 +52,12 @@ pub(crate) fn estimate(accs: &[&SegAcc], c: usize, theta_c: &[f64], sigma: f64) 
             let span = chunk.len() as f64;
             groups.push((span, t, n, m));
         }
-        for w in groups.windows(2) {
-            pairs.push((w[0], w[1]));
+        // Pairs at lags of 1, 2, 4, 8 and 16 groups (10 s to about 3 min): the longer lags
+        // carry the wander the segments' spacing exposes the fit to.
+        for lag in [1usize, 2, 4, 8, 16] {
+            for i in lag..groups.len() {
+                pairs.push((groups[i - lag], groups[i]));
+            }
         }
     }
     let a = if den > 0.0 { num / den } else { sigma * sigma };
