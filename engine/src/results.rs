@@ -47,6 +47,20 @@ pub struct Results {
     /// Everything the analysis could not do as asked, in plain words.
     #[serde(default)]
     pub warnings: Vec<String>,
+    /// Joint fits with effects: their parameter keys in order and correlation matrix.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub fits: BTreeMap<String, JointFit>,
+}
+
+/// A joint fit's parameters (results.json keys, in order) and their correlation matrix.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct JointFit {
+    /// The effects in the model.
+    pub effects: Vec<String>,
+    /// Parameter keys, in the matrix's order.
+    pub parameters: Vec<String>,
+    /// Correlation coefficients, square, in that order.
+    pub correlation: Vec<Vec<f64>>,
 }
 
 /// A parameter estimate, or the statement that the motion did not determine it.
@@ -62,10 +76,13 @@ pub enum Parameter {
         /// Unit (`m/s^2`, `ppm`, `deg/s`, `mrad`...).
         unit: String,
     },
-    /// `{ "observable": false }`.
+    /// `{ "observable": false, "needs": "..." }`.
     Unobservable {
         /// Always `false`.
         observable: bool,
+        /// The motion that would determine it, when known.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        needs: Option<String>,
     },
 }
 
@@ -81,7 +98,18 @@ impl Parameter {
 
     /// `{ "observable": false }`.
     pub fn unobservable() -> Self {
-        Parameter::Unobservable { observable: false }
+        Parameter::Unobservable {
+            observable: false,
+            needs: None,
+        }
+    }
+
+    /// `{ "observable": false, "needs": "..." }`.
+    pub fn needs(motion: &str) -> Self {
+        Parameter::Unobservable {
+            observable: false,
+            needs: Some(motion.to_string()),
+        }
     }
 
     /// `(value, u)` of an estimate.

@@ -29,6 +29,7 @@ fn fit(step: &str, model: FitModel, axes: Vec<usize>, seg: &str) -> FitSpec {
         outliers: Some(Outliers::Sigma(3.0)),
         lowpass: None,
         using: None,
+        effects: Vec::new(),
     }
 }
 

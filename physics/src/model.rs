@@ -66,7 +66,11 @@ impl ImuErrors {
             t_ref_c: self.t_ref_c,
         };
         let v = |x: Vec3| x.iter().copied().collect::<Vec<f64>>();
-        let diag = |k: &Mat3| (0..3).map(|i| (k[(i, i)] - 1.0) * 1e6).collect::<Vec<f64>>();
+        let diag = |k: &Mat3| {
+            (0..3)
+                .map(|i| (k[(i, i)] - 1.0) * 1e6)
+                .collect::<Vec<f64>>()
+        };
         m.push("accel_bias", v(self.b_a));
         m.push("accel_scale", diag(&self.k_a));
         m.push("gyro_bias", v(self.b_g));
@@ -75,13 +79,19 @@ impl ImuErrors {
             "earth_rate",
             crate::effects::EarthRate::values(site.latitude_deg).to_vec(),
         );
-        m.push("lever_arm", self.lever_m.transpose().iter().map(|x| x * 1e3).collect());
+        m.push(
+            "lever_arm",
+            self.lever_m.transpose().iter().map(|x| x * 1e3).collect(),
+        );
         m.push("time_offset", vec![self.tau_s * 1e3]);
         m.push("accel_misalignment", offdiag(&self.k_a));
         m.push("gyro_misalignment", offdiag(&self.k_g));
         m.push(
             "g_sensitivity",
-            (self.g_sens.transpose() * site.gravity_mps2).iter().copied().collect(),
+            (self.g_sens.transpose() * site.gravity_mps2)
+                .iter()
+                .copied()
+                .collect(),
         );
         m.push("gyro_thermal_drift", v(self.gyro_thermal));
         m.push("accel_thermal_drift", v(self.accel_thermal));

@@ -25,6 +25,10 @@ pub struct Args {
     /// otherwise segments are chosen by kind.
     #[arg(long, value_name = "PROCEDURE")]
     procedure: Option<PathBuf>,
+    /// Catalogue effects to add to whatever model applies, fitted jointly with it
+    /// (`--with lever_arm,time_offset`; ids of spec/physics.md).
+    #[arg(long, value_name = "EFFECTS", value_delimiter = ',')]
+    with: Vec<String>,
     /// Where to write results.json (default: standard output).
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
@@ -48,7 +52,11 @@ pub fn main(args: Args) -> ExitCode {
         }
     }
     let plan = plan.or_else(|| default_plan(&runs[0].1));
-    let mut results = fit::analyze_runs(&runs, plan.as_ref(), &Options::default());
+    let opts = Options {
+        with: args.with.clone(),
+        ..Options::default()
+    };
+    let mut results = fit::analyze_runs(&runs, plan.as_ref(), &opts);
     // The procedure given on the command line is identified by its own canonical hash.
     if let (Some(h), Some(p)) = (sha256, results.model.procedure.as_mut()) {
         p.sha256 = h;

@@ -4,13 +4,13 @@
 pub mod analyze;
 pub mod check;
 pub mod diff;
+pub mod explain;
 pub mod fmt;
 pub mod log;
 pub mod procedure;
 pub mod report;
 pub mod run;
 pub mod verify;
-pub mod explain;
 
 /// Writes to standard output; a closed pipe (`ratecal ... | head`) is not an error worth a
 /// panic: the caller ends quietly.

@@ -492,7 +492,9 @@ impl Ck<'_> {
         for e in &f.with {
             let known = ratecal_physics::effects::catalogue().any(|x| x.id() == e.node);
             if !known {
-                let ids: Vec<&str> = ratecal_physics::effects::catalogue().map(|x| x.id()).collect();
+                let ids: Vec<&str> = ratecal_physics::effects::catalogue()
+                    .map(|x| x.id())
+                    .collect();
                 self.err(
                     Diagnostic::error(
                         "check::unknown_effect",

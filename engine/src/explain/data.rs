@@ -27,7 +27,11 @@ impl Data {
         let geos = geometries(rec);
         let t_ref = rec.imu.temp.as_ref().map_or(0.0, |t| {
             let v: Vec<f64> = t.iter().copied().filter(|x| x.is_finite()).collect();
-            if v.is_empty() { 0.0 } else { v.iter().sum::<f64>() / v.len() as f64 }
+            if v.is_empty() {
+                0.0
+            } else {
+                v.iter().sum::<f64>() / v.len() as f64
+            }
         });
         let segs = &rec.manifest.segments;
         let accs: Vec<SegAcc> = (0..segs.len())
@@ -42,7 +46,11 @@ impl Data {
             .max_by(|a, b| a.1.n.cmp(&b.1.n))
             .map(|(i, _)| i);
         let mut held = Vec::new();
-        for kind in [SegmentKind::Static, SegmentKind::Rate, SegmentKind::Oscillation] {
+        for kind in [
+            SegmentKind::Static,
+            SegmentKind::Rate,
+            SegmentKind::Oscillation,
+        ] {
             let of: Vec<usize> = (0..accs.len())
                 .filter(|&i| segs[accs[i].seg].kind == kind && Some(i) != longest)
                 .collect();

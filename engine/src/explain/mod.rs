@@ -6,17 +6,18 @@
 //! time, each judged by a Wald test with the honest covariance (white noise plus the
 //! wandering bias) and confirmed on segments held out of every fit.
 
-mod data;
+// Numeric loops index the six channels of several arrays at once.
+#![allow(clippy::needless_range_loop)]
+
+pub(crate) mod data;
 mod locate;
-mod model;
+pub(crate) mod model;
 mod output;
 mod select;
 mod text;
 
 pub use model::NominalModel;
-pub use output::{
-    Evidence, Explanation, FORMAT, Final, Finding, Located, Nominal, ParamOut, Rms,
-};
+pub use output::{Evidence, Explanation, FORMAT, Final, Finding, Located, Nominal, ParamOut, Rms};
 pub use text::render_text;
 
 use crate::recording::Recording;
@@ -92,7 +93,12 @@ pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Expla
     if std::env::var_os("RATECAL_DEBUG_EXPLAIN").is_some() {
         eprintln!("noise {:?}\nrejected {:?}", last.noise, rejected);
         for st in &steps {
-            eprintln!("step {} chi2 {} dof {}", lay.effects[st.effect].id(), st.chi2, st.dof);
+            eprintln!(
+                "step {} chi2 {} dof {}",
+                lay.effects[st.effect].id(),
+                st.chi2,
+                st.dof
+            );
         }
     }
     let floor = |cs: std::ops::Range<usize>| {

@@ -3,8 +3,8 @@
 
 use super::data::Data;
 use crate::fit::joint::{Fit, FitRequest, rss_on, solve};
-use crate::recording::{Recording, SegmentKind};
 use crate::plan::Plan;
+use crate::recording::{Recording, SegmentKind};
 use ratecal_physics::effects::{EarthRate, Sensor};
 
 /// The model a recording is compared with before anything is added.
@@ -100,7 +100,12 @@ impl Terms {
 /// Fits terms over segments (indices into `data.accs`) for each sensor. Columns of an
 /// effect that these segments barely excite (below a thousandth of the effect's most
 /// excited column) are left out as unobservable.
-pub(crate) fn fit(data: &Data, terms: &Terms, accel: &[usize], gyro: &[usize]) -> (Fit, Vec<usize>) {
+pub(crate) fn fit(
+    data: &Data,
+    terms: &Terms,
+    accel: &[usize],
+    gyro: &[usize],
+) -> (Fit, Vec<usize>) {
     let lay = &data.layout;
     let mut cols = Vec::new();
     let mut weak = Vec::new();
@@ -173,7 +178,10 @@ pub(crate) fn rms(data: &Data, fit: &Fit, segs: &[usize]) -> super::Rms {
 pub(crate) fn seed_segments(rec: &Recording, data: &Data) -> (Vec<usize>, Vec<usize>) {
     let kind = |i: usize| rec.manifest.segments[data.accs[i].seg].kind;
     let all = 0..data.accs.len();
-    let accel: Vec<usize> = all.clone().filter(|&i| kind(i) == SegmentKind::Static).collect();
+    let accel: Vec<usize> = all
+        .clone()
+        .filter(|&i| kind(i) == SegmentKind::Static)
+        .collect();
     let longest = accel.iter().copied().max_by_key(|&i| data.accs[i].n);
     let gyro: Vec<usize> = all
         .filter(|&i| kind(i) == SegmentKind::Rate || Some(i) == longest)

@@ -29,6 +29,10 @@ pub(crate) struct Step {
     pub alpha: f64,
 }
 
+/// A candidate tried at one step: effect, fit, unobservable columns, Wald statistic,
+/// degrees of freedom, p-value, held-out misfit.
+type Tried = (usize, Fit, Vec<usize>, f64, usize, f64, f64);
+
 /// Wald statistic of the estimated columns of an effect, with its degrees of freedom.
 pub(crate) fn wald(fit: &Fit, cols: &[usize]) -> (f64, usize) {
     let est: Vec<usize> = cols
@@ -104,7 +108,7 @@ pub(crate) fn forward(
         let (base, _) = fit(data, &terms, &work, &work);
         let base_hold = holdout_score(data, &base, &base);
         let a = alpha / candidates.len().max(1) as f64;
-        let tried: Vec<(usize, Fit, Vec<usize>, f64, usize, f64, f64)> = {
+        let tried: Vec<Tried> = {
             use rayon::prelude::*;
             candidates
                 .par_iter()
@@ -125,8 +129,8 @@ pub(crate) fn forward(
             last_p.insert(lay.effects[c.0].id().to_string(), c.5);
             let held_ok = data.held.is_empty() || c.6 < base_hold;
             if c.4 > 0 && c.5 < a && held_ok {
-                let better = best
-                    .is_none_or(|b| score(c.3, c.4, n) > score(tried[b].3, tried[b].4, n));
+                let better =
+                    best.is_none_or(|b| score(c.3, c.4, n) > score(tried[b].3, tried[b].4, n));
                 if better {
                     best = Some(k);
                 }
@@ -148,7 +152,10 @@ pub(crate) fn forward(
             t.effects.push(tried[b].0);
             t.effects.push(tried[k].0);
             let (_, un) = fit(data, &t, &work, &work);
-            if lay.columns_of(tried[k].0).any(|g| un.contains(&g) && !tried[k].2.contains(&g)) {
+            if lay
+                .columns_of(tried[k].0)
+                .any(|g| un.contains(&g) && !tried[k].2.contains(&g))
+            {
                 b = k;
                 break;
             }

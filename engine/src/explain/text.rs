@@ -5,7 +5,10 @@ use crate::fit::format_measured;
 use std::fmt::Write;
 
 fn rms(r: &Rms) -> String {
-    format!("accel {:.3e} m/s^2, gyro {:.3e} deg/s", r.accel_mps2, r.gyro_dps)
+    format!(
+        "accel {:.3e} m/s^2, gyro {:.3e} deg/s",
+        r.accel_mps2, r.gyro_dps
+    )
 }
 
 /// Renders an explanation for a person.
@@ -20,7 +23,10 @@ pub fn render_text(x: &Explanation) -> String {
         rms(&x.nominal.rms)
     );
     if x.findings.is_empty() {
-        let _ = writeln!(s, "\nnothing found: the nominal model explains the recording to its noise");
+        let _ = writeln!(
+            s,
+            "\nnothing found: the nominal model explains the recording to its noise"
+        );
     }
     for (k, f) in x.findings.iter().enumerate() {
         let _ = writeln!(s, "\n{}. {}: {}", k + 1, f.effect, f.explanation);

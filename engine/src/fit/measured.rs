@@ -19,16 +19,12 @@ pub fn format_measured(value: f64, u: f64, unit: &str) -> String {
     let scale = 10f64.powi(e);
     let (v, du) = ((value / scale).round() * scale, (u / scale).round() * scale);
     let big = value.abs().max(u);
-    if big >= 1e6 || big < 1e-4 {
+    if !(1e-4..1e6).contains(&big) {
         // Scientific: a common exponent for both.
         let ex = big.log10().floor() as i32;
         let m = 10f64.powi(ex);
         let dec = (ex - e).max(0) as usize;
-        return format!(
-            "({:.dec$} ± {:.dec$})e{ex}{sep}{unit}",
-            v / m,
-            du / m,
-        );
+        return format!("({:.dec$} ± {:.dec$})e{ex}{sep}{unit}", v / m, du / m,);
     }
     let dec = (-e).max(0) as usize;
     format!("{v:.dec$} ± {du:.dec$}{sep}{unit}")

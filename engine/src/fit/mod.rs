@@ -11,6 +11,7 @@
 mod accel;
 mod accept;
 mod allan;
+mod effects;
 mod gyro;
 pub(crate) mod joint;
 mod lsq;
@@ -43,6 +44,8 @@ pub struct Options {
     pub lowpass: Option<(u32, f64)>,
     /// How the recording is named in the results (its folder).
     pub path: String,
+    /// Catalogue effects added to whatever model applies (`--with`).
+    pub with: Vec<String>,
 }
 
 impl Default for Options {
@@ -51,6 +54,7 @@ impl Default for Options {
             outliers: Some(Outliers::Sigma(3.0)),
             lowpass: None,
             path: String::new(),
+            with: Vec::new(),
         }
     }
 }
@@ -231,6 +235,7 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
             }
         }
     }
+    moving_accel_residuals(&data, &mut out);
     let (verification, wh) = accept::verify(&sel, &data, &out, rec);
     let segments = sel.uses(rec, &data);
     let mut res = Results {
@@ -248,10 +253,58 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
         repeatability: None,
         environment: select::environment(rec),
         warnings: Vec::new(),
+        fits: Default::default(),
     };
+    let declared = effects::declared(plan, &opts.with);
+    if !declared.is_empty() {
+        effects::apply(rec, &sel, &declared, &mut res);
+    }
     res.acceptance = accept::evaluate(plan, &res, &out.quantities, &wh, &mut out.warnings);
-    res.warnings = std::mem::take(&mut out.warnings);
+    let mut w = std::mem::take(&mut out.warnings);
+    w.append(&mut res.warnings);
+    res.warnings = w;
     res
+}
+
+/// The accelerometer model checked on the segments that move (rate and oscillation),
+/// which the seed model does not fit: their residuals join the results, and a mean
+/// residual far beyond the static fit's noise is a warning (a lever arm, a time offset).
+fn moving_accel_residuals(data: &BTreeMap<usize, SegData>, out: &mut Out) {
+    let Some((k, b)) = out.accel_model else {
+        return;
+    };
+    let noise = out
+        .quantities
+        .get("accel.residual.std")
+        .map_or(0.0, |q| q.0);
+    let mut worst: Option<(f64, String, usize)> = None;
+    for s in data.values() {
+        if s.kind == crate::recording::SegmentKind::Static {
+            continue;
+        }
+        for ax in 0..3 {
+            let r: Vec<f64> = (0..s.t.len())
+                .map(|i| {
+                    s.accel[ax][i] - b[ax] - (0..3).map(|j| k[(ax, j)] * s.f_ref[j][i]).sum::<f64>()
+                })
+                .collect();
+            let st = residual_stats(s, "accel", ax, &r, &s.keep_a, "m/s^2");
+            if worst.as_ref().is_none_or(|w| st.mean.abs() > w.0) {
+                worst = Some((st.mean.abs(), s.id.clone(), ax));
+            }
+            out.residuals.push(st);
+        }
+    }
+    if let Some((m, id, ax)) = worst
+        && noise > 0.0
+        && m > 5.0 * noise
+    {
+        out.warnings.push(format!(
+                "accelerometer {} residual on moving segment {id}: mean {m:.4} m/s^2, {:.0} times the static noise: the model leaves out motion-dependent physics (a lever arm, a time offset); see `ratecal explain` or `--with lever_arm`",
+                AXES[ax],
+                m / noise
+            ));
+    }
 }
 
 /// Bias per axis from the rate points when there is no static block: mean of output minus

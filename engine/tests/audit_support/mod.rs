@@ -202,6 +202,7 @@ pub fn standard() -> Plan {
                 outliers: Some(Outliers::Sigma(3.0)),
                 lowpass: None,
                 using: None,
+                effects: Vec::new(),
             },
             FitSpec {
                 step: "gyro_bias".into(),
@@ -211,6 +212,7 @@ pub fn standard() -> Plan {
                 outliers: Some(Outliers::Sigma(3.0)),
                 lowpass: None,
                 using: None,
+                effects: Vec::new(),
             },
             FitSpec {
                 step: "gyro_scale".into(),
@@ -220,6 +222,7 @@ pub fn standard() -> Plan {
                 outliers: None,
                 lowpass: None,
                 using: Some("gyro_bias".into()),
+                effects: Vec::new(),
             },
         ],
         accepts: vec![

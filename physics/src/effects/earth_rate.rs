@@ -7,7 +7,6 @@
 use super::{Effect, Param, Partials, Sensor, Signals};
 use crate::{DEG, EARTH_RATE_RADPS};
 
-
 /// The `earth_rate` effect.
 #[derive(Debug)]
 pub struct EarthRate;

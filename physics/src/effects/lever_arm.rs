@@ -25,13 +25,37 @@ const fn p(name: &'static str, i: usize, needs: &'static str) -> Param {
 // about an axis between i and j.
 static PARAMS: [Param; 9] = [
     p("rxx_mm", 0, "rotate about Y or Z"),
-    p("rxy_mm", 0, "accelerate about Z, or rotate about an axis between X and Y"),
-    p("rxz_mm", 0, "accelerate about Y, or rotate about an axis between X and Z"),
-    p("ryx_mm", 1, "accelerate about Z, or rotate about an axis between X and Y"),
+    p(
+        "rxy_mm",
+        0,
+        "accelerate about Z, or rotate about an axis between X and Y",
+    ),
+    p(
+        "rxz_mm",
+        0,
+        "accelerate about Y, or rotate about an axis between X and Z",
+    ),
+    p(
+        "ryx_mm",
+        1,
+        "accelerate about Z, or rotate about an axis between X and Y",
+    ),
     p("ryy_mm", 1, "rotate about X or Z"),
-    p("ryz_mm", 1, "accelerate about X, or rotate about an axis between Y and Z"),
-    p("rzx_mm", 2, "accelerate about Y, or rotate about an axis between X and Z"),
-    p("rzy_mm", 2, "accelerate about X, or rotate about an axis between Y and Z"),
+    p(
+        "ryz_mm",
+        1,
+        "accelerate about X, or rotate about an axis between Y and Z",
+    ),
+    p(
+        "rzx_mm",
+        2,
+        "accelerate about Y, or rotate about an axis between X and Z",
+    ),
+    p(
+        "rzy_mm",
+        2,
+        "accelerate about X, or rotate about an axis between Y and Z",
+    ),
     p("rzz_mm", 2, "rotate about X or Y"),
 ];
 
@@ -54,6 +78,10 @@ impl Effect for LeverArm {
 
     fn sensors(&self) -> &'static [Sensor] {
         &[Sensor::Accel]
+    }
+
+    fn sensed(&self) -> bool {
+        true
     }
 
     fn regressors(&self, s: &Signals, out: &mut [Partials]) {

@@ -26,12 +26,42 @@ const fn p(sensor: Sensor, name: &'static str, i: usize, needs: &'static str) ->
 pub static ACCEL_MISALIGNMENT: Misalignment = Misalignment {
     sensor: Sensor::Accel,
     params: &[
-        p(Sensor::Accel, "xy_mrad", 0, "an attitude with gravity along Y"),
-        p(Sensor::Accel, "xz_mrad", 0, "an attitude with gravity along Z"),
-        p(Sensor::Accel, "yx_mrad", 1, "an attitude with gravity along X"),
-        p(Sensor::Accel, "yz_mrad", 1, "an attitude with gravity along Z"),
-        p(Sensor::Accel, "zx_mrad", 2, "an attitude with gravity along X"),
-        p(Sensor::Accel, "zy_mrad", 2, "an attitude with gravity along Y"),
+        p(
+            Sensor::Accel,
+            "xy_mrad",
+            0,
+            "an attitude with gravity along Y",
+        ),
+        p(
+            Sensor::Accel,
+            "xz_mrad",
+            0,
+            "an attitude with gravity along Z",
+        ),
+        p(
+            Sensor::Accel,
+            "yx_mrad",
+            1,
+            "an attitude with gravity along X",
+        ),
+        p(
+            Sensor::Accel,
+            "yz_mrad",
+            1,
+            "an attitude with gravity along Z",
+        ),
+        p(
+            Sensor::Accel,
+            "zx_mrad",
+            2,
+            "an attitude with gravity along X",
+        ),
+        p(
+            Sensor::Accel,
+            "zy_mrad",
+            2,
+            "an attitude with gravity along Y",
+        ),
     ],
 };
 

@@ -109,6 +109,12 @@ pub trait Effect: Send + Sync + std::fmt::Debug {
         }
         out
     }
+    /// Whether its accelerometer contribution is part of the specific force the
+    /// accelerometers sense (the lever arm), to which scale and cross-coupling then apply
+    /// (`a = K_a s + b_a`).
+    fn sensed(&self) -> bool {
+        false
+    }
     /// How much later than the motion the samples are stamped, s (the time offset).
     fn delay_s(&self, _values: &[f64]) -> f64 {
         0.0

@@ -27,7 +27,11 @@ impl ImuModel {
     pub fn push(&mut self, id: &str, values: Vec<f64>) {
         if values.iter().any(|v| *v != 0.0) {
             let effect = super::effect(id).expect("a registry id");
-            assert_eq!(values.len(), effect.params().len(), "{id}: one value a parameter");
+            assert_eq!(
+                values.len(),
+                effect.params().len(),
+                "{id}: one value a parameter"
+            );
             self.terms.push(Term { effect, values });
         }
     }
@@ -36,12 +40,19 @@ impl ImuModel {
     /// ideal outputs are the specific force at the reference point and the body rate
     /// relative to the lab; the Earth's rate, like everything else, is a term.
     pub fn outputs(&self, s: &Signals) -> (Vec3, Vec3) {
-        let mut a = s.f_b;
+        // What the accelerometers sense (the lever arm included): the other accelerometer
+        // terms (scale, cross-coupling) apply to it, exactly as `a = K_a s + b_a`.
+        let mut sensed = *s;
+        for t in self.terms.iter().filter(|t| t.effect.sensed()) {
+            sensed.f_b += t.effect.forward(&t.values, s).accel;
+        }
+        let mut a = sensed.f_b;
         let mut g = s.w_b_dps();
         for t in &self.terms {
-            let p = t.effect.forward(&t.values, s);
-            a += p.accel;
-            g += p.gyro;
+            if !t.effect.sensed() {
+                a += t.effect.forward(&t.values, &sensed).accel;
+            }
+            g += t.effect.forward(&t.values, s).gyro;
         }
         (a, g)
     }

@@ -78,11 +78,17 @@ fn time_offset_regressor_is_the_reference_derivative() {
     let (fp, wp) = d(t + h);
     let (fm, wm) = d(t - h);
     let mut out = [Partials::default()];
-    effect("time_offset").unwrap().regressors(&signals(t), &mut out);
+    effect("time_offset")
+        .unwrap()
+        .regressors(&signals(t), &mut out);
     // d y / d tau_ms = -1e-3 dy/dt
     let fa = -(fp - fm) / (2.0 * h) * 1e-3;
     let fg = -(wp - wm) / (2.0 * h) * 1e-3;
-    assert!((out[0].accel - fa).norm() < 1e-8, "{} vs {fa}", out[0].accel);
+    assert!(
+        (out[0].accel - fa).norm() < 1e-8,
+        "{} vs {fa}",
+        out[0].accel
+    );
     assert!((out[0].gyro - fg).norm() < 1e-8, "{} vs {fg}", out[0].gyro);
 }
 

@@ -248,7 +248,11 @@ pub(super) fn fits(step_path: &str, old: &[FitSpec], new: &[FitSpec], out: &mut 
                 let using = |u: &Option<String>| u.clone().unwrap_or_else(|| "none".into());
                 field("using", using(&o.using), using(&n.using));
                 let with = |e: &[String]| {
-                    if e.is_empty() { "none".to_string() } else { e.join(", ") }
+                    if e.is_empty() {
+                        "none".to_string()
+                    } else {
+                        e.join(", ")
+                    }
                 };
                 field("effects", with(&o.effects), with(&n.effects));
             }

@@ -83,7 +83,12 @@ pub(crate) fn estimate(accs: &[&SegAcc], c: usize, theta_c: &[f64], sigma: f64) 
 
 /// `X^T Sigma_rw X / q` for a random walk starting at the first block: sums over the
 /// blocks in time order of the gap times the outer product of the regressor sums after it.
-pub(crate) fn random_walk_gram(accs: &[&SegAcc], c: usize, local: &[Option<usize>], p: usize) -> DMatrix<f64> {
+pub(crate) fn random_walk_gram(
+    accs: &[&SegAcc],
+    c: usize,
+    local: &[Option<usize>],
+    p: usize,
+) -> DMatrix<f64> {
     let mut blocks: Vec<&Block> = accs.iter().flat_map(|a| a.blocks.iter()).collect();
     blocks.sort_by(|a, b| a.t.total_cmp(&b.t));
     let mut m = DMatrix::zeros(p, p);

@@ -37,10 +37,6 @@ pub(crate) struct Fit {
     pub estimated: Vec<usize>,
     /// Noise of each channel's residuals.
     pub noise: [ChannelNoise; 6],
-    /// Residual sum of squares per channel over the fitted segments.
-    pub rss: [f64; 6],
-    /// Samples per channel.
-    pub n: [usize; 6],
 }
 
 impl Fit {
@@ -130,7 +126,9 @@ pub(crate) fn solve(req: &FitRequest) -> Fit {
         let est: DVector<f64> = rp
             .solve_upper_triangular(&z)
             .map_or_else(|| DVector::zeros(p), |m| m.column(0).into_owned());
-        let inv = rp.solve_upper_triangular(&DMatrix::identity(p, p)).unwrap_or_else(|| DMatrix::zeros(p, p));
+        let inv = rp
+            .solve_upper_triangular(&DMatrix::identity(p, p))
+            .unwrap_or_else(|| DMatrix::zeros(p, p));
         bread = &inv * inv.transpose();
         let mut full = theta.clone();
         for (l, &g) in cols.iter().enumerate() {
@@ -146,13 +144,20 @@ pub(crate) fn solve(req: &FitRequest) -> Fit {
             }
             v[k] = -1.0;
             rss[c] = (&facs[c] * v).norm_squared();
-            let pc = lay.by_channel[c].iter().filter(|g| cols.contains(g)).count();
+            let pc = lay.by_channel[c]
+                .iter()
+                .filter(|g| cols.contains(g))
+                .count();
             let dof = n[c].saturating_sub(pc).max(1) as f64;
             let sigma = (rss[c] / dof).sqrt();
             let theta_c: Vec<f64> = lay.by_channel[c].iter().map(|&g| full[g]).collect();
             noise[c] = noise::estimate(req.segs(c), c, &theta_c, sigma);
             if pass == 0 {
-                w[c] = if sigma > 0.0 { 1.0 / (sigma * sigma) } else { 1.0 };
+                w[c] = if sigma > 0.0 {
+                    1.0 / (sigma * sigma)
+                } else {
+                    1.0
+                };
             }
         }
         if pass == 1 {
@@ -200,8 +205,6 @@ pub(crate) fn solve(req: &FitRequest) -> Fit {
         unobservable,
         estimated: cols,
         noise,
-        rss,
-        n,
     }
 }
 
@@ -238,7 +241,9 @@ fn rank_deficient(r: &DMatrix<f64>, p: usize) -> Vec<usize> {
     }
     let rp = r.view((0, 0), (p, p)).clone_owned();
     let norms: Vec<f64> = (0..p).map(|j| rp.column(j).norm()).collect();
-    let mut bad: Vec<usize> = (0..p).filter(|&j| !(norms[j] > 1e-300)).collect();
+    let mut bad: Vec<usize> = (0..p)
+        .filter(|&j| norms[j].is_nan() || norms[j] <= 1e-300)
+        .collect();
     let good: Vec<usize> = (0..p).filter(|j| !bad.contains(j)).collect();
     if !good.is_empty() {
         let scaled = DMatrix::from_fn(p, good.len(), |i, j| rp[(i, good[j])] / norms[good[j]]);

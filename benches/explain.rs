@@ -1,0 +1,49 @@
+//! `ratecal explain` on a standard-procedure recording with a 15-minute gyro block at 100 Hz
+//! (about 28 minutes, 170,000 IMU rows), every candidate of the catalogue tried: the whole
+//! process from the command line (the figure: under 1 s on this machine).
+//! The recording is the analyze bench's (`target/analyze-bench-recording/`).
+
+#[path = "../engine/tests/fit_support/mod.rs"]
+mod fit_support;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use std::path::PathBuf;
+use std::process::Command;
+use std::time::Duration;
+
+fn recording() -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/analyze-bench-recording");
+    if !dir.join("manifest.yaml").exists() {
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut spec = fit_support::SimSpec::tactical(42);
+        spec.block_s = 900.0;
+        spec.temp = Some((22.0, 1.5));
+        spec.settle_s = 40.0;
+        let windows = fit_support::standard_windows(spec.block_s);
+        fit_support::write(&dir, &spec, &windows);
+    }
+    dir
+}
+
+fn bench(c: &mut Criterion) {
+    let dir = recording();
+    let mut g = c.benchmark_group("explain");
+    g.sample_size(10).measurement_time(Duration::from_secs(20));
+    g.bench_function("cli", |b| {
+        b.iter(|| {
+            let st = Command::new(env!("CARGO_BIN_EXE_ratecal"))
+                .arg("explain")
+                .arg(&dir)
+                .arg("--format")
+                .arg("json")
+                .stdout(std::process::Stdio::null())
+                .status()
+                .expect("ratecal runs");
+            assert!(st.code().is_some_and(|c| c == 0 || c == 1), "{st}");
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
