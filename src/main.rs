@@ -3,7 +3,21 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+/// `println!` that ends quietly on a closed pipe.
+macro_rules! outln {
+    ($($t:tt)*) => { $crate::out::stdout(format_args!($($t)*), true) };
+}
+/// `print!` that ends quietly on a closed pipe.
+macro_rules! out {
+    ($($t:tt)*) => { $crate::out::stdout(format_args!($($t)*), false) };
+}
+/// `eprintln!` that ends quietly on a closed pipe.
+macro_rules! errln {
+    ($($t:tt)*) => { $crate::out::stderr(format_args!($($t)*), true) };
+}
+
 mod cli;
+mod out;
 
 /// Declarative calibration procedures for IMUs on dual-axis rate tables.
 #[derive(Parser)]
@@ -29,8 +43,10 @@ enum Command {
     Diff(cli::diff::Args),
     /// Every version of a procedure folder, with hashes and summaries.
     Log(cli::log::Args),
-    /// Check that a run folder was not altered since the run.
+    /// Check a run folder against its seal (and the lab's signature with --key).
     Verify(cli::verify::Args),
+    /// Lab signing keys: `ratecal key new DIR` writes DIR/lab.key and DIR/lab.pub.
+    Key(cli::key::Args),
 }
 
 fn main() -> ExitCode {
@@ -44,5 +60,6 @@ fn main() -> ExitCode {
         Command::Diff(a) => cli::diff::main(a),
         Command::Log(a) => cli::log::main(a),
         Command::Verify(a) => cli::verify::main(a),
+        Command::Key(a) => cli::key::main(a),
     }
 }

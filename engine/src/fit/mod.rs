@@ -232,6 +232,7 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
     let segments = sel.uses(rec, &data);
     let mut res = Results {
         format: results::FORMAT.into(),
+        verdict: results::RunVerdict::default(),
         parameters: std::mem::take(&mut out.params),
         acceptance: Vec::new(),
         observability: std::mem::take(&mut out.observability),
@@ -248,6 +249,7 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
     };
     res.acceptance = accept::evaluate(plan, &res, &out.quantities, &wh, &mut out.warnings);
     res.warnings = std::mem::take(&mut out.warnings);
+    res.decide(results::ended_early(&rec.manifest));
     res
 }
 
