@@ -242,3 +242,48 @@ fn signature_status(seal: &Seal, key: &VerifyingKey) -> Option<String> {
         Err(_) => Some("the signature does not match the sealed hashes".into()),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn folder(files: &[(&str, &str)]) -> BTreeMap<String, Vec<u8>> {
+        files
+            .iter()
+            .map(|(p, t)| (p.to_string(), t.as_bytes().to_vec()))
+            .collect()
+    }
+
+    #[test]
+    fn additions_supersede_and_signatures_cover_only_the_sealed_files() {
+        let f = folder(&[("imu.csv", "1"), ("report.md", "old")]);
+        let key = SigningKey::from_bytes(&[7; 32]);
+        let mut seal = Seal::new("t0", f.iter().map(|(p, b)| (p.as_str(), b.as_slice())));
+        seal.sign(&key);
+        let json = seal.to_json();
+        let hash = Seal::hash_line(&json);
+        let pk = key.verifying_key();
+        assert!(verify_seal(Some(&json), Some(&hash), &f, Some(&pk)).intact());
+
+        // A re-rendered report, recorded: intact without a key, not vouched for by it.
+        let g = folder(&[("imu.csv", "1"), ("report.md", "new")]);
+        seal.add("t1", "ratecal report", &[("report.md", b"new")]);
+        let json = seal.to_json();
+        let hash = Seal::hash_line(&json);
+        assert!(verify_seal(Some(&json), Some(&hash), &g, None).intact());
+        let signed = verify_seal(Some(&json), Some(&hash), &g, Some(&pk));
+        assert!(!signed.intact());
+        assert!(
+            signed.text().contains("UNSIGNED report.md"),
+            "{}",
+            signed.text()
+        );
+
+        // An unknown file, and a seal whose hash is not the one beside it.
+        let h = folder(&[("imu.csv", "1"), ("report.md", "new"), ("x", "")]);
+        let r = verify_seal(Some(&json), Some(&hash), &h, None);
+        assert!(r.text().contains("! UNKNOWN  x"), "{}", r.text());
+        let r = verify_seal(Some(&json.replace("t1", "t2")), Some(&hash), &g, None);
+        assert!(!r.intact());
+    }
+}
