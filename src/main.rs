@@ -3,7 +3,21 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+/// `println!` that ends quietly on a closed pipe.
+macro_rules! outln {
+    ($($t:tt)*) => { $crate::out::stdout(format_args!($($t)*), true) };
+}
+/// `print!` that ends quietly on a closed pipe.
+macro_rules! out {
+    ($($t:tt)*) => { $crate::out::stdout(format_args!($($t)*), false) };
+}
+/// `eprintln!` that ends quietly on a closed pipe.
+macro_rules! errln {
+    ($($t:tt)*) => { $crate::out::stderr(format_args!($($t)*), true) };
+}
+
 mod cli;
+mod out;
 
 /// Declarative calibration procedures for IMUs on dual-axis rate tables.
 #[derive(Parser)]
@@ -29,10 +43,12 @@ enum Command {
     Diff(cli::diff::Args),
     /// Every version of a procedure folder, with hashes and summaries.
     Log(cli::log::Args),
-    /// Check that a run folder was not altered since the run.
+    /// Check a run folder against its seal (and the lab's signature with --key).
     Verify(cli::verify::Args),
     /// Locate where a recording and the nominal model disagree and name the physics left out.
     Explain(cli::explain::Args),
+    /// Lab signing keys: `ratecal key new DIR` writes DIR/lab.key and DIR/lab.pub.
+    Key(cli::key::Args),
 }
 
 fn main() -> ExitCode {
@@ -47,5 +63,6 @@ fn main() -> ExitCode {
         Command::Log(a) => cli::log::main(a),
         Command::Verify(a) => cli::verify::main(a),
         Command::Explain(a) => cli::explain::main(a),
+        Command::Key(a) => cli::key::main(a),
     }
 }

@@ -1,4 +1,4 @@
-//! `ratecal verify` on run folders: intact, altered, missing, no longer parsing.
+//! `ratecal verify` on run folders: intact, altered, missing, unsealed.
 
 use std::path::Path;
 use std::process::Command;
@@ -44,6 +44,29 @@ run:
         sha(TABLE.as_bytes())
     );
     std::fs::write(dir.join("manifest.yaml"), manifest).unwrap();
+    // Sealed last, as `ratecal run` does.
+    let names = [
+        "imu.csv",
+        "table.csv",
+        "station.yaml",
+        "procedure.rcal",
+        "manifest.yaml",
+    ];
+    let bytes: Vec<(&str, Vec<u8>)> = names
+        .iter()
+        .map(|n| (*n, std::fs::read(dir.join(n)).unwrap()))
+        .collect();
+    let seal = ratecal_engine::audit::seal::Seal::new(
+        "2026-01-01T01:00:00Z",
+        bytes.iter().map(|(n, b)| (*n, b.as_slice())),
+    );
+    let json = seal.to_json();
+    std::fs::write(dir.join("seal.json"), &json).unwrap();
+    std::fs::write(
+        dir.join("seal.sha256"),
+        ratecal_engine::audit::seal::Seal::hash_line(&json),
+    )
+    .unwrap();
 }
 
 fn verify(dir: &Path) -> (i32, String) {
@@ -65,12 +88,17 @@ fn verify_says_intact_or_names_what_was_altered() {
     write_run(dir);
     let (code, out) = verify(dir);
     assert_eq!(code, 0, "{out}");
-    assert!(out.contains("intact: 4 file(s)"), "{out}");
+    assert!(out.contains("intact: 6 file(s)"), "{out}");
 
-    // re-indenting the procedure copy keeps its canonical hash
+    // Every byte is sealed: even a re-indented procedure copy is an altered file.
     let p = std::fs::read_to_string(dir.join("procedure.rcal")).unwrap();
     std::fs::write(dir.join("procedure.rcal"), p.replace("  ", "    ")).unwrap();
-    assert_eq!(verify(dir).0, 0);
+    let (code, out) = verify(dir);
+    assert_eq!(code, 1, "{out}");
+    assert!(
+        out.contains("! ALTERED  procedure.rcal: recorded sha256"),
+        "{out}"
+    );
 
     std::fs::write(
         dir.join("imu.csv"),
@@ -78,15 +106,10 @@ fn verify_says_intact_or_names_what_was_altered() {
     )
     .unwrap();
     std::fs::remove_file(dir.join("table.csv")).unwrap();
-    std::fs::write(dir.join("procedure.rcal"), "procedure broken {").unwrap();
     let (code, out) = verify(dir);
     assert_eq!(code, 1, "{out}");
     assert!(out.contains("! ALTERED  imu.csv: recorded sha256"), "{out}");
     assert!(out.contains("! ALTERED  table.csv: missing"), "{out}");
-    assert!(
-        out.contains("procedure.rcal (procedure imu-2d-standard 1.0.0): no longer parses"),
-        "{out}"
-    );
 }
 
 #[test]
@@ -100,6 +123,16 @@ fn a_manifest_that_no_longer_parses_is_altered() {
         out.contains("ALTERED since the run: manifest.yaml"),
         "{out}"
     );
+}
+
+#[test]
+fn an_unsealed_run_folder_is_not_intact() {
+    let tmp = tempfile::tempdir().unwrap();
+    write_run(tmp.path());
+    std::fs::remove_file(tmp.path().join("seal.json")).unwrap();
+    let (code, out) = verify(tmp.path());
+    assert_eq!(code, 1);
+    assert!(out.contains("! ALTERED  seal.json: missing"), "{out}");
 }
 
 #[test]

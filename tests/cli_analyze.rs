@@ -23,8 +23,10 @@ fn analyze(args: &[&str]) -> std::process::Output {
         .unwrap()
 }
 
+/// Results are written; a check this recording cannot evaluate makes the verdict
+/// `incomplete`, which is not a pass (exit 3).
 #[test]
-fn writes_results_and_exits_zero() {
+fn writes_results_and_an_incomplete_verdict_exits_three() {
     let Some(ex) = example() else { return };
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("results.json");
@@ -37,13 +39,14 @@ fn writes_results_and_exits_zero() {
     ]);
     assert_eq!(
         o.status.code(),
-        Some(0),
+        Some(3),
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out).unwrap()).unwrap();
     assert_eq!(v["format"], "ratecal-results/1");
+    assert_eq!(v["verdict"], "incomplete");
     assert_eq!(
         v["parameters"]["gyro.scale.z"],
         serde_json::json!({ "observable": false })

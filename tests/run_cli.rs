@@ -197,10 +197,10 @@ fn station_fault_aborts_with_4_and_resume_completes() {
     let rec = ratecal_engine::recording::read(&dir).unwrap();
     assert!(*rec.imu.t.last().unwrap() >= abort.t - 0.02);
 
-    // The operator fixes the lab (the fault leaves the run folder's station) and resumes.
-    std::fs::write(dir.join("station.yaml"), station_with("faults: []")).unwrap();
+    // The lab recovers; the run resumes with the station file it started with (the
+    // excursion is timed from the start of each part, after the rest of this one).
     let o = ratecal(&["run", "--resume", "r"], tmp.path());
-    assert!(matches!(code(&o), 0 | 3), "{}", text(&o));
+    assert_eq!(code(&o), 0, "{}", text(&o));
     let m = manifest(&dir);
     let ids: Vec<_> = m.segments.iter().map(|s| s.id.as_str()).collect();
     assert_eq!(
@@ -209,10 +209,14 @@ fn station_fault_aborts_with_4_and_resume_completes() {
     );
     assert_eq!(m.run.as_ref().unwrap().status, "completed");
     assert!(m.segments[2].t_start > abort.t);
-    // The resumed part ran with the fixed station: the manifest names it, the journal
-    // keeps the change, and the folder verifies.
-    let journal = std::fs::read_to_string(dir.join("journal.jsonl")).unwrap();
-    assert!(journal.contains("station.yaml changed before the resume"));
+    // The manifest and the report say where it was interrupted and when it resumed; the
+    // folder is sealed again and verifies.
+    let resumes = &m.run.as_ref().unwrap().resumes;
+    assert_eq!(resumes.len(), 1, "{resumes:?}");
+    assert_eq!(resumes[0].interrupted_status, "aborted");
+    assert_eq!(resumes[0].step.as_deref(), Some("rates"));
+    let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    assert!(report.contains("Interrupted (aborted) at t ="), "{report}");
     let o = ratecal(&["verify", "r"], tmp.path());
     assert_eq!(code(&o), 0, "{}", text(&o));
     // One recording, time increasing through the resume; it reads back.
@@ -254,9 +258,8 @@ fn imports_are_kept_in_the_run_folder_and_resume_uses_them() {
 
     // The lab file is gone by the time the run resumes.
     std::fs::remove_file(tmp.path().join("lab/limits.rcal")).unwrap();
-    std::fs::write(dir.join("station.yaml"), station_with("faults: []")).unwrap();
     let o = ratecal(&["run", "--resume", "r"], tmp.path());
-    assert!(matches!(code(&o), 0 | 3), "{}", text(&o));
+    assert_eq!(code(&o), 0, "{}", text(&o));
     assert_eq!(manifest(&dir).run.as_ref().unwrap().status, "completed");
 
     // The copy is part of what `verify` checks.
@@ -300,7 +303,25 @@ fn standard_procedure_dry_run_passes() {
             .count(),
         6
     );
-    assert!(tmp.path().join("std/results.json").exists());
+    // Its repeatability check (over 3 runs) is deferred, not failing: the verdict is pass.
+    let results: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(tmp.path().join("std/results.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(results["verdict"], "pass", "{}", text(&o));
+    let cv = results["acceptance"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|a| a["quantity"] == "repeatability.cv")
+        .unwrap();
+    assert_eq!(cv["verdict"], "deferred", "{cv}");
+    let report = std::fs::read_to_string(tmp.path().join("std/report.md")).unwrap();
+    assert!(
+        report.contains("Deferred to the analysis over several runs"),
+        "{report}"
+    );
+    assert!(text(&o).contains("verdict: PASS"), "{}", text(&o));
 }
 
 /// Ctrl-C (SIGINT) in the middle of a dry run: the run stops on the abort path, exit 4,

@@ -14,6 +14,10 @@ pub const FORMAT: &str = "ratecal-results/1";
 pub struct Results {
     /// `ratecal-results/1`.
     pub format: String,
+    /// The run's verdict over every check it can decide (`pass`, `fail`, `incomplete`,
+    /// `aborted`); an older results file without one reads as `incomplete`.
+    #[serde(default)]
+    pub verdict: RunVerdict,
     /// Parameters by dotted name (`accel.bias.x`, `gyro.scale.z`, `accel.misalignment.xy`...).
     pub parameters: BTreeMap<String, Parameter>,
     /// Every acceptance threshold of the procedure, evaluated (or not evaluated, with why).
@@ -141,6 +145,48 @@ pub enum Verdict {
     Indeterminate,
     /// Could not be evaluated (see `reason`).
     NotEvaluated,
+    /// Declared over several runs: decided by `ratecal analyze RUN1 RUN2 ...`, not by one run.
+    Deferred,
+}
+
+impl Verdict {
+    /// How the terminal shows it (a failure in capitals).
+    pub fn label(self) -> &'static str {
+        match self {
+            Verdict::Pass => "pass",
+            Verdict::Fail => "FAIL",
+            Verdict::Indeterminate => "indeterminate",
+            Verdict::NotEvaluated => "not evaluated",
+            Verdict::Deferred => "deferred",
+        }
+    }
+}
+
+/// The verdict of a whole run (or of several runs analysed together).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RunVerdict {
+    /// Every check this run can decide was evaluated and passed.
+    Pass,
+    /// A check failed.
+    Fail,
+    /// A check could not be evaluated or decided (missing data, guard band straddled).
+    #[default]
+    Incomplete,
+    /// The run was aborted (or otherwise did not complete).
+    Aborted,
+}
+
+impl RunVerdict {
+    /// The word results.json holds (`pass`, `fail`, `incomplete`, `aborted`).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            RunVerdict::Pass => "pass",
+            RunVerdict::Fail => "fail",
+            RunVerdict::Incomplete => "incomplete",
+            RunVerdict::Aborted => "aborted",
+        }
+    }
 }
 
 /// One evaluated acceptance threshold; `value`, `limit`, `margin` and `expanded_u` are in
@@ -359,9 +405,25 @@ pub struct AmbientStats {
 }
 
 impl Results {
-    /// Whether any acceptance check failed (exit code 3).
+    /// Whether any acceptance check failed.
     pub fn has_failure(&self) -> bool {
         self.acceptance.iter().any(|a| a.verdict == Verdict::Fail)
+    }
+
+    /// Sets `verdict` from the checks: `aborted` when the run did not complete, else `fail`
+    /// on a failed check, `incomplete` on one not evaluated or undecided, else `pass`
+    /// (deferred checks leave it at `pass`).
+    pub fn decide(&mut self, aborted: bool) {
+        let any = |v: Verdict| self.acceptance.iter().any(|a| a.verdict == v);
+        self.verdict = if aborted {
+            RunVerdict::Aborted
+        } else if any(Verdict::Fail) {
+            RunVerdict::Fail
+        } else if any(Verdict::NotEvaluated) || any(Verdict::Indeterminate) {
+            RunVerdict::Incomplete
+        } else {
+            RunVerdict::Pass
+        };
     }
 
     /// An estimate by name: `(value, u)`.
@@ -380,9 +442,80 @@ impl Results {
     }
 }
 
+/// Whether a recording's run ended other than `completed` (aborted, failed, or never
+/// ended); a recording from another system, with no `run` block, counts as complete.
+pub fn ended_early(manifest: &crate::recording::Manifest) -> bool {
+    manifest
+        .run
+        .as_ref()
+        .is_some_and(|r| r.status != "completed")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn check(verdict: Verdict) -> Acceptance {
+        Acceptance {
+            name: "q".into(),
+            quantity: "q".into(),
+            step: None,
+            value: None,
+            op: "<=".into(),
+            limit: 1.0,
+            unit: String::new(),
+            margin: None,
+            expanded_u: None,
+            rule: "simple".into(),
+            verdict,
+            reason: None,
+        }
+    }
+
+    #[test]
+    fn run_verdict_follows_the_worst_check() {
+        let mut r: Results = serde_json::from_value(serde_json::json!({
+            "format": FORMAT, "parameters": {}, "acceptance": [], "recording": {
+                "paths": [], "imu": {}, "latitude_deg": 0.0, "gravity_mps2": 9.8,
+                "imu_rows": 0, "table_rows": 0, "imu_rate_hz": 0.0, "table_rate_hz": 0.0,
+                "duration_s": 0.0 },
+            "model": { "selection": "by_kind", "fits": [] }, "sync": {
+                "method": "", "table_step_s": 0.0, "max_gap_s": 0.0, "max_sync_error_s": 0.0,
+                "max_angle_error_deg": 0.0 },
+            "environment": {}
+        }))
+        .unwrap();
+        assert_eq!(
+            r.verdict,
+            RunVerdict::Incomplete,
+            "no verdict recorded is no pass"
+        );
+        let cases = [
+            (
+                vec![Verdict::Pass, Verdict::Deferred],
+                false,
+                RunVerdict::Pass,
+            ),
+            (
+                vec![Verdict::Pass, Verdict::NotEvaluated],
+                false,
+                RunVerdict::Incomplete,
+            ),
+            (vec![Verdict::Indeterminate], false, RunVerdict::Incomplete),
+            (
+                vec![Verdict::NotEvaluated, Verdict::Fail],
+                false,
+                RunVerdict::Fail,
+            ),
+            (vec![Verdict::Pass], true, RunVerdict::Aborted),
+        ];
+        for (checks, aborted, want) in cases {
+            r.acceptance = checks.iter().copied().map(check).collect();
+            r.decide(aborted);
+            assert_eq!(r.verdict, want, "{checks:?} aborted={aborted}");
+        }
+        assert!(r.to_json().contains("\"verdict\": \"aborted\""));
+    }
 
     #[test]
     fn parameter_shapes() {

@@ -45,6 +45,9 @@ fn manifest(files: &[(&str, &str)]) -> Manifest {
                 .iter()
                 .map(|(a, b)| (a.to_string(), b.to_string()))
                 .collect(),
+            failure: None,
+            resumes: Vec::new(),
+            changed_after_release: None,
         }),
     }
 }

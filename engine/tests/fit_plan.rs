@@ -140,8 +140,8 @@ fn plan_fits_and_acceptance() {
     assert_eq!(by("gyro.residual.std").verdict, Verdict::Pass);
     assert_eq!(by("gyro.residual.std").rule, "guard_banded");
     let r = by("repeatability.cv");
-    assert_eq!(r.verdict, Verdict::NotEvaluated);
-    assert!(r.reason.as_ref().unwrap().contains("runs"));
+    assert_eq!(r.verdict, Verdict::Deferred);
+    assert!(r.reason.as_ref().unwrap().contains("3 runs"));
     let env: Vec<_> = res
         .acceptance
         .iter()

@@ -1,14 +1,14 @@
 //! `ratecal analyze RUN_DIR... [--procedure PROCEDURE] [--out results.json]`: fits,
 //! uncertainties and acceptance for one recording, or repeatability over several runs.
-//! Exit codes: 0 results written and no check failed, 3 a check failed, 1 input error,
-//! 2 usage error (clap).
+//! Exit codes: 0 the verdict is pass, 3 it is not (a failed check, a check that could not
+//! be evaluated, an aborted run), 1 input error, 2 usage error (clap).
 
 use super::procedure::{self, FsSources};
 use ratecal_engine::check::{CheckOptions, NoImports, check_text};
 use ratecal_engine::fit::{self, Options};
 use ratecal_engine::plan::{Plan, segment_matches};
 use ratecal_engine::recording;
-use ratecal_engine::results::{Parameter, Results, Verdict};
+use ratecal_engine::results::{Parameter, Results, RunVerdict};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -32,11 +32,15 @@ pub struct Args {
     /// Where to write results.json (default: standard output).
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
+    /// Accept a released version whose text no longer matches versions.lock.
+    #[arg(long)]
+    allow_changed: bool,
 }
 
 /// Runs the subcommand.
 pub fn main(args: Args) -> ExitCode {
-    let (plan, sha256) = match args.procedure.as_deref().map(load_plan).transpose() {
+    let load = |p: &std::path::Path| load_plan(p, args.allow_changed);
+    let (plan, sha256) = match args.procedure.as_deref().map(load).transpose() {
         Ok(Some((p, h))) => (Some(p), h),
         Ok(None) => (None, None),
         Err(()) => return ExitCode::from(1),
@@ -46,7 +50,7 @@ pub fn main(args: Args) -> ExitCode {
         match recording::read(dir) {
             Ok(r) => runs.push((dir.display().to_string(), r)),
             Err(e) => {
-                eprintln!("{:?}", miette::Report::new(e));
+                errln!("{:?}", miette::Report::new(e));
                 return ExitCode::from(1);
             }
         }
@@ -65,32 +69,40 @@ pub fn main(args: Args) -> ExitCode {
     match &args.out {
         Some(path) => {
             if let Err(e) = std::fs::write(path, json + "\n") {
-                eprintln!("error: cannot write {}: {e}", path.display());
+                errln!("error: cannot write {}: {e}", path.display());
+                return ExitCode::from(1);
+            }
+            // A file ratecal writes into a sealed run folder joins the seal, with the command.
+            if let Err(e) = super::seal::record_addition(path, &super::seal::command_line()) {
+                errln!("error: cannot add {} to the seal: {e}", path.display());
                 return ExitCode::from(1);
             }
         }
-        None => println!("{json}"),
+        None => outln!("{json}"),
     }
     summary(&results);
-    if results.has_failure() {
-        ExitCode::from(3)
-    } else {
-        ExitCode::SUCCESS
+    match results.verdict {
+        RunVerdict::Pass => ExitCode::SUCCESS,
+        _ => ExitCode::from(3),
     }
 }
 
 /// Loads and checks the procedure (a file, a folder's newest version, `folder@version`)
 /// with the SHA-256 of its canonical text; a checked plan serialized as JSON is accepted
 /// too (no hash then). Diagnostics go to standard error.
-pub(crate) fn load_plan(arg: &std::path::Path) -> Result<(Plan, Option<String>), ()> {
+pub(crate) fn load_plan(
+    arg: &std::path::Path,
+    allow_changed: bool,
+) -> Result<(Plan, Option<String>), ()> {
     if arg.extension().is_some_and(|e| e == "json") {
         let text = std::fs::read_to_string(arg)
-            .map_err(|e| eprintln!("error: cannot read {}: {e}", arg.display()))?;
+            .map_err(|e| errln!("error: cannot read {}: {e}", arg.display()))?;
         return serde_json::from_str(&text)
             .map(|p| (p, None))
-            .map_err(|e| eprintln!("error: {}: not a checked plan: {e}", arg.display()));
+            .map_err(|e| errln!("error: {}: not a checked plan: {e}", arg.display()));
     }
     let file = procedure::read(&arg.display().to_string()).map_err(|d| procedure::report(&d))?;
+    procedure::released_unchanged(&file, allow_changed)?;
     match check_text(
         &file.display,
         &file.text,
@@ -148,7 +160,7 @@ fn default_plan(rec: &recording::Recording) -> Option<Plan> {
 
 /// A short human summary on standard error (standard output may hold the JSON).
 fn summary(r: &Results) {
-    eprintln!(
+    errln!(
         "ratecal analyze: {} ({})",
         r.recording.paths.join(", "),
         r.model.selection
@@ -156,21 +168,16 @@ fn summary(r: &Results) {
     for (name, p) in &r.parameters {
         match p {
             Parameter::Estimate { value, u, unit } => {
-                eprintln!("  {name:<32} {value:>14.6} ± {u:<10.3e} {unit}")
+                errln!("  {name:<32} {value:>14.6} ± {u:<10.3e} {unit}")
             }
-            Parameter::Unobservable { .. } => eprintln!("  {name:<32} {:>14}", "not observable"),
+            Parameter::Unobservable { .. } => errln!("  {name:<32} {:>14}", "not observable"),
         }
     }
     for a in &r.acceptance {
-        let v = match a.verdict {
-            Verdict::Pass => "pass",
-            Verdict::Fail => "FAIL",
-            Verdict::Indeterminate => "indeterminate",
-            Verdict::NotEvaluated => "not evaluated",
-        };
-        eprintln!("  [{v}] {}", a.name);
+        errln!("  [{}] {}", a.verdict.label(), a.name);
     }
     for w in &r.warnings {
-        eprintln!("  warning: {w}");
+        errln!("  warning: {w}");
     }
+    errln!("verdict: {}", r.verdict.as_str().to_uppercase());
 }

@@ -18,6 +18,9 @@ pub struct Args {
     /// Output format: text, or json (the checked plans on standard output).
     #[arg(long, value_parser = ["text", "json"], default_value = "text")]
     format: String,
+    /// Accept a released version whose text no longer matches versions.lock (a warning).
+    #[arg(long)]
+    allow_changed: bool,
 }
 
 /// Formats a duration in seconds as `1 h 22 min`, `12 min`, `45 s`.
@@ -52,7 +55,7 @@ pub fn main(args: Args) -> ExitCode {
         let text = match std::fs::read_to_string(path) {
             Ok(t) => t,
             Err(e) => {
-                eprintln!(
+                errln!(
                     "ratecal check: cannot read station `{}`: {e}",
                     path.display()
                 );
@@ -62,7 +65,7 @@ pub fn main(args: Args) -> ExitCode {
         match Station::from_yaml(&text, &path.display().to_string()) {
             Ok(st) => opts.station = Some(station_limits(&st)),
             Err(e) => {
-                eprintln!("{:?}", miette::Report::new(*e));
+                errln!("{:?}", miette::Report::new(*e));
                 return ExitCode::from(1);
             }
         }
@@ -85,6 +88,12 @@ pub fn main(args: Args) -> ExitCode {
                 continue;
             }
         };
+        // A folder's versions were checked against the lock just above.
+        if !std::path::Path::new(input).is_dir()
+            && procedure::released_unchanged(&file, args.allow_changed).is_err()
+        {
+            failed = true;
+        }
         match check_text(&file.display, &file.text, &FsSources, &opts) {
             Ok(checked) => {
                 checked.warnings.iter().for_each(procedure::report);
@@ -96,16 +105,16 @@ pub fn main(args: Args) -> ExitCode {
                     human_duration(p.estimated_duration_s)
                 );
                 if args.format == "json" {
-                    eprintln!("{line}");
+                    errln!("{line}");
                 } else {
-                    println!("{line}");
+                    outln!("{line}");
                 }
                 plans.push(checked.plan);
             }
             Err(diags) => {
                 diags.iter().for_each(procedure::report);
                 let n = diags.iter().filter(|d| d.is_error()).count();
-                eprintln!(
+                errln!(
                     "{}: {n} error{}",
                     file.display,
                     if n == 1 { "" } else { "s" }
@@ -116,9 +125,9 @@ pub fn main(args: Args) -> ExitCode {
     }
     if args.format == "json" {
         match serde_json::to_string_pretty(&plans) {
-            Ok(s) => println!("{s}"),
+            Ok(s) => outln!("{s}"),
             Err(e) => {
-                eprintln!("ratecal check: cannot write JSON: {e}");
+                errln!("ratecal check: cannot write JSON: {e}");
                 return ExitCode::from(1);
             }
         }

@@ -79,10 +79,10 @@ pub fn main(args: Args) -> ExitCode {
     };
     let report = audit::diff_report(&old.plan, &old.sha256, &new.plan, &new.sha256);
     match args.format {
-        Format::Json => println!("{}", render::json(&report)),
+        Format::Json => outln!("{}", render::json(&report)),
         Format::Text => {
             let color = std::io::stdout().is_terminal() && std::env::var_os("NO_COLOR").is_none();
-            print!("{}", render::text(&report, color));
+            out!("{}", render::text(&report, color));
         }
     }
     if report.changes.is_empty() {

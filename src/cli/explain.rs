@@ -28,6 +28,9 @@ pub struct Args {
     /// Output format.
     #[arg(long, value_enum, default_value = "text")]
     format: Format,
+    /// Accept a released procedure version whose text changed after release.
+    #[arg(long)]
+    allow_changed: bool,
 }
 
 /// Runs the subcommand.
@@ -41,7 +44,7 @@ pub fn main(args: Args) -> ExitCode {
     };
     let nominal = match &args.procedure {
         None => NominalModel::seed(),
-        Some(p) => match super::analyze::load_plan(p) {
+        Some(p) => match super::analyze::load_plan(p, args.allow_changed) {
             Ok((plan, _)) => NominalModel::from_plan(&plan, rec.manifest.station.site.latitude_deg),
             Err(()) => return ExitCode::from(2),
         },
@@ -54,17 +57,18 @@ pub fn main(args: Args) -> ExitCode {
     let json = serde_json::to_string_pretty(&x).expect("plain data serializes");
     // Kept in a ratecal run folder (not in another system's recording): its report shows it.
     if rec.manifest.run.is_some() {
-        if let Err(e) = std::fs::write(args.run.join("explain.json"), format!("{json}\n")) {
-            eprintln!("warning: cannot write explain.json into the run folder: {e}");
+        let path = args.run.join("explain.json");
+        let written = std::fs::write(&path, format!("{json}\n"))
+            .and_then(|()| super::seal::record_addition(&path, &super::seal::command_line()));
+        if let Err(e) = written {
+            eprintln!("warning: cannot keep explain.json in the run folder: {e}");
         }
     }
     let out = match args.format {
         Format::Json => json + "\n",
         Format::Text => explain::render_text(&x),
     };
-    if super::print_out(&out).is_err() {
-        return ExitCode::from(if x.findings.is_empty() { 0 } else { 1 });
-    }
+    out!("{out}");
     if x.findings.is_empty() {
         ExitCode::SUCCESS
     } else {

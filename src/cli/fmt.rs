@@ -65,13 +65,13 @@ pub fn main(args: Args) -> ExitCode {
             continue;
         }
         if args.check {
-            println!("not canonical: {}", file.display);
+            outln!("not canonical: {}", file.display);
             bad = true;
         } else if let Err(e) = std::fs::write(&file.path, &canon.text) {
-            eprintln!("ratecal fmt: cannot write {}: {e}", file.display);
+            errln!("ratecal fmt: cannot write {}: {e}", file.display);
             bad = true;
         } else {
-            eprintln!("formatted {}", file.display);
+            errln!("formatted {}", file.display);
         }
     }
     if bad {

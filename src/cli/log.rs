@@ -100,7 +100,7 @@ pub fn main(args: Args) -> ExitCode {
                 "{} holds no procedure versions",
                 folder.display()
             );
-            eprintln!("{e:?}");
+            errln!("{e:?}");
             return ExitCode::from(2);
         }
     };
@@ -111,14 +111,14 @@ pub fn main(args: Args) -> ExitCode {
         .unwrap_or_default();
     let mut previous: Option<super::diff::Loaded> = None;
     let mut failed = false;
-    println!("{}", folder.display());
+    outln!("{}", folder.display());
     for (version, path) in files {
         let display = path.display().to_string();
         let loaded = std::fs::read(&path)
             .ok()
             .and_then(|b| super::diff::load_text(&display, &String::from_utf8_lossy(&b)));
         let Some(loaded) = loaded else {
-            println!(
+            outln!(
                 "{:<8} {:<64}  (does not check: see the errors above)",
                 version.to_string(),
                 "-"
@@ -138,7 +138,7 @@ pub fn main(args: Args) -> ExitCode {
             None => "first version".to_string(),
             Some(p) => render::summary(&diff(&p.plan, &loaded.plan)),
         };
-        println!(
+        outln!(
             "{:<8} {}  {status:<10}  {summary}",
             version.to_string(),
             loaded.sha256

@@ -137,5 +137,38 @@ impl Sources for FsSources {
 
 /// Prints a diagnostic on standard error.
 pub fn report(d: &Diagnostic) {
-    eprint!("{}", d.render());
+    crate::out::stderr(format_args!("{}", d.render()), false);
+}
+
+/// Whether a version file was changed after its release (its folder's versions.lock records
+/// another hash): refused with `check::changed_after_release` unless `allow`, when it is
+/// reported as a warning and described for the manifest (`Ok(Some(..))`).
+pub fn released_unchanged(file: &ProcedureFile, allow: bool) -> Result<Option<String>, ()> {
+    use ratecal_engine::audit::versions::{LOCK_FILE, changed_after_release};
+    let Some(dir) = file.path.parent() else {
+        return Ok(None);
+    };
+    let Ok(lock) = std::fs::read_to_string(dir.join(LOCK_FILE)) else {
+        return Ok(None);
+    };
+    let name = file
+        .path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let Some(d) = changed_after_release(&file.display, &name, &file.text, &lock) else {
+        return Ok(None);
+    };
+    if !allow {
+        report(&d);
+        return Err(());
+    }
+    errln!(
+        "warning: {} was changed after its release; run anyway (--allow-changed)",
+        file.display
+    );
+    Ok(Some(format!(
+        "{} differs from the text released in {LOCK_FILE}",
+        file.display
+    )))
 }

@@ -68,7 +68,7 @@ pub fn main(args: Args) -> ExitCode {
     match report(&args) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("{e:?}");
+            errln!("{e:?}");
             ExitCode::from(1)
         }
     }
@@ -89,9 +89,14 @@ fn report(args: &Args) -> miette::Result<()> {
     }
     let text = render::render_template(&input, &templates, &name)?;
     match &args.out {
-        Some(out) => std::fs::write(out, text)
-            .map_err(|e| io(out, e, "check that the folder exists and is writable"))?,
-        None => print!("{text}"),
+        Some(out) => {
+            std::fs::write(out, text)
+                .map_err(|e| io(out, e, "check that the folder exists and is writable"))?;
+            // A report written into a sealed run folder joins the seal, with the command.
+            super::seal::record_addition(out, &super::seal::command_line())
+                .map_err(|e| io(out, e, "check that the run folder is writable"))?;
+        }
+        None => out!("{text}"),
     }
     Ok(())
 }
@@ -100,7 +105,6 @@ fn report(args: &Args) -> miette::Result<()> {
 /// templates overridden by `template_dir`'s files if given. Returns the paths written.
 /// `ratecal run` calls this after the analysis (build `input` with
 /// `ReportInput::from_run`).
-// `ratecal run` is wired to this on another branch; until the merge nothing here calls it.
 pub fn write_reports(
     run_dir: &Path,
     input: &ReportInput,

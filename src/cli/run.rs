@@ -1,19 +1,20 @@
 //! `ratecal run`: runs a procedure on a station (simulated with `--dry-run` or without a
-//! station), records the run folder, then analyses it. Exit codes (spec/cli.md): 0 completed
-//! and no acceptance check failed, 3 an acceptance check failed, 4 aborted, 1 input error,
-//! 2 usage.
+//! station), records the run folder, analyses it, writes the reports and seals the folder.
+//! Exit codes (spec/cli.md): 0 the verdict is pass, 3 it is not (a failed check, a check
+//! that could not be evaluated), 4 aborted, 1 input error (or a run that failed: its folder
+//! ends with `status: failed`), 2 usage.
 
 mod check;
+mod finish;
 mod imports;
 mod progress;
+mod resume;
 mod setup;
 
+use ed25519_dalek::SigningKey;
 use miette::Report;
-use ratecal_engine::recording::sha256_hex;
 use ratecal_engine::recording::{Columns, RecordingWriter};
-use ratecal_engine::run::{
-    JournalEntry, JournalEvent, RunOptions, RunOutcome, RunSink, RunStatus, execute, resume_point,
-};
+use ratecal_engine::run::{RunOptions, execute};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -44,6 +45,13 @@ pub struct Args {
     /// Operator name, recorded in the manifest.
     #[arg(long)]
     operator: Option<String>,
+    /// Sign the run folder's seal with the lab's private key (`ratecal key new` wrote it).
+    #[arg(long, value_name = "LAB_KEY")]
+    sign: Option<PathBuf>,
+    /// Run a released version although its text no longer matches versions.lock (the
+    /// manifest and the report record it).
+    #[arg(long)]
+    allow_changed: bool,
 }
 
 /// Runs the subcommand.
@@ -51,14 +59,14 @@ pub fn main(args: Args) -> ExitCode {
     match run(args) {
         Ok(code) => code,
         Err(report) => {
-            eprintln!("{report:?}");
+            errln!("{report:?}");
             ExitCode::from(1)
         }
     }
 }
 
 /// Everything the interpreter needs, prepared.
-struct Prepared {
+pub(crate) struct Prepared {
     dir: PathBuf,
     plan: ratecal_engine::plan::Plan,
     station: ratecal_drivers::Station,
@@ -68,10 +76,30 @@ struct Prepared {
 }
 
 fn run(args: Args) -> Result<ExitCode, Report> {
+    // The key is read first: a run is not started only to find it cannot be signed.
+    let key = args
+        .sign
+        .as_deref()
+        .map(super::seal::signing_key)
+        .transpose()?;
     let prep = match &args.resume {
-        Some(dir) => prepare_resume(dir)?,
+        Some(dir) => resume::prepare(dir)?,
         None => prepare_new(&args)?,
     };
+    let dir = prep.dir.clone();
+    match execute_prepared(prep, key.as_ref()) {
+        Ok(code) => Ok(code),
+        Err(report) => {
+            // The folder exists: it must not be left saying `running`.
+            if let Err(e) = finish::mark_failed(&dir, &report.to_string(), key.as_ref()) {
+                errln!("cannot record the failure in {}: {e}", dir.display());
+            }
+            Err(report)
+        }
+    }
+}
+
+fn execute_prepared(prep: Prepared, key: Option<&SigningKey>) -> Result<ExitCode, Report> {
     let Prepared {
         dir,
         plan,
@@ -90,7 +118,7 @@ fn run(args: Args) -> Result<ExitCode, Report> {
     // run needs no IO driver.
     let flag = cancel.clone();
     if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)) {
-        eprintln!("warning: Ctrl-C will not stop the run cleanly: {e}");
+        errln!("warning: Ctrl-C will not stop the run cleanly: {e}");
     }
     // A simulated station runs on the paused (virtual) clock with only the timer (each
     // control tick would otherwise poll the IO driver); hardware in real time with IO.
@@ -119,17 +147,29 @@ fn run(args: Args) -> Result<ExitCode, Report> {
             )
             .await,
         )
-    })?;
+    });
+    // The recording is closed before anything reads it back (or records a failure).
+    drop(writer);
+    let outcome = outcome?;
     bar.finish();
     let wall = wall.elapsed().as_secs_f64();
     let outcome = outcome
         .map_err(|e| miette::miette!("cannot close the recording in {}: {e}", dir.display()))?;
-    Ok(finish(&dir, &plan, &outcome, wall, simulated))
+    let end = finish::End {
+        dir: &dir,
+        plan: &plan,
+        outcome: &outcome,
+        wall_s: wall,
+        simulated,
+        key,
+    };
+    Ok(end.finish())
 }
 
 fn prepare_new(args: &Args) -> Result<Prepared, Report> {
     let st = setup::station(args.station.as_deref(), args.dry_run)?;
     let proc_path = setup::procedure_file(args.procedure.as_deref().unwrap_or(Path::new(".")))?;
+    let changed = setup::released_unchanged(&proc_path, args.allow_changed)?;
     let pr = setup::procedure(&proc_path, &st.station, None)?;
     let dir = args
         .out
@@ -153,6 +193,7 @@ fn prepare_new(args: &Args) -> Result<Prepared, Report> {
         dry_run: args.dry_run || args.station.is_none(),
         seed: args.seed,
         operator: args.operator.clone(),
+        changed_after_release: changed,
     };
     let manifest = setup::manifest(&st, &pr, &facts);
     let columns = Columns {
@@ -168,185 +209,4 @@ fn prepare_new(args: &Args) -> Result<Prepared, Report> {
         opts: RunOptions::default(),
         seed: args.seed,
     })
-}
-
-fn prepare_resume(dir: &Path) -> Result<Prepared, Report> {
-    let io = |e: std::io::Error| {
-        miette::miette!(
-            help = "--resume takes a run folder written by `ratecal run`",
-            "cannot resume {}: {e}",
-            dir.display()
-        )
-    };
-    let journal = std::fs::read_to_string(dir.join("journal.jsonl")).map_err(io)?;
-    let point = resume_point(&journal);
-    if point.completed {
-        return Err(miette::miette!(
-            "{} is a completed run: nothing to resume",
-            dir.display()
-        ));
-    }
-    let (mut writer, last_t) = RecordingWriter::append(dir).map_err(io)?;
-    let dry_run = writer.manifest().run.as_ref().is_some_and(|r| r.dry_run);
-    let seed = writer
-        .manifest()
-        .run
-        .as_ref()
-        .and_then(|r| r.seed)
-        .unwrap_or(1);
-    let st = setup::station(Some(&dir.join("station.yaml")), dry_run)?;
-    let station_sha = sha256_hex(st.yaml.as_bytes());
-    let pr = setup::procedure(&dir.join("procedure.rcal"), &st.station, Some(dir))?;
-    let mut changed_station = None;
-    let m = writer.manifest_mut();
-    m.segments.truncate(point.segments);
-    if let Some(run) = m.run.as_mut() {
-        run.status = "running".into();
-        run.abort = None;
-        run.ended = None;
-        // An operator may fix the station file before resuming (a fault rehearsal, a
-        // repaired table): the resumed part runs with the new file, the journal keeps both.
-        if let Some(old) = run.station_sha256.replace(station_sha.clone())
-            && old != station_sha
-        {
-            changed_station = Some((old, station_sha.clone()));
-        }
-        // The data files are hashed again when the run ends; the import copies stand.
-        run.files_sha256
-            .retain(|name, _| name.starts_with(&format!("{}/", imports::IMPORTS_DIR)));
-    }
-    writer.checkpoint().map_err(io)?;
-    if let Some((old, new)) = changed_station {
-        eprintln!("station.yaml changed since the interrupted part: the rest runs with it");
-        let entry = JournalEntry {
-            t: last_t.unwrap_or(0.0),
-            step: None,
-            event: JournalEvent::Warning {
-                rule: "station.yaml changed before the resume".into(),
-                values: format!("sha256 {old} -> {new}"),
-            },
-        };
-        writer.journal(&entry).map_err(io)?;
-    }
-    let opts = RunOptions {
-        start_step: point.next_step,
-        resume_segments: point.segments,
-        // Time keeps increasing across the interruption (1 s gap).
-        t_offset: last_t.map_or(0.0, |t| t + 1.0),
-        ..RunOptions::default()
-    };
-    Ok(Prepared {
-        dir: dir.to_path_buf(),
-        plan: pr.plan,
-        station: st.station,
-        writer,
-        opts,
-        seed,
-    })
-}
-
-/// Analysis of a completed run, summary, exit code.
-fn finish(
-    dir: &Path,
-    plan: &ratecal_engine::plan::Plan,
-    out: &RunOutcome,
-    wall_s: f64,
-    simulated: bool,
-) -> ExitCode {
-    let run_s = out.t_end - out.t_start;
-    println!("run folder: {}", dir.display());
-    let clock = if simulated { "simulated" } else { "run" };
-    println!(
-        "duration: {} {clock}, {:.1} s real ({:.0}x)",
-        progress::hms(run_s),
-        wall_s,
-        run_s / wall_s.max(1e-9)
-    );
-    println!(
-        "steps: {}/{}, segments: {}, warnings: {}",
-        out.steps_completed,
-        plan.steps.len(),
-        out.segments,
-        out.warnings.len()
-    );
-    match &out.status {
-        RunStatus::Aborted(a) => {
-            println!(
-                "ABORTED at t = {:.3} s{}: {}",
-                a.t,
-                a.step
-                    .as_ref()
-                    .map(|s| format!(" in step {s}"))
-                    .unwrap_or_default(),
-                a.rule
-            );
-            println!("  {}", a.values);
-            println!(
-                "the recording holds every sample up to the safe stop; continue with `ratecal run --resume {}`",
-                dir.display()
-            );
-            ExitCode::from(4)
-        }
-        RunStatus::Completed => analyze(dir, plan),
-    }
-}
-
-/// Runs the analysis stage on the fresh recording and writes `results.json`.
-fn analyze(dir: &Path, plan: &ratecal_engine::plan::Plan) -> ExitCode {
-    let rec = match ratecal_engine::recording::read(dir) {
-        Ok(r) => r,
-        Err(e) => {
-            eprintln!("{:?}", Report::new(e));
-            return ExitCode::from(1);
-        }
-    };
-    let results = ratecal_engine::fit::analyze(&rec, Some(plan));
-    if let Err(e) = std::fs::write(dir.join("results.json"), results.to_json()) {
-        eprintln!("cannot write results.json: {e}");
-        return ExitCode::from(1);
-    }
-    use ratecal_engine::results::Verdict;
-    for a in &results.acceptance {
-        let v = match a.verdict {
-            Verdict::Pass => "pass",
-            Verdict::Fail => "FAIL",
-            Verdict::Indeterminate => "indeterminate",
-            Verdict::NotEvaluated => "not evaluated",
-        };
-        let value = a
-            .value
-            .map_or_else(|| "-".to_string(), |x| format!("{x:.6}"));
-        println!(
-            "  {v:>13}  {} = {value} {} (limit {} {} {})",
-            a.quantity, a.unit, a.op, a.limit, a.unit
-        );
-    }
-    println!("results: {}", dir.join("results.json").display());
-    // The checked plan beside the results lets `ratecal report` describe the process later.
-    if let Ok(json) = serde_json::to_string_pretty(plan) {
-        let _ = std::fs::write(dir.join("plan.json"), json);
-    }
-    let input = ratecal_engine::render::ReportInput::from_run(
-        &results,
-        &rec.manifest,
-        Some(plan),
-        Some(&rec),
-        env!("CARGO_PKG_VERSION"),
-    );
-    match super::report::write_reports(dir, &input, None) {
-        Ok(paths) => {
-            for p in paths {
-                println!("report: {}", p.display());
-            }
-        }
-        Err(e) => {
-            eprintln!("{e:?}");
-            return ExitCode::from(1);
-        }
-    }
-    if results.has_failure() {
-        ExitCode::from(3)
-    } else {
-        ExitCode::from(0)
-    }
 }

@@ -6,6 +6,7 @@
 //!   summary of `ratecal log`.
 //! - [`versions`] holds the rules of a procedure folder and its `versions.lock`.
 //! - [`verify`] compares the hashes a run recorded with the files handed in.
+//! - [`seal`] seals a run folder (every file's hash, optionally signed) and checks it.
 //!
 //! Nothing here opens a file: the CLI reads and hands in the data.
 
@@ -13,6 +14,7 @@ mod change;
 mod diff;
 mod direction;
 pub mod render;
+pub mod seal;
 pub mod verify;
 pub mod versions;
 

@@ -37,6 +37,10 @@ pub enum Status {
     Missing,
     /// The file no longer parses.
     Unparsable(String),
+    /// The file is in the folder but not in the seal.
+    Unknown,
+    /// Not signed by the given key: why.
+    Unsigned(String),
 }
 
 /// One file checked against its recorded hash.
@@ -99,6 +103,8 @@ impl VerifyReport {
                 Status::Unparsable(why) => {
                     format!("! ALTERED  {}: no longer parses ({why})\n", c.file)
                 }
+                Status::Unknown => format!("! UNKNOWN  {}: not in the seal\n", c.file),
+                Status::Unsigned(why) => format!("! UNSIGNED {}: {why}\n", c.file),
             };
             s.push_str(&line);
         }

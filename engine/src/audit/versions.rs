@@ -379,3 +379,38 @@ pub fn check_versions(folder: &FolderData) -> Vec<Diagnostic> {
     }
     out
 }
+
+/// `check::changed_after_release`: `text`, the version file `file_name` of a procedure
+/// folder whose lock is `lock_text`, was released with another canonical hash. `None` when
+/// the version is not released, or is released as it stands.
+pub fn changed_after_release(
+    path: &str,
+    file_name: &str,
+    text: &str,
+    lock_text: &str,
+) -> Option<Diagnostic> {
+    let version = version_of_file_name(file_name)?;
+    let (entries, _) = parse_lock(LOCK_FILE, lock_text);
+    let entry = entries
+        .iter()
+        .find(|e| Version::parse(&e.version).as_ref() == Some(&version))?;
+    let now = ratecal_grammar::canonical(text).ok()?.sha256;
+    if now == entry.sha256 {
+        return None;
+    }
+    let v = version.to_string();
+    Some(
+        Diagnostic::error(
+            "check::changed_after_release",
+            format!("version {v} was changed after its release"),
+        )
+        .label(
+            span(version_span(text, &v)),
+            format!("released as {}, now {now}", entry.sha256),
+        )
+        .help(format!(
+            "release a new version: copy the change to a higher version file and add it to {LOCK_FILE} (--allow-changed runs it anyway, and the run records it)"
+        ))
+        .with_source(&source(path, text)),
+    )
+}

@@ -54,15 +54,20 @@ const SIGNALS: &[(&str, Signal, Dim)] = &[
 /// Quantities acceptance and verification limits may name.
 const ACCEPTS: &[(&str, Dim)] = &[
     ("accel.residual.std", Dim::Accel),
-    ("accel.residual.mean", Dim::Accel),
     ("accel.error", Dim::Accel),
     ("gyro.residual.std", Dim::Rate),
-    ("gyro.residual.mean", Dim::Rate),
     ("gyro.error", Dim::Rate),
     ("gyro.bias.std", Dim::Rate),
-    ("gyro.noise.std", Dim::Rate),
     ("repeatability.cv", Dim::Ratio),
-    ("size_effect.uncertainty", Dim::Length),
+];
+
+/// Quantities the language once named that no fit computes: a check on one could never be
+/// evaluated, so it is refused here rather than leaving every run incomplete.
+const NOT_COMPUTED: &[(&str, &str)] = &[
+    ("accel.residual.mean", "accel.residual.std"),
+    ("gyro.residual.mean", "gyro.residual.std"),
+    ("gyro.noise.std", "gyro.bias.std"),
+    ("size_effect.uncertainty", "accel.error"),
 ];
 
 /// Fit models: (sensor, model word) -> model.
@@ -325,6 +330,19 @@ impl Ck<'_> {
 
     fn limit(&mut self, l: &ast::Limit) -> Option<(String, Cmp, Quantity)> {
         let names: Vec<&str> = ACCEPTS.iter().map(|x| x.0).collect();
+        if let Some((_, instead)) = NOT_COMPUTED.iter().find(|x| x.0 == l.name.node) {
+            self.err(
+                Diagnostic::error(
+                    "check::not_computed",
+                    format!("no fit computes `{}`", l.name.node),
+                )
+                .label(l.name.span, "this check could never be evaluated")
+                .help(format!(
+                    "check a quantity the analysis computes, e.g. `{instead}` (docs/language.md lists them)"
+                )),
+            );
+            return None;
+        }
         let Some(&(name, dim)) = ACCEPTS.iter().find(|x| x.0 == l.name.node) else {
             self.err(
                 Diagnostic::error(

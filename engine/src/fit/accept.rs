@@ -96,6 +96,11 @@ pub(crate) fn evaluate(
     let Some(plan) = plan else { return Vec::new() };
     let mut out = Vec::new();
     for a in &plan.accepts {
+        // A check over several runs is decided by the analysis of those runs, not one.
+        if let Some(n) = a.over_runs {
+            out.push(deferred(a, n));
+            continue;
+        }
         let measured = lookup(&a.quantity, res, q);
         out.push(match measured {
             Ok((v, u)) => judge(a, v, u, None),
@@ -348,4 +353,14 @@ pub(crate) fn not_evaluated(a: &Accept, why: &str) -> Acceptance {
         verdict: Verdict::NotEvaluated,
         reason: Some(why.into()),
     }
+}
+
+/// A check declared over `n` runs, left to the analysis of those runs.
+fn deferred(a: &Accept, n: u32) -> Acceptance {
+    let mut d = not_evaluated(
+        a,
+        &format!("decided over {n} runs: `ratecal analyze RUN1 ... RUN{n}`"),
+    );
+    d.verdict = Verdict::Deferred;
+    d
 }

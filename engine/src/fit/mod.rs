@@ -240,6 +240,7 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
     let segments = sel.uses(rec, &data);
     let mut res = Results {
         format: results::FORMAT.into(),
+        verdict: results::RunVerdict::default(),
         parameters: std::mem::take(&mut out.params),
         acceptance: Vec::new(),
         observability: std::mem::take(&mut out.observability),
@@ -263,6 +264,7 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
     let mut w = std::mem::take(&mut out.warnings);
     w.append(&mut res.warnings);
     res.warnings = w;
+    res.decide(results::ended_early(&rec.manifest));
     res
 }
 

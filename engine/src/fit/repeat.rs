@@ -115,5 +115,9 @@ pub fn analyze_runs(runs: &[(String, Recording)], plan: Option<&Plan>, opts: &Op
         runs: each.len(),
         parameters: rep,
     });
+    res.decide(
+        runs.iter()
+            .any(|(_, r)| crate::results::ended_early(&r.manifest)),
+    );
     res
 }

@@ -184,6 +184,40 @@ pub struct RunInfo {
     /// SHA-256 of each data file once the run ended (`imu.csv`, `table.csv`, ...).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub files_sha256: BTreeMap<String, String>,
+    /// Why the run failed (status `failed`: the station could not be reached...).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub failure: Option<String>,
+    /// Each interruption and resume, oldest first.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub resumes: Vec<ResumeRecord>,
+    /// Set when the procedure ran although its released version was changed after release
+    /// (`--allow-changed`): what changed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub changed_after_release: Option<String>,
+}
+
+/// Where a run was interrupted and when it resumed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ResumeRecord {
+    /// How the interrupted part ended (`aborted`, `failed`, or `running` when the process
+    /// stopped without ending it).
+    pub interrupted_status: String,
+    /// Why, when recorded (abort rule and values, failure).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+    /// Stream time of the last sample before the interruption, s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub t: Option<f64>,
+    /// Step it was interrupted in, when recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step: Option<String>,
+    /// When the interrupted part ended (RFC 3339), when recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ended: Option<String>,
+    /// When the run resumed (RFC 3339).
+    pub resumed: String,
+    /// Index of the first step the resumed part ran.
+    pub from_step: usize,
 }
 
 /// Why and when a run aborted.

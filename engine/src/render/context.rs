@@ -130,12 +130,72 @@ pub fn build(input: &ReportInput) -> Value {
         "warnings": results.get("warnings").cloned().unwrap_or(json!([])),
         "findings": results.get("findings").cloned().unwrap_or(json!([])),
         "summary": summary,
+        "history": history(&run),
         "recommendations": {
             "temperature_span_c": environment["imu_temperature"].get("span"),
             "temperature_compensation": views::has_temperature_model(results, &parameters),
             "recalibration_interval": interval,
         },
     })
+}
+
+/// What happened to the run, in plain sentences for the report's first lines: each
+/// interruption and resume, an abort, a failure, a procedure run although changed after
+/// release (from the manifest's `run` block, where the journal's abort and resume are kept).
+fn history(run: &Value) -> Vec<String> {
+    let s = |v: Option<&Value>| v.and_then(Value::as_str).map(str::to_string);
+    let at = |t: Option<&Value>, step: Option<&Value>| {
+        let t = t
+            .and_then(Value::as_f64)
+            .map(|t| format!(" at t = {t:.3} s"));
+        let step = s(step).map(|st| format!(" in step {st}"));
+        format!("{}{}", t.unwrap_or_default(), step.unwrap_or_default())
+    };
+    let mut out = Vec::new();
+    for r in run
+        .get("resumes")
+        .and_then(Value::as_array)
+        .into_iter()
+        .flatten()
+    {
+        let why = s(r.get("reason")).map(|w| format!(": {w}"));
+        let ended = s(r.get("ended")).map(|e| format!(" (ended {e})"));
+        let from = r.get("from_step").and_then(Value::as_u64).unwrap_or(0) + 1;
+        out.push(format!(
+            "Interrupted ({}){}{}{}; resumed {} from step {from}.",
+            s(r.get("interrupted_status")).unwrap_or_else(|| "interrupted".into()),
+            at(r.get("t"), r.get("step")),
+            why.unwrap_or_default(),
+            ended.unwrap_or_default(),
+            s(r.get("resumed")).unwrap_or_else(|| "later".into()),
+        ));
+    }
+    let ended = s(run.get("ended")).map(|e| format!(" (ended {e})"));
+    match run.get("status").and_then(Value::as_str) {
+        Some("aborted") => {
+            let a = run.get("abort");
+            let rule =
+                s(a.and_then(|a| a.get("rule"))).unwrap_or_else(|| "no reason recorded".into());
+            let values = s(a.and_then(|a| a.get("values"))).map(|v| format!(" ({v})"));
+            out.push(format!(
+                "ABORTED{}: {rule}{}{}.",
+                at(a.and_then(|a| a.get("t")), a.and_then(|a| a.get("step"))),
+                values.unwrap_or_default(),
+                ended.unwrap_or_default()
+            ));
+        }
+        Some("failed") => out.push(format!(
+            "FAILED: {}{}.",
+            s(run.get("failure")).unwrap_or_else(|| "no reason recorded".into()),
+            ended.unwrap_or_default()
+        )),
+        Some("running") => out.push("The run never ended (status `running`).".into()),
+        _ => {}
+    }
+    if let Some(c) = s(run.get("changed_after_release")) {
+        out.push(format!("Run with --allow-changed: {c}."));
+    }
+    out
 }
 
 /// Lab conditions: the manifest's block (or the one results.json repeats), ambient and IMU

@@ -208,11 +208,11 @@ pub fn residual_table(results: &Value) -> Value {
     Value::Array(rows.collect())
 }
 
-/// Worst verdict over the acceptance checks (and over verification points and repeatability
-/// parameters that carry a verdict of their own).
+/// The run's verdict (results.json `verdict`; for an older results file without one, the
+/// worst over the checks, `incomplete` when one was not decided) and the checks by outcome.
 pub fn summary(checks: &Value, results: &Value, params: &Value) -> Value {
     let mut counts = Map::new();
-    let mut by: [Vec<Value>; 3] = Default::default(); // fail, indeterminate, not evaluated
+    let mut by: [Vec<Value>; 4] = Default::default(); // fail, indeterminate, not evaluated, deferred
     let empty = vec![];
     let arr = |v: Option<&Value>| v.and_then(Value::as_array).unwrap_or(&empty).clone();
     let with_verdict = |v: &Value| v.get("verdict").is_some_and(Value::is_string);
@@ -245,24 +245,24 @@ pub fn summary(checks: &Value, results: &Value, params: &Value) -> Value {
             "fail" => by[0].push(item),
             "indeterminate" => by[1].push(item),
             "pass" => {}
+            "deferred" => by[3].push(item),
             _ => by[2].push(item),
         }
     }
-    let verdict = if !by[0].is_empty() {
-        "fail"
-    } else if !by[1].is_empty() {
-        "indeterminate"
-    } else if counts.contains_key("pass") {
-        "pass"
-    } else {
-        "not_evaluated"
+    let recorded = results.get("verdict").and_then(Value::as_str);
+    let verdict = match recorded {
+        Some(v) => v,
+        None if !by[0].is_empty() => "fail",
+        None if !by[1].is_empty() || !by[2].is_empty() => "incomplete",
+        None if counts.contains_key("pass") => "pass",
+        None => "incomplete",
     };
     let unobservable: Vec<Value> = arr(Some(params))
         .into_iter()
         .filter(|p| p.get("observable") == Some(&json!(false)))
         .map(|p| json!({ "name": p.get("name"), "reason": p.get("reason") }))
         .collect();
-    let [failed, indeterminate, not_evaluated] = by;
+    let [failed, indeterminate, not_evaluated, deferred] = by;
     json!({
         "verdict": verdict,
         "meets_standard": verdict == "pass",
@@ -270,6 +270,7 @@ pub fn summary(checks: &Value, results: &Value, params: &Value) -> Value {
         "failed": failed,
         "indeterminate": indeterminate,
         "not_evaluated": not_evaluated,
+        "deferred": deferred,
         "unobservable": unobservable,
     })
 }

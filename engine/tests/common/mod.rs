@@ -355,6 +355,9 @@ pub fn manifest(name: &str) -> Manifest {
             seed: None,
             station_sha256: None,
             files_sha256: Default::default(),
+            failure: None,
+            resumes: Vec::new(),
+            changed_after_release: None,
         }),
     }
 }

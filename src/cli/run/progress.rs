@@ -69,7 +69,7 @@ impl Progress for Bar {
     fn message(&mut self, text: &str) {
         match &self.bar {
             Some(b) => b.println(text),
-            None => eprintln!("{text}"),
+            None => errln!("{text}"),
         }
     }
 
@@ -88,7 +88,7 @@ impl Progress for Bar {
 
 /// Asks the operator on the terminal; anything but `n`/`no` confirms.
 fn ask(text: &str) -> bool {
-    eprintln!("operator: {text}\npress Enter when done (or type `no` to abort)");
+    errln!("operator: {text}\npress Enter when done (or type `no` to abort)");
     let mut line = String::new();
     if std::io::stdin().read_line(&mut line).is_err() {
         return false;

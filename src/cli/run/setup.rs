@@ -44,6 +44,21 @@ pub fn station(path: Option<&Path>, dry_run: bool) -> Result<LoadedStation, Repo
     Ok(LoadedStation { station, yaml })
 }
 
+/// Refuses a released version changed after its release (unless `allow`); with `allow`,
+/// what the manifest records.
+pub fn released_unchanged(path: &Path, allow: bool) -> Result<Option<String>, Report> {
+    let file = crate::cli::procedure::read(&path.display().to_string()).map_err(|d| {
+        crate::cli::procedure::report(&d);
+        miette!("no procedure to run")
+    })?;
+    crate::cli::procedure::released_unchanged(&file, allow).map_err(|()| {
+        miette!(
+            "{}: changed after its release; nothing was run",
+            file.display
+        )
+    })
+}
+
 /// A procedure ready to run.
 pub struct LoadedProcedure {
     /// The checked plan.
@@ -111,6 +126,8 @@ pub struct RunFacts<'a> {
     pub dry_run: bool,
     pub seed: u64,
     pub operator: Option<String>,
+    /// Set when a released version changed after release runs (`--allow-changed`).
+    pub changed_after_release: Option<String>,
 }
 
 /// The manifest of a new run.
@@ -170,6 +187,9 @@ pub fn manifest(st: &LoadedStation, proc_: &LoadedProcedure, facts: &RunFacts) -
             station_sha256: Some(sha256_hex(st.yaml.as_bytes())),
             // The import copies are hashed now; the data files when the run ends.
             files_sha256: proc_.imports.hashes(),
+            failure: None,
+            resumes: Vec::new(),
+            changed_after_release: facts.changed_after_release.clone(),
         }),
     }
 }

@@ -1,0 +1,289 @@
+//! The seal of a run folder: the SHA-256 of every file, written last (`seal.json`), its own
+//! hash beside it (`seal.sha256`), optionally an Ed25519 signature by the lab's key. Files
+//! ratecal adds later are listed with when and by which command. The CLI reads the folder
+//! and hands the files in; nothing here opens a file.
+
+use super::verify::{FileCheck, Status, VerifyReport, sha256_hex};
+use ed25519_dalek::{Signature, Signer, SigningKey, Verifier, VerifyingKey};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// The seal's file name in a run folder.
+pub const SEAL_FILE: &str = "seal.json";
+/// The file holding the SHA-256 of `seal.json`.
+pub const SEAL_HASH_FILE: &str = "seal.sha256";
+/// The format tag of a seal.
+pub const SEAL_FORMAT: &str = "ratecal-seal/1";
+
+/// What `seal.json` holds.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Seal {
+    /// `ratecal-seal/1`.
+    pub format: String,
+    /// When the run sealed its folder (RFC 3339).
+    pub sealed: String,
+    /// SHA-256 of each file of the folder when sealed, by path (`/`-separated).
+    pub files: BTreeMap<String, String>,
+    /// The lab's signature over [`Seal::signed_text`], if the run was signed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub signature: Option<SealSignature>,
+    /// Files ratecal added or rewrote after sealing, oldest first.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub added: Vec<Addition>,
+}
+
+/// An Ed25519 signature and the public key that made it (both hex).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SealSignature {
+    /// `ed25519`.
+    pub algorithm: String,
+    /// Public key, 32 bytes hex.
+    pub public_key: String,
+    /// Signature, 64 bytes hex.
+    pub signature: String,
+}
+
+/// Files ratecal wrote into a sealed folder later (a re-rendered report, a new analysis).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Addition {
+    /// When (RFC 3339).
+    pub time: String,
+    /// The command that wrote them.
+    pub command: String,
+    /// SHA-256 of each file written, by path.
+    pub files: BTreeMap<String, String>,
+}
+
+/// Whether a path names the seal itself (never listed in it).
+pub fn is_seal_file(path: &str) -> bool {
+    path == SEAL_FILE || path == SEAL_HASH_FILE
+}
+
+impl Seal {
+    /// Seals `files` (path and bytes, the seal's own files left out) at time `sealed`.
+    pub fn new<'a>(sealed: &str, files: impl IntoIterator<Item = (&'a str, &'a [u8])>) -> Self {
+        Seal {
+            format: SEAL_FORMAT.into(),
+            sealed: sealed.into(),
+            files: files
+                .into_iter()
+                .filter(|(p, _)| !is_seal_file(p))
+                .map(|(p, b)| (p.to_string(), sha256_hex(b)))
+                .collect(),
+            signature: None,
+            added: Vec::new(),
+        }
+    }
+
+    /// The text a signature covers: format, time and one `sha256  path` line per sealed
+    /// file (additions are covered by the seal's hash, not by the signature).
+    pub fn signed_text(&self) -> String {
+        let mut s = format!("{}\n{}\n", self.format, self.sealed);
+        for (path, sha) in &self.files {
+            s.push_str(&format!("{sha}  {path}\n"));
+        }
+        s
+    }
+
+    /// Signs the sealed files with the lab's key.
+    pub fn sign(&mut self, key: &SigningKey) {
+        let sig = key.sign(self.signed_text().as_bytes());
+        self.signature = Some(SealSignature {
+            algorithm: "ed25519".into(),
+            public_key: hex::encode(key.verifying_key().as_bytes()),
+            signature: hex::encode(sig.to_bytes()),
+        });
+    }
+
+    /// Records files written after sealing.
+    pub fn add(&mut self, time: &str, command: &str, files: &[(&str, &[u8])]) {
+        self.added.push(Addition {
+            time: time.into(),
+            command: command.into(),
+            files: files
+                .iter()
+                .map(|(p, b)| (p.to_string(), sha256_hex(b)))
+                .collect(),
+        });
+    }
+
+    /// `seal.json` text.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("seal serializes") + "\n"
+    }
+
+    /// `seal.sha256` text for this seal's JSON.
+    pub fn hash_line(json: &str) -> String {
+        format!("{}  {SEAL_FILE}\n", sha256_hex(json.as_bytes()))
+    }
+}
+
+/// Checks a run folder against its seal: `seal` and `seal_hash` are the seal files' text
+/// (`None` when missing), `files` every other file of the folder with its bytes, `key` the
+/// lab's public key when the signature must be checked.
+pub fn verify_seal(
+    seal: Option<&str>,
+    seal_hash: Option<&str>,
+    files: &BTreeMap<String, Vec<u8>>,
+    key: Option<&VerifyingKey>,
+) -> VerifyReport {
+    let mut report = VerifyReport::default();
+    let mut push = |file: &str, status: Status| {
+        report.checks.push(FileCheck {
+            file: file.into(),
+            status,
+        })
+    };
+    let Some(text) = seal else {
+        push(SEAL_FILE, Status::Missing);
+        return report;
+    };
+    let parsed: Seal = match serde_json::from_str(text) {
+        Ok(s) => s,
+        Err(e) => {
+            push(SEAL_FILE, Status::Unparsable(e.to_string()));
+            return report;
+        }
+    };
+    if parsed.format != SEAL_FORMAT {
+        let why = format!("format `{}`, not `{SEAL_FORMAT}`", parsed.format);
+        push(SEAL_FILE, Status::Unparsable(why));
+        return report;
+    }
+    let actual = sha256_hex(text.as_bytes());
+    let recorded = seal_hash.and_then(|h| h.split_whitespace().next());
+    push(
+        &format!("{SEAL_FILE} (its hash in {SEAL_HASH_FILE})"),
+        match recorded {
+            None => Status::Missing,
+            Some(h) if h.eq_ignore_ascii_case(&actual) => Status::Intact,
+            Some(h) => Status::Altered {
+                expected: h.into(),
+                actual,
+            },
+        },
+    );
+    // The newest record of a file wins: a re-rendered report replaces the sealed one.
+    let mut expected: BTreeMap<&str, (&str, Option<&Addition>)> = parsed
+        .files
+        .iter()
+        .map(|(p, h)| (p.as_str(), (h.as_str(), None)))
+        .collect();
+    for a in &parsed.added {
+        for (p, h) in &a.files {
+            expected.insert(p.as_str(), (h.as_str(), Some(a)));
+        }
+    }
+    for (path, (sha, added)) in &expected {
+        let name = match added {
+            Some(a) => format!("{path} (written by `{}` at {})", a.command, a.time),
+            None => path.to_string(),
+        };
+        let status = match files.get(*path) {
+            None => Status::Missing,
+            Some(b) => {
+                let now = sha256_hex(b);
+                if now.eq_ignore_ascii_case(sha) {
+                    Status::Intact
+                } else {
+                    Status::Altered {
+                        expected: sha.to_string(),
+                        actual: now,
+                    }
+                }
+            }
+        };
+        push(&name, status);
+    }
+    for path in files.keys().filter(|p| !expected.contains_key(p.as_str())) {
+        push(path, Status::Unknown);
+    }
+    if let Some(key) = key {
+        push(
+            "signature",
+            signature_status(&parsed, key).map_or(Status::Intact, Status::Unsigned),
+        );
+        // A later addition is not signed: it must not stand in for a file the lab signed.
+        for a in &parsed.added {
+            for p in a.files.keys().filter(|p| parsed.files.contains_key(*p)) {
+                let why = format!(
+                    "signed file rewritten later by `{}` at {}",
+                    a.command, a.time
+                );
+                push(p, Status::Unsigned(why));
+            }
+        }
+    }
+    report
+}
+
+/// `None` when the seal is signed by `key`, else why not.
+fn signature_status(seal: &Seal, key: &VerifyingKey) -> Option<String> {
+    let Some(sig) = &seal.signature else {
+        return Some("the seal is not signed".into());
+    };
+    if !sig
+        .public_key
+        .eq_ignore_ascii_case(&hex::encode(key.as_bytes()))
+    {
+        return Some(format!("signed by another key ({})", sig.public_key));
+    }
+    let bytes: Option<[u8; 64]> = hex::decode(&sig.signature)
+        .ok()
+        .and_then(|b| b.try_into().ok());
+    let Some(bytes) = bytes else {
+        return Some("the signature is not 64 bytes of hex".into());
+    };
+    match key.verify(
+        seal.signed_text().as_bytes(),
+        &Signature::from_bytes(&bytes),
+    ) {
+        Ok(()) => None,
+        Err(_) => Some("the signature does not match the sealed hashes".into()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn folder(files: &[(&str, &str)]) -> BTreeMap<String, Vec<u8>> {
+        files
+            .iter()
+            .map(|(p, t)| (p.to_string(), t.as_bytes().to_vec()))
+            .collect()
+    }
+
+    #[test]
+    fn additions_supersede_and_signatures_cover_only_the_sealed_files() {
+        let f = folder(&[("imu.csv", "1"), ("report.md", "old")]);
+        let key = SigningKey::from_bytes(&[7; 32]);
+        let mut seal = Seal::new("t0", f.iter().map(|(p, b)| (p.as_str(), b.as_slice())));
+        seal.sign(&key);
+        let json = seal.to_json();
+        let hash = Seal::hash_line(&json);
+        let pk = key.verifying_key();
+        assert!(verify_seal(Some(&json), Some(&hash), &f, Some(&pk)).intact());
+
+        // A re-rendered report, recorded: intact without a key, not vouched for by it.
+        let g = folder(&[("imu.csv", "1"), ("report.md", "new")]);
+        seal.add("t1", "ratecal report", &[("report.md", b"new")]);
+        let json = seal.to_json();
+        let hash = Seal::hash_line(&json);
+        assert!(verify_seal(Some(&json), Some(&hash), &g, None).intact());
+        let signed = verify_seal(Some(&json), Some(&hash), &g, Some(&pk));
+        assert!(!signed.intact());
+        assert!(
+            signed.text().contains("UNSIGNED report.md"),
+            "{}",
+            signed.text()
+        );
+
+        // An unknown file, and a seal whose hash is not the one beside it.
+        let h = folder(&[("imu.csv", "1"), ("report.md", "new"), ("x", "")]);
+        let r = verify_seal(Some(&json), Some(&hash), &h, None);
+        assert!(r.text().contains("! UNKNOWN  x"), "{}", r.text());
+        let r = verify_seal(Some(&json.replace("t1", "t2")), Some(&hash), &g, None);
+        assert!(!r.intact());
+    }
+}

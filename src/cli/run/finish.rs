@@ -1,0 +1,179 @@
+//! The end of `ratecal run`: the summary on the terminal (every warning with its text), the
+//! analysis (of an aborted run too, from the data kept), the reports, then the seal, written
+//! last; and the record of a run that failed after its folder existed.
+
+use ed25519_dalek::SigningKey;
+use miette::Report;
+use ratecal_engine::plan::Plan;
+use ratecal_engine::recording::{manifest_yaml, parse_manifest, rfc3339};
+use ratecal_engine::results::RunVerdict;
+use ratecal_engine::run::{JournalEntry, JournalEvent, RunOutcome, RunStatus};
+use std::path::Path;
+use std::process::ExitCode;
+
+/// A run that ended (completed or aborted), to analyse, report and seal.
+pub struct End<'a> {
+    /// The run folder.
+    pub dir: &'a Path,
+    /// The checked plan that ran.
+    pub plan: &'a Plan,
+    /// How the interpreter ended.
+    pub outcome: &'a RunOutcome,
+    /// Wall-clock seconds the run took.
+    pub wall_s: f64,
+    /// Whether the station was simulated (virtual clock).
+    pub simulated: bool,
+    /// The lab's key, to sign the seal.
+    pub key: Option<&'a SigningKey>,
+}
+
+impl End<'_> {
+    /// Summary, analysis, reports, seal; the exit code of spec/cli.md.
+    pub fn finish(&self) -> ExitCode {
+        let (dir, out) = (self.dir, self.outcome);
+        let run_s = out.t_end - out.t_start;
+        outln!("run folder: {}", dir.display());
+        let clock = if self.simulated { "simulated" } else { "run" };
+        outln!(
+            "duration: {} {clock}, {:.1} s real ({:.0}x)",
+            super::progress::hms(run_s),
+            self.wall_s,
+            run_s / self.wall_s.max(1e-9)
+        );
+        outln!(
+            "steps: {}/{}, segments: {}, warnings: {}",
+            out.steps_completed,
+            self.plan.steps.len(),
+            out.segments,
+            out.warnings.len()
+        );
+        for w in &out.warnings {
+            outln!("  warning: {w}");
+        }
+        let aborted = matches!(out.status, RunStatus::Aborted(_));
+        if let RunStatus::Aborted(a) = &out.status {
+            let step = a.step.as_ref().map(|s| format!(" in step {s}"));
+            outln!(
+                "ABORTED at t = {:.3} s{}: {}",
+                a.t,
+                step.unwrap_or_default(),
+                a.rule
+            );
+            outln!("  {}", a.values);
+            outln!(
+                "the recording holds every sample up to the safe stop; continue with `ratecal run --resume {}`",
+                dir.display()
+            );
+        }
+        let verdict = analyze(dir, self.plan);
+        if let Err(e) = crate::cli::seal::write(dir, self.key) {
+            errln!("cannot seal {}: {e}", dir.display());
+            return ExitCode::from(1);
+        }
+        outln!("sealed: {}", dir.join("seal.json").display());
+        match verdict {
+            _ if aborted => ExitCode::from(4),
+            Some(RunVerdict::Pass) => ExitCode::SUCCESS,
+            Some(_) => ExitCode::from(3),
+            None => ExitCode::from(1),
+        }
+    }
+}
+
+/// Every warning of the run (all its parts, resumed or not) with its text, from the journal.
+pub fn journal_warnings(dir: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(dir.join("journal.jsonl")).unwrap_or_default();
+    text.lines()
+        .filter_map(|l| serde_json::from_str::<JournalEntry>(l).ok())
+        .filter_map(|e| {
+            let what = match e.event {
+                JournalEvent::Warning { rule, values } => format!("{rule}: {values}"),
+                JournalEvent::SettleTimeout {
+                    after_s,
+                    action,
+                    unmet,
+                } if action == "warn" => format!("settle timeout after {after_s:.1} s: {unmet}"),
+                _ => return None,
+            };
+            let step = e.step.map(|s| format!(", step {s}")).unwrap_or_default();
+            Some(format!("during the run (t = {:.3} s{step}): {what}", e.t))
+        })
+        .collect()
+}
+
+/// Analyses the recording kept (complete or not), writes results.json, plan.json and the
+/// reports; the verdict, or `None` when the recording could not be analysed.
+fn analyze(dir: &Path, plan: &Plan) -> Option<RunVerdict> {
+    let rec = match ratecal_engine::recording::read(dir) {
+        Ok(r) => r,
+        Err(e) => {
+            errln!("{:?}", Report::new(e));
+            errln!("no analysis: the recording cannot be read back");
+            return None;
+        }
+    };
+    let mut results = ratecal_engine::fit::analyze(&rec, Some(plan));
+    let run_warnings = journal_warnings(dir);
+    results.warnings.splice(0..0, run_warnings);
+    if let Err(e) = std::fs::write(dir.join("results.json"), results.to_json()) {
+        errln!("cannot write results.json: {e}");
+        return None;
+    }
+    for a in &results.acceptance {
+        let value = a
+            .value
+            .map_or_else(|| "-".to_string(), |x| format!("{x:.6}"));
+        outln!(
+            "  {:>13}  {} = {value} {} (limit {} {} {})",
+            a.verdict.label(),
+            a.quantity,
+            a.unit,
+            a.op,
+            a.limit,
+            a.unit
+        );
+    }
+    outln!("verdict: {}", results.verdict.as_str().to_uppercase());
+    outln!("results: {}", dir.join("results.json").display());
+    // The checked plan beside the results lets `ratecal report` describe the process later.
+    if let Ok(json) = serde_json::to_string_pretty(plan) {
+        let _ = std::fs::write(dir.join("plan.json"), json);
+    }
+    let input = ratecal_engine::render::ReportInput::from_run(
+        &results,
+        &rec.manifest,
+        Some(plan),
+        Some(&rec),
+        env!("CARGO_PKG_VERSION"),
+    );
+    match crate::cli::report::write_reports(dir, &input, None) {
+        Ok(paths) => {
+            for p in paths {
+                outln!("report: {}", p.display());
+            }
+        }
+        Err(e) => {
+            errln!("{e:?}");
+            return None;
+        }
+    }
+    Some(results.verdict)
+}
+
+/// Records that the run failed after its folder existed (`status: failed` and why), then
+/// seals what the folder holds.
+pub fn mark_failed(dir: &Path, why: &str, key: Option<&SigningKey>) -> std::io::Result<()> {
+    let path = dir.join("manifest.yaml");
+    let text = std::fs::read_to_string(&path)?;
+    let mut m =
+        parse_manifest("manifest.yaml", &text).map_err(|e| std::io::Error::other(e.to_string()))?;
+    if let Some(run) = m.run.as_mut() {
+        run.status = "failed".into();
+        run.failure = Some(why.to_string());
+        run.ended = Some(rfc3339(std::time::SystemTime::now()));
+    }
+    std::fs::write(&path, manifest_yaml(&m)?)?;
+    outln!("FAILED: {why}");
+    outln!("the run folder {} records the failure", dir.display());
+    crate::cli::seal::write(dir, key)
+}

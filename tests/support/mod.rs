@@ -1,0 +1,92 @@
+//! What the CLI tests share: running `ratecal`, a small procedure, station variants.
+
+#![allow(dead_code)]
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+/// Two attitudes and one rate point: a dry run of it takes well under a second.
+pub const MINI: &str = r#"procedure mini version 1.0.0 {
+  title "Two attitudes and one rate"
+  imu class tactical
+
+  abort when table.attitude_error > 5 arcsec for 1 s
+  abort when ambient.temperature outside 18 degC .. 22 degC for 2 s
+
+  step statics "Two static attitudes" {
+    for (n, pitch, roll) in [(1, 0 deg, 0 deg), (2, 90 deg, 0 deg)] {
+      move to pitch pitch, roll roll
+      settle {
+        at least 5 s
+        table.attitude_error <= 5 arcsec
+        timeout 60 s -> abort
+      }
+      acquire accel, gyro, table for 10 s at 100 Hz as "accel_static/{n}"
+    }
+  }
+
+  step rates "One rate point" {
+    for axis in [outer] {
+      for rate in [50] deg/s {
+        spin axis at rate
+        settle {
+          at least 5 s
+          table.rate_error <= 0.5 deg/s
+          timeout 60 s -> abort
+        }
+        acquire gyro, table for 10 s at 100 Hz as "gyro_scale/{axis}/{rate:+}"
+      }
+      stop axis
+    }
+  }
+}
+"#;
+
+/// A lab temperature excursion during MINI's rate step: the run aborts there.
+pub const EXCURSION: &str = "faults: [ { temperature_excursion: { at: 36 s, delta: 4 degC, ramp: 1 s, duration: 600 s } } ]";
+
+/// Runs `ratecal` in `cwd`.
+pub fn ratecal(args: &[&str], cwd: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_ratecal"))
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .unwrap()
+}
+
+/// The exit code (-1 for a signal).
+pub fn code(o: &Output) -> i32 {
+    o.status.code().unwrap_or(-1)
+}
+
+/// Standard output and standard error, for assertion messages.
+pub fn text(o: &Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+/// The default station with `faults: []` replaced.
+pub fn station_with(fault: &str) -> String {
+    ratecal_drivers::DEFAULT_STATION_YAML.replace("faults: []", fault)
+}
+
+/// A JSON file of a run folder.
+pub fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// The bundled procedures folder.
+pub fn procedures(name: &str) -> String {
+    format!("{}/procedures/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Writes MINI as `p.rcal` in `dir` and dry-runs it into `dir/out` (optionally more args).
+pub fn mini_run(dir: &Path, out: &str, extra: &[&str]) -> Output {
+    std::fs::write(dir.join("p.rcal"), MINI).unwrap();
+    let mut args = vec!["run", "p.rcal", "--dry-run", "--out", out];
+    args.extend_from_slice(extra);
+    ratecal(&args, dir)
+}
