@@ -31,6 +31,8 @@ enum Command {
     Log(cli::log::Args),
     /// Check that a run folder was not altered since the run.
     Verify(cli::verify::Args),
+    /// The calibration archive: add, list, show, export, trend, backup, check.
+    Archive(cli::archive::Args),
 }
 
 fn main() -> ExitCode {
@@ -44,5 +46,6 @@ fn main() -> ExitCode {
         Command::Diff(a) => cli::diff::main(a),
         Command::Log(a) => cli::log::main(a),
         Command::Verify(a) => cli::verify::main(a),
+        Command::Archive(a) => cli::archive::main(a),
     }
 }

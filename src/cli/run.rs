@@ -44,6 +44,9 @@ pub struct Args {
     /// Operator name, recorded in the manifest.
     #[arg(long)]
     operator: Option<String>,
+    /// Archive the run here (folder or postgres:// URL; also $RATECAL_ARCHIVE).
+    #[arg(long, value_name = "DIR_OR_URL")]
+    archive: Option<String>,
 }
 
 /// Runs the subcommand.
@@ -124,7 +127,9 @@ fn run(args: Args) -> Result<ExitCode, Report> {
     let wall = wall.elapsed().as_secs_f64();
     let outcome = outcome
         .map_err(|e| miette::miette!("cannot close the recording in {}: {e}", dir.display()))?;
-    Ok(finish(&dir, &plan, &outcome, wall, simulated))
+    let code = finish(&dir, &plan, &outcome, wall, simulated);
+    super::archive::after_run(args.archive.as_deref(), &dir);
+    Ok(code)
 }
 
 fn prepare_new(args: &Args) -> Result<Prepared, Report> {

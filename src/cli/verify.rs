@@ -17,30 +17,46 @@ pub struct Args {
     run_dir: PathBuf,
 }
 
-/// Runs the subcommand.
-pub fn main(args: Args) -> ExitCode {
-    let dir = &args.run_dir;
+/// Why a folder cannot be verified at all.
+pub enum Unverifiable {
+    /// No readable manifest.yaml.
+    NotARun(miette::Report),
+    /// The manifest records no hashes.
+    NothingRecorded(miette::Report),
+}
+
+impl Unverifiable {
+    /// The diagnostic.
+    pub fn report(self) -> miette::Report {
+        match self {
+            Unverifiable::NotARun(r) | Unverifiable::NothingRecorded(r) => r,
+        }
+    }
+}
+
+/// Checks a run folder as `ratecal verify` does (also used by `ratecal archive add`).
+pub fn verify_folder(dir: &Path) -> Result<verify::VerifyReport, Unverifiable> {
     let manifest_path = dir.join("manifest.yaml");
     let Ok(manifest_text) = std::fs::read_to_string(&manifest_path) else {
-        let e = miette::miette!(
+        return Err(Unverifiable::NotARun(miette::miette!(
             code = "verify::not_a_run",
             help = "give the folder `ratecal run --out` wrote",
             "{} is not a run folder (no readable manifest.yaml)",
             dir.display()
-        );
-        eprintln!("{e:?}");
-        return ExitCode::from(2);
+        )));
     };
     let manifest: Manifest = match serde_saphyr::from_str(&manifest_text) {
         Ok(m) => m,
         Err(e) => {
             // The manifest holds the hashes: if it no longer parses, it was altered.
-            println!(
-                "! ALTERED  manifest.yaml: no longer parses ({})",
-                first_line(&e.to_string())
+            let check = verify::check_file(
+                "manifest.yaml",
+                "",
+                Actual::Unparsable(first_line(&e.to_string()).to_string()),
             );
-            println!("ALTERED since the run: manifest.yaml");
-            return ExitCode::from(1);
+            return Ok(verify::VerifyReport {
+                checks: vec![check],
+            });
         }
     };
     let procedure = manifest.procedure.as_ref().map(|_| procedure_copy(dir));
@@ -52,21 +68,32 @@ pub fn main(args: Args) -> ExitCode {
     let read = |name: &str| std::fs::read(dir.join(name)).ok();
     let report = verify::verify_run(&manifest, read, procedure, station);
     if report.checks.is_empty() {
-        let e = miette::miette!(
+        return Err(Unverifiable::NothingRecorded(miette::miette!(
             code = "verify::nothing_recorded",
             help = "ratecal records the hashes when a run ends; a recording from another system, \
                     or a run that did not end, cannot be verified",
             "{} records no hashes to verify against",
             manifest_path.display()
-        );
-        eprintln!("{e:?}");
-        return ExitCode::from(2);
+        )));
     }
-    print!("{}", report.text());
-    if report.intact() {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::from(1)
+    Ok(report)
+}
+
+/// Runs the subcommand.
+pub fn main(args: Args) -> ExitCode {
+    match verify_folder(&args.run_dir) {
+        Err(e) => {
+            eprintln!("{:?}", e.report());
+            ExitCode::from(2)
+        }
+        Ok(report) => {
+            print!("{}", report.text());
+            if report.intact() {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(1)
+            }
+        }
     }
 }
 
