@@ -11,9 +11,18 @@ use std::process::Command;
 const UNITS: usize = 100;
 const CALIBRATIONS: usize = 100;
 const PARAMS: [&str; 12] = [
-    "accel.bias.x", "accel.bias.y", "accel.bias.z", "accel.scale.x", "accel.scale.y",
-    "accel.scale.z", "gyro.bias.x", "gyro.bias.y", "gyro.bias.z", "gyro.scale.x",
-    "gyro.scale.y", "gyro.scale.z",
+    "accel.bias.x",
+    "accel.bias.y",
+    "accel.bias.z",
+    "accel.scale.x",
+    "accel.scale.y",
+    "accel.scale.z",
+    "gyro.bias.x",
+    "gyro.bias.y",
+    "gyro.bias.z",
+    "gyro.scale.x",
+    "gyro.scale.y",
+    "gyro.scale.z",
 ];
 
 fn run(unit: usize, cal: usize) -> Folder {
@@ -60,7 +69,9 @@ fn build(dir: &Path) {
         .build()
         .unwrap();
     rt.block_on(async {
-        let a = Archive::open(&Location::Folder(dir.to_path_buf())).await.unwrap();
+        let a = Archive::open(&Location::Folder(dir.to_path_buf()))
+            .await
+            .unwrap();
         let runs: Vec<Folder> = (0..UNITS)
             .flat_map(|u| (0..CALIBRATIONS).map(move |c| run(u, c)))
             .collect();
@@ -70,7 +81,10 @@ fn build(dir: &Path) {
 }
 
 fn ratecal(args: &[&str]) {
-    let o = Command::new(env!("CARGO_BIN_EXE_ratecal")).args(args).output().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_ratecal"))
+        .args(args)
+        .output()
+        .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
@@ -79,15 +93,39 @@ fn bench(c: &mut Criterion) {
     let dir = tmp.path().join("archive");
     let t = std::time::Instant::now();
     build(&dir);
-    eprintln!("built 10,000 index rows in {:.1} s", t.elapsed().as_secs_f64());
+    eprintln!(
+        "built 10,000 index rows in {:.1} s",
+        t.elapsed().as_secs_f64()
+    );
     let d = dir.to_str().unwrap();
     let mut g = c.benchmark_group("archive");
     g.sample_size(20);
     g.bench_function("list --serial (process, 10k runs)", |b| {
-        b.iter(|| ratecal(&["archive", "list", "--serial", "SN0042", "--format", "json", "--archive", d]))
+        b.iter(|| {
+            ratecal(&[
+                "archive",
+                "list",
+                "--serial",
+                "SN0042",
+                "--format",
+                "json",
+                "--archive",
+                d,
+            ])
+        })
     });
     g.bench_function("trend over 100 calibrations (process, 10k runs)", |b| {
-        b.iter(|| ratecal(&["archive", "trend", "SN0042", "--format", "json", "--archive", d]))
+        b.iter(|| {
+            ratecal(&[
+                "archive",
+                "trend",
+                "SN0042",
+                "--format",
+                "json",
+                "--archive",
+                d,
+            ])
+        })
     });
     g.finish();
 }

@@ -30,7 +30,15 @@ fn run_adds_itself_and_export_gives_the_folder_back() {
     let cwd = tmp.path();
     std::fs::write(cwd.join("p.rcal"), MINI).unwrap();
     let o = ratecal(
-        &["run", "p.rcal", "--dry-run", "--out", "r1", "--archive", "arch"],
+        &[
+            "run",
+            "p.rcal",
+            "--dry-run",
+            "--out",
+            "r1",
+            "--archive",
+            "arch",
+        ],
         cwd,
     );
     assert!(matches!(code(&o), 0 | 3), "{}", text(&o));
@@ -40,7 +48,16 @@ fn run_adds_itself_and_export_gives_the_folder_back() {
     let runs = list("arch", &["--include-dry-runs"], cwd);
     assert_eq!(runs.len(), 1);
     let r = &runs[0];
-    for key in ["id", "serial", "model", "procedure", "version", "started", "verdict", "dry_run"] {
+    for key in [
+        "id",
+        "serial",
+        "model",
+        "procedure",
+        "version",
+        "started",
+        "verdict",
+        "dry_run",
+    ] {
         assert!(r.get(key).is_some(), "{key} in {r}");
     }
     assert_eq!(r["serial"], "SIM-0001");
@@ -55,7 +72,10 @@ fn run_adds_itself_and_export_gives_the_folder_back() {
     assert_eq!(list("arch", &["--include-dry-runs"], cwd).len(), 1);
 
     // Export by id prefix: byte-identical, and `ratecal verify` passes on it.
-    let o = ratecal(&["archive", "export", &id[..8], "back", "--archive", "arch"], cwd);
+    let o = ratecal(
+        &["archive", "export", &id[..8], "back", "--archive", "arch"],
+        cwd,
+    );
     assert_eq!(code(&o), 0, "{}", text(&o));
     assert_eq!(tree(&cwd.join("r1")), tree(&cwd.join("back")));
     let o = ratecal(&["verify", "back"], cwd);
@@ -63,7 +83,18 @@ fn run_adds_itself_and_export_gives_the_folder_back() {
     let o = ratecal(&["report", "back", "--out", "back-report.md"], cwd);
     assert_eq!(code(&o), 0, "{}", text(&o));
 
-    let o = ratecal(&["archive", "show", &id, "--format", "json", "--archive", "arch"], cwd);
+    let o = ratecal(
+        &[
+            "archive",
+            "show",
+            &id,
+            "--format",
+            "json",
+            "--archive",
+            "arch",
+        ],
+        cwd,
+    );
     assert_eq!(code(&o), 0, "{}", text(&o));
     let show: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(show["id"], id.as_str());
@@ -73,7 +104,11 @@ fn run_adds_itself_and_export_gives_the_folder_back() {
     std::fs::write(cwd.join("r1/imu.csv"), "t,ax\n0,1\n").unwrap();
     let o = ratecal(&["archive", "add", "r1", "--archive", "arch"], cwd);
     assert_eq!(code(&o), 1, "{}", text(&o));
-    assert!(text(&o).contains("altered") && text(&o).contains("imu.csv"), "{}", text(&o));
+    assert!(
+        text(&o).contains("altered") && text(&o).contains("imu.csv"),
+        "{}",
+        text(&o)
+    );
     let o = ratecal(&["archive", "check", "--archive", "arch"], cwd);
     assert_eq!(code(&o), 0, "{}", text(&o));
 }
@@ -82,19 +117,43 @@ fn run_adds_itself_and_export_gives_the_folder_back() {
 fn filters_env_default_and_a_manifest_without_serial() {
     let tmp = tempfile::tempdir().unwrap();
     let cwd = tmp.path();
-    write_run(&cwd.join("a"), Some("1234"), "2025-03-01T10:00:00Z", 0.01, &[]);
-    write_run(&cwd.join("b"), Some("1234"), "2026-03-01T10:00:00Z", 0.012, &[]);
+    write_run(
+        &cwd.join("a"),
+        Some("1234"),
+        "2025-03-01T10:00:00Z",
+        0.01,
+        &[],
+    );
+    write_run(
+        &cwd.join("b"),
+        Some("1234"),
+        "2026-03-01T10:00:00Z",
+        0.012,
+        &[],
+    );
     write_run(&cwd.join("c"), None, "2026-06-15T08:30:00Z", 0.02, &[]);
     // Default archive: ./archive/.
     let o = ratecal(&["archive", "add", "a", "b", "c"], cwd);
     assert_eq!(code(&o), 0, "{}", text(&o));
     assert!(cwd.join("archive/index.sqlite").exists());
     assert_eq!(list("archive", &["--serial", "1234"], cwd).len(), 2);
-    let unknown = list("archive", &["--since", "2026-06-15", "--until", "2026-06-15"], cwd);
+    let unknown = list(
+        "archive",
+        &["--since", "2026-06-15", "--until", "2026-06-15"],
+        cwd,
+    );
     assert_eq!(unknown.len(), 1);
     assert_eq!(unknown[0]["serial"], "unknown");
     assert_eq!(list("archive", &["--serial", "unknown"], cwd).len(), 1);
-    assert_eq!(list("archive", &["--verdict", "pass", "--model", "SIM-TAC-100"], cwd).len(), 3);
+    assert_eq!(
+        list(
+            "archive",
+            &["--verdict", "pass", "--model", "SIM-TAC-100"],
+            cwd
+        )
+        .len(),
+        3
+    );
     assert!(list("archive", &["--verdict", "fail"], cwd).is_empty());
     assert_eq!(list("archive", &["--until", "2025-12-31"], cwd).len(), 1);
     // RATECAL_ARCHIVE names the archive.
@@ -106,7 +165,18 @@ fn filters_env_default_and_a_manifest_without_serial() {
     let v: Vec<serde_json::Value> = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v.len(), 2);
     // Trend: two dates, a limit; JSON and SVG.
-    let o = ratecal(&["archive", "trend", "1234", "--param", "accel.bias.x", "--format", "json"], cwd);
+    let o = ratecal(
+        &[
+            "archive",
+            "trend",
+            "1234",
+            "--param",
+            "accel.bias.x",
+            "--format",
+            "json",
+        ],
+        cwd,
+    );
     assert_eq!(code(&o), 0, "{}", text(&o));
     let t: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(t["parameters"][0]["drift_status"], "determined");
@@ -183,8 +253,15 @@ fn a_process_killed_mid_add_leaves_the_archive_consistent() {
     let extra: Vec<(String, Vec<u8>)> = (0..120)
         .map(|i| (format!("extra/f{i:03}.bin"), vec![i as u8; 150_000]))
         .collect();
-    let extra_ref: Vec<(&str, Vec<u8>)> = extra.iter().map(|(n, b)| (n.as_str(), b.clone())).collect();
-    write_run(&cwd.join("big"), Some("9"), "2026-02-02T00:00:00Z", 0.0, &extra_ref);
+    let extra_ref: Vec<(&str, Vec<u8>)> =
+        extra.iter().map(|(n, b)| (n.as_str(), b.clone())).collect();
+    write_run(
+        &cwd.join("big"),
+        Some("9"),
+        "2026-02-02T00:00:00Z",
+        0.0,
+        &extra_ref,
+    );
     // The archive exists (schema made) before the add starts.
     assert_eq!(list("arch", &[], cwd).len(), 0);
     let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_ratecal"))
@@ -222,7 +299,13 @@ fn a_process_killed_mid_add_leaves_the_archive_consistent() {
 fn a_corrupted_stored_file_is_found_by_check() {
     let tmp = tempfile::tempdir().unwrap();
     let cwd = tmp.path();
-    write_run(&cwd.join("r"), Some("5"), "2026-04-01T00:00:00Z", 0.003, &[]);
+    write_run(
+        &cwd.join("r"),
+        Some("5"),
+        "2026-04-01T00:00:00Z",
+        0.003,
+        &[],
+    );
     let o = ratecal(&["archive", "add", "r", "--archive", "arch"], cwd);
     assert_eq!(code(&o), 0, "{}", text(&o));
     let imu_sha = sha(&std::fs::read(cwd.join("r/imu.csv")).unwrap());
@@ -230,14 +313,24 @@ fn a_corrupted_stored_file_is_found_by_check() {
     std::fs::write(&stored, b"bit rot").unwrap();
     let o = ratecal(&["archive", "check", "--archive", "arch"], cwd);
     assert_eq!(code(&o), 1, "{}", text(&o));
-    assert!(text(&o).contains("CORRUPTED") && text(&o).contains("imu.csv"), "{}", text(&o));
-    let id = list("arch", &[], cwd)[0]["id"].as_str().unwrap().to_string();
+    assert!(
+        text(&o).contains("CORRUPTED") && text(&o).contains("imu.csv"),
+        "{}",
+        text(&o)
+    );
+    let id = list("arch", &[], cwd)[0]["id"]
+        .as_str()
+        .unwrap()
+        .to_string();
     let o = ratecal(&["archive", "export", &id, "out", "--archive", "arch"], cwd);
     assert_eq!(code(&o), 1);
     assert!(text(&o).contains("archive::missing_file"), "{}", text(&o));
     // A missing stored file too.
     std::fs::remove_file(&stored).unwrap();
-    let o = ratecal(&["archive", "check", "--archive", "arch", "--format", "json"], cwd);
+    let o = ratecal(
+        &["archive", "check", "--archive", "arch", "--format", "json"],
+        cwd,
+    );
     assert_eq!(code(&o), 1);
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["missing"].as_array().unwrap().len(), 1);

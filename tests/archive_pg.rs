@@ -138,9 +138,21 @@ fn postgresql_archive_end_to_end() {
     let names: Vec<String> = (0..6).map(|i| format!("r{i}")).collect();
     for (i, n) in names.iter().enumerate() {
         let started = format!("202{}-05-01T12:00:00Z", i);
-        write_run(&cwd.join(n), Some("PG-1"), &started, 0.01 + 0.002 * i as f64, &[]);
+        write_run(
+            &cwd.join(n),
+            Some("PG-1"),
+            &started,
+            0.01 + 0.002 * i as f64,
+            &[],
+        );
     }
-    write_run(&cwd.join("noserial"), None, "2026-07-01T00:00:00Z", 0.0, &[]);
+    write_run(
+        &cwd.join("noserial"),
+        None,
+        "2026-07-01T00:00:00Z",
+        0.0,
+        &[],
+    );
 
     // Two stations adding at once (files in the database, index in one transaction each).
     let spawn = |runs: &[String]| {
@@ -161,24 +173,57 @@ fn postgresql_archive_end_to_end() {
     });
     assert_eq!(code(&a), 0, "{}", text(&a));
     assert_eq!(code(&b), 0, "{}", text(&b));
-    ok(&["archive", "add", "noserial", "r0", "--archive", &url], cwd);
+    ok(
+        &["archive", "add", "noserial", "r0", "--archive", &url],
+        cwd,
+    );
     assert_eq!(list(&url, &["--serial", "PG-1"], cwd).len(), 6);
     let unknown = list(&url, &["--since", "2026-07-01"], cwd);
     assert_eq!(unknown.len(), 1);
     assert_eq!(unknown[0]["serial"], "unknown");
 
     // Round trip from the database's file store.
-    let id = list(&url, &["--serial", "PG-1"], cwd)[2]["id"].as_str().unwrap().to_string();
+    let id = list(&url, &["--serial", "PG-1"], cwd)[2]["id"]
+        .as_str()
+        .unwrap()
+        .to_string();
     ok(&["archive", "export", &id, "back", "--archive", &url], cwd);
     assert_eq!(tree(&cwd.join("r2")), tree(&cwd.join("back")));
     ok(&["verify", "back"], cwd);
-    let show = ok(&["archive", "show", &id, "--format", "json", "--archive", &url], cwd);
+    let show = ok(
+        &[
+            "archive",
+            "show",
+            &id,
+            "--format",
+            "json",
+            "--archive",
+            &url,
+        ],
+        cwd,
+    );
     assert!(show.contains("\"accel.bias.x\""));
 
     // Trend: 0.002 m/s^2 a year, exactly.
-    let t = ok(&["archive", "trend", "PG-1", "--format", "json", "--archive", &url], cwd);
+    let t = ok(
+        &[
+            "archive",
+            "trend",
+            "PG-1",
+            "--format",
+            "json",
+            "--archive",
+            &url,
+        ],
+        cwd,
+    );
     let t: serde_json::Value = serde_json::from_str(&t).unwrap();
-    let p = t["parameters"].as_array().unwrap().iter().find(|p| p["name"] == "accel.bias.x").unwrap();
+    let p = t["parameters"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["name"] == "accel.bias.x")
+        .unwrap();
     let rate = p["drift"]["rate_per_year"].as_f64().unwrap();
     assert!((rate - 0.002).abs() < 1e-5, "{rate}");
 
@@ -191,12 +236,21 @@ fn postgresql_archive_end_to_end() {
     ok(&["archive", "check", "--archive", "copy"], cwd);
 
     // A shared folder for the files instead of the database.
-    write_run(&cwd.join("r9"), Some("PG-2"), "2026-08-01T00:00:00Z", 0.5, &[]);
+    write_run(
+        &cwd.join("r9"),
+        Some("PG-2"),
+        "2026-08-01T00:00:00Z",
+        0.5,
+        &[],
+    );
     let shared = ["--archive", url.as_str(), "--archive-files", "shared"];
     let mut args = vec!["archive", "add", "r9"];
     args.extend_from_slice(&shared);
     ok(&args, cwd);
-    let id = list(&url, &["--serial", "PG-2"], cwd)[0]["id"].as_str().unwrap().to_string();
+    let id = list(&url, &["--serial", "PG-2"], cwd)[0]["id"]
+        .as_str()
+        .unwrap()
+        .to_string();
     let mut args = vec!["archive", "export", id.as_str(), "back9"];
     args.extend_from_slice(&shared);
     ok(&args, cwd);

@@ -100,61 +100,63 @@ impl Archive {
 /// Inserts one run's rows; false when the run is already indexed (nothing written).
 async fn insert_rows(tx: &mut sqlx::Transaction<'_, sqlx::Any>, folder: &Folder) -> Result<bool> {
     let f = &folder.facts;
-        // The first statement writes, so SQLite takes its write lock at once (and waits
-        // for another station's add instead of failing on a stale read snapshot).
-        let done = sqlx::query(
-            "INSERT INTO runs (id, name, serial, model, procedure, version, procedure_sha256, \
+    // The first statement writes, so SQLite takes its write lock at once (and waits
+    // for another station's add instead of failing on a stale read snapshot).
+    let done = sqlx::query(
+        "INSERT INTO runs (id, name, serial, model, procedure, version, procedure_sha256, \
              station, operator, started, ended, status, dry_run, verdict, temperature_c, \
              humidity_pct, pressure_kpa, vibration_g, imu, added) VALUES ($1, $2, $3, $4, $5, \
              $6, $7, $8, $9, $10, $11, $12, $13, $14, $15, $16, $17, $18, $19, $20) \
              ON CONFLICT (id) DO NOTHING",
+    )
+    .bind(&f.id)
+    .bind(&f.name)
+    .bind(&f.serial)
+    .bind(&f.model)
+    .bind(&f.procedure)
+    .bind(&f.version)
+    .bind(&f.procedure_sha256)
+    .bind(&f.station)
+    .bind(f.operator.clone())
+    .bind(&f.started)
+    .bind(f.ended.clone())
+    .bind(&f.status)
+    .bind(i64::from(f.dry_run))
+    .bind(&f.verdict)
+    .bind(f.environment[0])
+    .bind(f.environment[1])
+    .bind(f.environment[2])
+    .bind(f.environment[3])
+    .bind(&f.imu)
+    .bind(crate::dates::now_rfc3339())
+    .execute(&mut **tx)
+    .await?;
+    if done.rows_affected() == 0 {
+        return Ok(false);
+    }
+    for (path, sha, size) in &folder.files {
+        sqlx::query("INSERT INTO run_files (run_id, path, sha256, size) VALUES ($1, $2, $3, $4)")
+            .bind(&f.id)
+            .bind(path)
+            .bind(sha)
+            .bind(*size as i64)
+            .execute(&mut **tx)
+            .await?;
+    }
+    for p in &f.parameters {
+        sqlx::query(
+            "INSERT INTO parameters (run_id, name, value, u, unit) VALUES ($1, $2, $3, $4, $5)",
         )
         .bind(&f.id)
-        .bind(&f.name)
-        .bind(&f.serial)
-        .bind(&f.model)
-        .bind(&f.procedure)
-        .bind(&f.version)
-        .bind(&f.procedure_sha256)
-        .bind(&f.station)
-        .bind(f.operator.clone())
-        .bind(&f.started)
-        .bind(f.ended.clone())
-        .bind(&f.status)
-        .bind(i64::from(f.dry_run))
-        .bind(&f.verdict)
-        .bind(f.environment[0])
-        .bind(f.environment[1])
-        .bind(f.environment[2])
-        .bind(f.environment[3])
-        .bind(&f.imu)
-        .bind(crate::dates::now_rfc3339())
+        .bind(&p.name)
+        .bind(p.value)
+        .bind(p.u)
+        .bind(&p.unit)
         .execute(&mut **tx)
         .await?;
-        if done.rows_affected() == 0 {
-            return Ok(false);
-        }
-        for (path, sha, size) in &folder.files {
-            sqlx::query("INSERT INTO run_files (run_id, path, sha256, size) VALUES ($1, $2, $3, $4)")
-                .bind(&f.id)
-                .bind(path)
-                .bind(sha)
-                .bind(*size as i64)
-                .execute(&mut **tx)
-                .await?;
-        }
-        for p in &f.parameters {
-            sqlx::query("INSERT INTO parameters (run_id, name, value, u, unit) VALUES ($1, $2, $3, $4, $5)")
-                .bind(&f.id)
-                .bind(&p.name)
-                .bind(p.value)
-                .bind(p.u)
-                .bind(&p.unit)
-                .execute(&mut **tx)
-                .await?;
-        }
-        for l in &f.limits {
-            sqlx::query("INSERT INTO limits (run_id, quantity, op, limit_value, unit) VALUES ($1, $2, $3, $4, $5)")
+    }
+    for l in &f.limits {
+        sqlx::query("INSERT INTO limits (run_id, quantity, op, limit_value, unit) VALUES ($1, $2, $3, $4, $5)")
                 .bind(&f.id)
                 .bind(&l.quantity)
                 .bind(&l.op)
@@ -162,6 +164,6 @@ async fn insert_rows(tx: &mut sqlx::Transaction<'_, sqlx::Any>, folder: &Folder)
                 .bind(&l.unit)
                 .execute(&mut **tx)
                 .await?;
-        }
-        Ok(true)
+    }
+    Ok(true)
 }

@@ -58,10 +58,11 @@ impl Archive {
         )
         .fetch_all(&mut *tx)
         .await?;
-        let files: Vec<(String, String, String, i64)> =
-            sqlx::query_as("SELECT run_id, path, sha256, size FROM run_files ORDER BY run_id, path")
-                .fetch_all(&mut *tx)
-                .await?;
+        let files: Vec<(String, String, String, i64)> = sqlx::query_as(
+            "SELECT run_id, path, sha256, size FROM run_files ORDER BY run_id, path",
+        )
+        .fetch_all(&mut *tx)
+        .await?;
         let params: Vec<(String, String, f64, f64, String)> =
             sqlx::query_as("SELECT run_id, name, value, u, unit FROM parameters")
                 .fetch_all(&mut *tx)
@@ -93,7 +94,12 @@ impl Archive {
         }
         for (run, name, value, u, unit) in params {
             if let Some(f) = by_id.get_mut(&run) {
-                f.facts.parameters.push(ParamRow { name, value, u, unit });
+                f.facts.parameters.push(ParamRow {
+                    name,
+                    value,
+                    u,
+                    unit,
+                });
             }
         }
         for (run, quantity, op, limit, unit) in limits {
@@ -106,7 +112,10 @@ impl Archive {
                 });
             }
         }
-        Ok(order.into_iter().filter_map(|id| by_id.remove(&id)).collect())
+        Ok(order
+            .into_iter()
+            .filter_map(|id| by_id.remove(&id))
+            .collect())
     }
 }
 
@@ -127,7 +136,12 @@ fn facts_of(r: &sqlx::any::AnyRow) -> Result<IndexFacts> {
         status: r.try_get(11)?,
         dry_run: r.try_get::<i64, _>(12)? != 0,
         verdict: r.try_get(13)?,
-        environment: [r.try_get(14)?, r.try_get(15)?, r.try_get(16)?, r.try_get(17)?],
+        environment: [
+            r.try_get(14)?,
+            r.try_get(15)?,
+            r.try_get(16)?,
+            r.try_get(17)?,
+        ],
         imu: r.try_get(18)?,
         parameters: Vec::new(),
         limits: Vec::new(),

@@ -86,7 +86,10 @@ mod tests {
     #[test]
     fn round_trip_and_offsets() {
         assert_eq!(days_from_iso("1970-01-01"), Some(0.0));
-        assert_eq!(iso_date(days_from_iso("2026-11-24T02:21:05Z").unwrap()), "2026-11-24");
+        assert_eq!(
+            iso_date(days_from_iso("2026-11-24T02:21:05Z").unwrap()),
+            "2026-11-24"
+        );
         let a = days_from_iso("2026-03-01T12:00:00Z").unwrap();
         let b = days_from_iso("2026-03-01T14:00:00+02:00").unwrap();
         assert!((a - b).abs() < 1e-9);

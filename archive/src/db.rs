@@ -45,8 +45,7 @@ impl Archive {
         };
         let (url, backend, store) = match loc {
             Location::Folder(dir) => {
-                std::fs::create_dir_all(dir.join("files"))
-                    .map_err(|e| open_err(e.to_string()))?;
+                std::fs::create_dir_all(dir.join("files")).map_err(|e| open_err(e.to_string()))?;
                 let db = dir.join("index.sqlite");
                 let url = format!("sqlite://{}?mode=rwc", db.display());
                 (url, Backend::Sqlite, Store::Folder(dir.join("files")))
@@ -85,7 +84,9 @@ impl Archive {
         if backend == Backend::Sqlite {
             // Readers (backup, list) never block a writer; persistent in the file. Another
             // process switching it at the same moment is fine to ignore.
-            let _ = sqlx::query("PRAGMA journal_mode = WAL").execute(&pool).await;
+            let _ = sqlx::query("PRAGMA journal_mode = WAL")
+                .execute(&pool)
+                .await;
         }
         migrate(&pool).await?;
         Ok(Archive {
@@ -127,10 +128,10 @@ async fn migrate(pool: &AnyPool) -> Result<()> {
             }
         }
     }
-    Err(last.map(ArchiveError::from).unwrap_or_else(|| {
-        ArchiveError::Open {
+    Err(last
+        .map(ArchiveError::from)
+        .unwrap_or_else(|| ArchiveError::Open {
             location: String::new(),
             message: "migration failed".into(),
-        }
-    }))
+        }))
 }

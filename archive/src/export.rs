@@ -18,10 +18,7 @@ impl Archive {
         for f in &files {
             let rel = Path::new(&f.path);
             // Paths come from the index; never write outside the destination.
-            if rel
-                .components()
-                .any(|c| !matches!(c, Component::Normal(_)))
-            {
+            if rel.components().any(|c| !matches!(c, Component::Normal(_))) {
                 return Err(ArchiveError::Io {
                     path: rel.to_path_buf(),
                     message: "stored path leaves the run folder".into(),

@@ -154,10 +154,16 @@ fn facts(m: &Manifest, results: Option<&Value>) -> IndexFacts {
             .unwrap_or_else(|| UNKNOWN.to_string())
     };
     let run = m.run.as_ref();
-    let run_str = |f: fn(&ratecal_engine::recording::RunInfo) -> String| run.map(f).unwrap_or_default();
+    let run_str =
+        |f: fn(&ratecal_engine::recording::RunInfo) -> String| run.map(f).unwrap_or_default();
     let proc_ = m.procedure.clone();
     let env = m.environment.clone().unwrap_or_default();
-    let table_model = m.station.table.model.clone().unwrap_or_else(|| UNKNOWN.into());
+    let table_model = m
+        .station
+        .table
+        .model
+        .clone()
+        .unwrap_or_else(|| UNKNOWN.into());
     let station = match run.and_then(|r| r.station_sha256.as_ref()) {
         Some(sha) => format!("{table_model} ({})", &sha[..sha.len().min(12)]),
         None => table_model,
@@ -177,7 +183,12 @@ fn facts(m: &Manifest, results: Option<&Value>) -> IndexFacts {
         status: run_str(|r| r.status.clone()),
         dry_run: run.is_some_and(|r| r.dry_run),
         verdict: verdict(&run_str(|r| r.status.clone()), results),
-        environment: [env.temperature_c, env.humidity_pct, env.pressure_kpa, env.vibration_g],
+        environment: [
+            env.temperature_c,
+            env.humidity_pct,
+            env.pressure_kpa,
+            env.vibration_g,
+        ],
         imu: serde_json::to_string(&m.imu).unwrap_or_else(|_| "{}".into()),
         parameters: results.map(parameters).unwrap_or_default(),
         limits: results.map(limits).unwrap_or_default(),
@@ -187,7 +198,10 @@ fn facts(m: &Manifest, results: Option<&Value>) -> IndexFacts {
 /// The run's verdict: results.json's own `verdict` when it has one, else derived from the
 /// run status and the acceptance entries.
 pub fn verdict(status: &str, results: Option<&Value>) -> String {
-    if let Some(v) = results.and_then(|r| r.get("verdict")).and_then(Value::as_str) {
+    if let Some(v) = results
+        .and_then(|r| r.get("verdict"))
+        .and_then(Value::as_str)
+    {
         return v.to_string();
     }
     if status == "aborted" {

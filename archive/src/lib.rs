@@ -30,7 +30,7 @@ pub use check::CheckReport;
 pub use dates::{days_from_iso, iso_date};
 pub use db::{Archive, Backend};
 pub use error::ArchiveError;
-pub use ingest::{Folder, IndexFacts, ParamRow, LimitRow};
+pub use ingest::{Folder, IndexFacts, LimitRow, ParamRow};
 pub use location::Location;
 pub use query::{Filter, RunDetail, RunSummary, StoredFile};
 

@@ -20,7 +20,9 @@ impl Location {
     /// Reads `--archive` (a folder or a `postgres://` URL), else `RATECAL_ARCHIVE`, else
     /// `./archive/`; `files` is the shared folder for a server's stored files.
     pub fn resolve(arg: Option<&str>, files: Option<PathBuf>) -> Self {
-        let env = std::env::var("RATECAL_ARCHIVE").ok().filter(|s| !s.is_empty());
+        let env = std::env::var("RATECAL_ARCHIVE")
+            .ok()
+            .filter(|s| !s.is_empty());
         let text = arg.map(str::to_string).or(env);
         match text {
             Some(t) => Self::parse(&t, files),

@@ -3,9 +3,9 @@
 
 use crate::{Archive, ArchiveError, Result};
 use serde::Serialize;
+use sqlx::Arguments;
 use sqlx::AssertSqlSafe;
 use sqlx::any::AnyArguments;
-use sqlx::Arguments;
 
 /// Which runs to list; `None` fields do not filter.
 #[derive(Debug, Clone, Default)]
@@ -159,7 +159,11 @@ impl Archive {
         }
         if let Some(s) = &f.until {
             // A bare date includes its whole day ('~' sorts after every time character).
-            let bound = if s.len() == 10 { format!("{s}~") } else { s.clone() };
+            let bound = if s.len() == 10 {
+                format!("{s}~")
+            } else {
+                s.clone()
+            };
             add(&mut sql, "started <=", bound);
         }
         if !f.include_dry_runs {
@@ -180,18 +184,22 @@ impl Archive {
             // Matches no id: ids are hex.
             "-".to_string()
         };
-        let rows: Vec<(String,)> =
-            sqlx::query_as("SELECT id FROM runs WHERE id = $1 OR name = $1 OR id LIKE $2 ORDER BY id")
-                .bind(key)
-                .bind(prefix)
-                .fetch_all(&self.pool)
-                .await?;
+        let rows: Vec<(String,)> = sqlx::query_as(
+            "SELECT id FROM runs WHERE id = $1 OR name = $1 OR id LIKE $2 ORDER BY id",
+        )
+        .bind(key)
+        .bind(prefix)
+        .fetch_all(&self.pool)
+        .await?;
         match rows.len() {
             0 => Err(ArchiveError::NoSuchRun(key.to_string())),
             1 => Ok(rows[0].0.clone()),
             _ => Err(ArchiveError::Ambiguous(
                 key.to_string(),
-                rows.iter().map(|r| r.0.as_str()).collect::<Vec<_>>().join(", "),
+                rows.iter()
+                    .map(|r| r.0.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
             )),
         }
     }
@@ -204,7 +212,16 @@ impl Archive {
             .bind(&id)
             .fetch_one(&self.pool)
             .await?;
-        type More = (String, Option<String>, String, Option<f64>, Option<f64>, Option<f64>, Option<f64>, String);
+        type More = (
+            String,
+            Option<String>,
+            String,
+            Option<f64>,
+            Option<f64>,
+            Option<f64>,
+            Option<f64>,
+            String,
+        );
         let more: More = sqlx::query_as(
             "SELECT procedure_sha256, ended, status, temperature_c, humidity_pct, pressure_kpa, \
              vibration_g, imu FROM runs WHERE id = $1",
@@ -241,17 +258,23 @@ impl Archive {
         .await?;
         Ok(rows
             .into_iter()
-            .map(|(name, value, u, unit)| crate::ParamRow { name, value, u, unit })
+            .map(|(name, value, u, unit)| crate::ParamRow {
+                name,
+                value,
+                u,
+                unit,
+            })
             .collect())
     }
 
     /// The stored files of run `id`, by path.
     pub async fn files_of(&self, id: &str) -> Result<Vec<StoredFile>> {
-        let rows: Vec<(String, String, i64)> =
-            sqlx::query_as("SELECT path, sha256, size FROM run_files WHERE run_id = $1 ORDER BY path")
-                .bind(id)
-                .fetch_all(&self.pool)
-                .await?;
+        let rows: Vec<(String, String, i64)> = sqlx::query_as(
+            "SELECT path, sha256, size FROM run_files WHERE run_id = $1 ORDER BY path",
+        )
+        .bind(id)
+        .fetch_all(&self.pool)
+        .await?;
         Ok(rows
             .into_iter()
             .map(|(path, sha256, size)| StoredFile { path, sha256, size })

@@ -12,7 +12,9 @@ const U: f64 = 0.001;
 fn normals(n: usize) -> Vec<f64> {
     let mut x: u64 = 0x2545_f491_4f6c_dd1d;
     let mut uni = || {
-        x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        x = x
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((x >> 11) as f64 + 0.5) / (1u64 << 53) as f64
     };
     (0..n)
@@ -113,7 +115,11 @@ async fn known_drift_is_recovered_within_its_uncertainty() {
     assert!(p.recalibrate_by.is_some());
     // No limit on the scale factor: drift, but no interval.
     let all = a.trend("1234", &opts(&[])).await.unwrap();
-    let g = all.parameters.iter().find(|p| p.name == "gyro.scale.z").unwrap();
+    let g = all
+        .parameters
+        .iter()
+        .find(|p| p.name == "gyro.scale.z")
+        .unwrap();
     assert!(g.limit.is_none() && g.recalibration_days.is_none());
     assert!(t.svg().contains("class=\"drift\""));
     assert!(t.text().contains("recalibrate within"));

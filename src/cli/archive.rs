@@ -263,7 +263,12 @@ async fn add_one(archive: &Archive, dir: &Path) -> Result<String, Report> {
     }
     let added = archive.add(dir).await?;
     Ok(if added.new {
-        format!("archived {} as {} ({} file(s))", dir.display(), added.id, added.files)
+        format!(
+            "archived {} as {} ({} file(s))",
+            dir.display(),
+            added.id,
+            added.files
+        )
     } else {
         format!("{} is already archived as {}", dir.display(), added.id)
     })
@@ -361,11 +366,17 @@ fn show_text(d: &ratecal_archive::RunDetail) -> String {
     );
     s.push_str(&format!("parameters ({}):\n", d.parameters.len()));
     for p in &d.parameters {
-        s.push_str(&format!("  {:<28} {:>14.6e} ± {:.2e} {}\n", p.name, p.value, p.u, p.unit));
+        s.push_str(&format!(
+            "  {:<28} {:>14.6e} ± {:.2e} {}\n",
+            p.name, p.value, p.u, p.unit
+        ));
     }
     s.push_str(&format!("files ({}):\n", d.files.len()));
     for f in &d.files {
-        s.push_str(&format!("  {:<28} {:>10} B  {}\n", f.path, f.size, f.sha256));
+        s.push_str(&format!(
+            "  {:<28} {:>10} B  {}\n",
+            f.path, f.size, f.sha256
+        ));
     }
     s
 }

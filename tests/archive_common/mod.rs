@@ -15,11 +15,19 @@ const STATION: &str = "site: { latitude_deg: 55.7, gravity_mps2: 9.8156 }\n";
 
 /// A finished run folder: `serial` (none: no serial in the manifest), start date, accel
 /// bias x in results.json, and `extra` files stored with it.
-pub fn write_run(dir: &Path, serial: Option<&str>, started: &str, bias: f64, extra: &[(&str, Vec<u8>)]) {
+pub fn write_run(
+    dir: &Path,
+    serial: Option<&str>,
+    started: &str,
+    bias: f64,
+    extra: &[(&str, Vec<u8>)],
+) {
     std::fs::create_dir_all(dir).unwrap();
-    let procedure =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/procedures/imu-2d-standard/1.0.0.rcal"))
-            .unwrap();
+    let procedure = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/procedures/imu-2d-standard/1.0.0.rcal"
+    ))
+    .unwrap();
     let canon = ratecal_grammar::canonical(&procedure).unwrap();
     // The IMU stream differs per run (by its bias), so each run has its own files.
     let imu = format!("t,ax,ay,az,gx,gy,gz\n0,{bias},0,9.8,0,0,0\n0.01,{bias},0,9.8,0,0,0\n");
@@ -32,7 +40,9 @@ pub fn write_run(dir: &Path, serial: Option<&str>, started: &str, bias: f64, ext
         std::fs::create_dir_all(p.parent().unwrap()).unwrap();
         std::fs::write(p, bytes).unwrap();
     }
-    let serial_line = serial.map(|s| format!("  serial: {s}\n")).unwrap_or_default();
+    let serial_line = serial
+        .map(|s| format!("  serial: {s}\n"))
+        .unwrap_or_default();
     let name = dir.file_name().unwrap().to_string_lossy();
     let manifest = format!(
         "format: ratecal-recording/1
@@ -73,7 +83,11 @@ run:
               "U": 0.001, "rule": "simple", "verdict": "pass" }
         ]
     });
-    std::fs::write(dir.join("results.json"), serde_json::to_string_pretty(&results).unwrap()).unwrap();
+    std::fs::write(
+        dir.join("results.json"),
+        serde_json::to_string_pretty(&results).unwrap(),
+    )
+    .unwrap();
 }
 
 /// `ratecal ARGS` in `cwd`, with no archive from the environment.

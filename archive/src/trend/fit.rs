@@ -100,7 +100,9 @@ impl Drift {
     pub fn predict(&self, tau_days: f64) -> (f64, f64) {
         let b = self.rate_per_year / YEAR_DAYS;
         let vb = (self.u_rate_per_year / YEAR_DAYS).powi(2);
-        let v = self.u_value_at_last.powi(2) + 2.0 * tau_days * self.cov_per_day + tau_days * tau_days * vb;
+        let v = self.u_value_at_last.powi(2)
+            + 2.0 * tau_days * self.cov_per_day
+            + tau_days * tau_days * vb;
         (self.value_at_last + b * tau_days, v.max(0.0).sqrt())
     }
 
@@ -200,7 +202,10 @@ mod tests {
             value: 1.0,
             u: 0.1,
         };
-        let q = Point { t_days: 20000.7, ..p };
+        let q = Point {
+            t_days: 20000.7,
+            ..p
+        };
         assert!(drift(&[p]).is_none());
         assert!(drift(&[p, q]).is_none());
     }

@@ -87,7 +87,11 @@ pub struct LimitUse {
 impl Archive {
     /// The trend of every (or the chosen) parameter of `serial`.
     pub async fn trend(&self, serial: &str, opt: &TrendOptions) -> Result<Trend> {
-        let dry = if opt.include_dry_runs { "" } else { " AND r.dry_run = 0" };
+        let dry = if opt.include_dry_runs {
+            ""
+        } else {
+            " AND r.dry_run = 0"
+        };
         let sql = format!(
             "SELECT r.id, r.started, p.name, p.value, p.u, p.unit FROM parameters p \
              JOIN runs r ON r.id = p.run_id WHERE r.serial = $1{dry} ORDER BY r.started, r.id"
@@ -106,10 +110,12 @@ impl Archive {
             .await?;
         let limits: Vec<(String, String, f64, String)> = match runs.first() {
             Some((latest,)) => {
-                sqlx::query_as("SELECT quantity, op, limit_value, unit FROM limits WHERE run_id = $1")
-                    .bind(latest)
-                    .fetch_all(&self.pool)
-                    .await?
+                sqlx::query_as(
+                    "SELECT quantity, op, limit_value, unit FROM limits WHERE run_id = $1",
+                )
+                .bind(latest)
+                .fetch_all(&self.pool)
+                .await?
             }
             None => Vec::new(),
         };
@@ -142,14 +148,22 @@ impl Archive {
 
 type Row = (String, String, String, f64, f64, String);
 
-fn param_trend(name: &str, rows: &[&Row], limits: &[(String, String, f64, String)], k: f64) -> ParamTrend {
+fn param_trend(
+    name: &str,
+    rows: &[&Row],
+    limits: &[(String, String, f64, String)],
+    k: f64,
+) -> ParamTrend {
     let mut notes = Vec::new();
     let unit = rows.last().map(|r| r.5.clone()).unwrap_or_default();
     let mut points = Vec::new();
     let mut fit_points = Vec::new();
     for r in rows {
         if r.5 != unit {
-            notes.push(format!("run {} gives it in {}, not {unit}: left out", r.0, r.5));
+            notes.push(format!(
+                "run {} gives it in {}, not {unit}: left out",
+                r.0, r.5
+            ));
             continue;
         }
         let Some(t) = dates::days_from_iso(&r.1) else {
@@ -191,7 +205,12 @@ fn param_trend(name: &str, rows: &[&Row], limits: &[(String, String, f64, String
         name: name.to_string(),
         unit,
         points,
-        drift_status: if d.is_some() { "determined" } else { "undetermined" }.into(),
+        drift_status: if d.is_some() {
+            "determined"
+        } else {
+            "undetermined"
+        }
+        .into(),
         drift: d,
         limit,
         recalibration_days: days,
@@ -215,7 +234,9 @@ fn find_limit(
         }
         let text = format!("{q} {op} {limit} {lunit}");
         if lunit != unit {
-            notes.push(format!("limit `{text}` is in {lunit}, the parameter in {unit}: not compared"));
+            notes.push(format!(
+                "limit `{text}` is in {lunit}, the parameter in {unit}: not compared"
+            ));
             continue;
         }
         let bound = match (magnitude, op.as_str()) {
@@ -231,7 +252,8 @@ fn find_limit(
         });
     }
     if !notes.iter().any(|n| n.starts_with("limit")) {
-        notes.push("the procedure sets no acceptance limit on it: no recalibration interval".into());
+        notes
+            .push("the procedure sets no acceptance limit on it: no recalibration interval".into());
     }
     None
 }

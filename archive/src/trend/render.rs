@@ -68,10 +68,18 @@ fn param_text(p: &ParamTrend) -> String {
     if let Some(l) = &p.limit {
         match (&p.recalibration_days, &p.recalibrate_by) {
             (Some(days), Some(by)) if *days <= 0.0 => {
-                let _ = writeln!(s, "  limit {}: reached already (by {by}): recalibrate now", l.text);
+                let _ = writeln!(
+                    s,
+                    "  limit {}: reached already (by {by}): recalibrate now",
+                    l.text
+                );
             }
             (Some(days), Some(by)) => {
-                let _ = writeln!(s, "  limit {}: recalibrate within {days:.0} days (by {by})", l.text);
+                let _ = writeln!(
+                    s,
+                    "  limit {}: recalibrate within {days:.0} days (by {by})",
+                    l.text
+                );
             }
             _ => {
                 let _ = writeln!(s, "  limit {}", l.text);
@@ -175,5 +183,8 @@ fn panel(p: &ParamTrend, top: f64, w: f64, h: f64) -> String {
 }
 
 fn xml(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
 }
