@@ -210,11 +210,20 @@ pub fn verdict(status: &str, results: Option<&Value>) -> String {
     let Some(r) = results else {
         return "incomplete".into();
     };
+    // A check declared over several runs (repeatability) is deferred on a single run: shown,
+    // not deciding (spec/cli.md), so it is left out here.
+    let deferred = |e: &Value| {
+        e.get("verdict").and_then(Value::as_str) == Some("not_evaluated")
+            && e.get("quantity")
+                .and_then(Value::as_str)
+                .is_some_and(|q| q.starts_with("repeatability."))
+    };
     let verdicts: Vec<&str> = r
         .get("acceptance")
         .and_then(Value::as_array)
         .map(|a| {
             a.iter()
+                .filter(|e| !deferred(e))
                 .filter_map(|e| e.get("verdict").and_then(Value::as_str))
                 .collect()
         })
@@ -258,4 +267,32 @@ fn limits(r: &Value) -> Vec<LimitRow> {
             })
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::verdict;
+    use serde_json::json;
+
+    fn results(verdicts: &[(&str, &str)]) -> serde_json::Value {
+        let acc: Vec<_> = verdicts
+            .iter()
+            .map(|(q, v)| json!({ "quantity": q, "verdict": v }))
+            .collect();
+        json!({ "acceptance": acc })
+    }
+
+    #[test]
+    fn verdict_from_results_or_acceptance() {
+        let own = json!({ "verdict": "fail", "acceptance": [] });
+        assert_eq!(verdict("completed", Some(&own)), "fail");
+        assert_eq!(verdict("aborted", None), "aborted");
+        assert_eq!(verdict("completed", None), "incomplete");
+        let deferred = results(&[("a.b", "pass"), ("repeatability.cv", "not_evaluated")]);
+        assert_eq!(verdict("completed", Some(&deferred)), "pass");
+        let open = results(&[("a.b", "pass"), ("a.c", "indeterminate")]);
+        assert_eq!(verdict("completed", Some(&open)), "incomplete");
+        let failed = results(&[("a.b", "fail"), ("a.c", "not_evaluated")]);
+        assert_eq!(verdict("completed", Some(&failed)), "fail");
+    }
 }
