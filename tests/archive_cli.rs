@@ -194,6 +194,10 @@ fn filters_env_default_and_a_manifest_without_serial() {
     let o = ratecal(&["archive", "show", "ffffffff"], cwd);
     assert_eq!(code(&o), 1);
     assert!(text(&o).contains("archive::no_such_run"), "{}", text(&o));
+    let o = ratecal(&["archive", "list", "--archive", "no-such-archive"], cwd);
+    assert_eq!(code(&o), 1);
+    assert!(text(&o).contains("archive::no_archive"), "{}", text(&o));
+    assert!(!cwd.join("no-such-archive").exists());
     let o = ratecal(&["archive", "add", "nowhere"], cwd);
     assert_eq!(code(&o), 1);
     assert!(text(&o).contains("not a run folder"), "{}", text(&o));
@@ -262,8 +266,16 @@ fn a_process_killed_mid_add_leaves_the_archive_consistent() {
         0.0,
         &extra_ref,
     );
-    // The archive exists (schema made) before the add starts.
-    assert_eq!(list("arch", &[], cwd).len(), 0);
+    // The archive exists (schema made, one run) before the add starts.
+    write_run(
+        &cwd.join("small"),
+        Some("9"),
+        "2026-02-01T00:00:00Z",
+        0.1,
+        &[],
+    );
+    let o = ratecal(&["archive", "add", "small", "--archive", "arch"], cwd);
+    assert_eq!(code(&o), 0, "{}", text(&o));
     let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_ratecal"))
         .args(["archive", "add", "big", "--archive", "arch"])
         .current_dir(cwd)
@@ -283,14 +295,14 @@ fn a_process_killed_mid_add_leaves_the_archive_consistent() {
         eprintln!("note: the add finished before it could be killed");
     } else {
         // Files first, index last: the run is not visible.
-        assert!(runs.is_empty(), "{runs:?}");
+        assert_eq!(runs.len(), 1, "{runs:?}");
     }
     let o = ratecal(&["archive", "check", "--archive", "arch"], cwd);
     assert_eq!(code(&o), 0, "{}", text(&o));
     // Adding it again completes it.
     let o = ratecal(&["archive", "add", "big", "--archive", "arch"], cwd);
     assert_eq!(code(&o), 0, "{}", text(&o));
-    assert_eq!(list("arch", &[], cwd).len(), 1);
+    assert_eq!(list("arch", &[], cwd).len(), 2);
     let o = ratecal(&["archive", "check", "--archive", "arch"], cwd);
     assert_eq!(code(&o), 0, "{}", text(&o));
 }

@@ -36,6 +36,17 @@ fn migrator() -> Migrator {
 }
 
 impl Archive {
+    /// Opens an archive that exists (a folder must hold `index.sqlite`): for commands that
+    /// only read, so that a mistyped `--archive` is an error, not a new empty archive.
+    pub async fn open_existing(loc: &Location) -> Result<Self> {
+        if let Location::Folder(dir) = loc
+            && !dir.join("index.sqlite").is_file()
+        {
+            return Err(ArchiveError::NoArchive(dir.clone()));
+        }
+        Self::open(loc).await
+    }
+
     /// Opens (creating if needed) the archive at `loc` and brings its schema up to date.
     pub async fn open(loc: &Location) -> Result<Self> {
         install_default_drivers();

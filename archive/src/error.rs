@@ -59,6 +59,15 @@ pub enum ArchiveError {
         /// Why.
         why: String,
     },
+    /// The folder holds no archive.
+    #[error("{} holds no archive", .0.display())]
+    #[diagnostic(
+        code(archive::no_archive),
+        help(
+            "give --archive the archive's folder or URL (or set RATECAL_ARCHIVE); `ratecal archive add RUN` creates one"
+        )
+    )]
+    NoArchive(PathBuf),
     /// No run has this id.
     #[error("no run {0} in the archive")]
     #[diagnostic(

@@ -143,7 +143,12 @@ async fn run(loc: &Location, cmd: Command) -> Result<ExitCode, Report> {
             "--confidence {confidence} is not a confidence level"
         ));
     }
-    let archive = Archive::open(loc).await?;
+    // Only `add` creates an archive; a command that reads needs one that exists.
+    let archive = if matches!(cmd, Command::Add { .. }) {
+        Archive::open(loc).await?
+    } else {
+        Archive::open_existing(loc).await?
+    };
     let code = match cmd {
         Command::Add { runs } => add(&archive, &runs).await,
         Command::List {
