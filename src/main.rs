@@ -49,6 +49,8 @@ enum Command {
     Explain(cli::explain::Args),
     /// Lab signing keys: `ratecal key new DIR` writes DIR/lab.key and DIR/lab.pub.
     Key(cli::key::Args),
+    /// The calibration archive: add, list, show, export, trend, backup, check.
+    Archive(cli::archive::Args),
 }
 
 fn main() -> ExitCode {
@@ -64,5 +66,6 @@ fn main() -> ExitCode {
         Command::Verify(a) => cli::verify::main(a),
         Command::Explain(a) => cli::explain::main(a),
         Command::Key(a) => cli::key::main(a),
+        Command::Archive(a) => cli::archive::main(a),
     }
 }

@@ -52,6 +52,9 @@ pub struct Args {
     /// manifest and the report record it).
     #[arg(long)]
     allow_changed: bool,
+    /// Archive the run here (folder or postgres:// URL; also $RATECAL_ARCHIVE).
+    #[arg(long, value_name = "DIR_OR_URL")]
+    archive: Option<String>,
 }
 
 /// Runs the subcommand.
@@ -88,7 +91,11 @@ fn run(args: Args) -> Result<ExitCode, Report> {
     };
     let dir = prep.dir.clone();
     match execute_prepared(prep, key.as_ref()) {
-        Ok(code) => Ok(code),
+        Ok(code) => {
+            // Archived once sealed; a failure to archive is a warning, never the run's fate.
+            super::archive::after_run(args.archive.as_deref(), &dir);
+            Ok(code)
+        }
         Err(report) => {
             // The folder exists: it must not be left saying `running`.
             if let Err(e) = finish::mark_failed(&dir, &report.to_string(), key.as_ref()) {

@@ -5,7 +5,8 @@
 //! or not signed by the key; 2 error (no such run folder, unreadable key).
 
 use ratecal_engine::audit::seal::{SEAL_FILE, SEAL_HASH_FILE, verify_seal};
-use std::path::PathBuf;
+use ratecal_engine::audit::verify::VerifyReport as SealReport;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// Arguments of `ratecal verify`.
@@ -16,6 +17,41 @@ pub struct Args {
     /// The lab's public key (`ratecal key new` wrote it): the seal must be signed by it.
     #[arg(long, value_name = "PUB")]
     key: Option<PathBuf>,
+}
+
+/// Why a folder cannot be verified at all.
+pub enum Unverifiable {
+    /// Not a run folder (no manifest, no seal).
+    NotARun(miette::Report),
+}
+
+impl Unverifiable {
+    /// The diagnostic.
+    pub fn report(self) -> miette::Report {
+        match self {
+            Unverifiable::NotARun(r) => r,
+        }
+    }
+}
+
+/// Every file of a run folder against its seal (no key): what `ratecal verify` and
+/// `ratecal archive add` check.
+pub fn verify_folder(dir: &Path) -> Result<SealReport, Unverifiable> {
+    let is_run = dir.join("manifest.yaml").is_file() || dir.join(SEAL_FILE).is_file();
+    let files = match super::seal::folder_files(dir) {
+        Ok(f) if is_run => f,
+        Ok(_) | Err(_) => {
+            return Err(Unverifiable::NotARun(miette::miette!(
+                code = "verify::not_a_run",
+                help = "give the folder `ratecal run --out` wrote",
+                "{} is not a run folder (no manifest.yaml, no seal.json)",
+                dir.display()
+            )));
+        }
+    };
+    let seal = std::fs::read_to_string(dir.join(SEAL_FILE)).ok();
+    let seal_hash = std::fs::read_to_string(dir.join(SEAL_HASH_FILE)).ok();
+    Ok(verify_seal(seal.as_deref(), seal_hash.as_deref(), &files, None))
 }
 
 /// Runs the subcommand.

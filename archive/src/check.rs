@@ -1,0 +1,99 @@
+//! `archive check`: every stored file's hash recomputed, every index row pointing at a
+//! stored file.
+
+use crate::{Archive, Result};
+use ratecal_engine::audit::verify::sha256_hex;
+use serde::Serialize;
+
+/// What `check` found.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct CheckReport {
+    /// Stored files whose hash was recomputed.
+    pub files_checked: usize,
+    /// Runs in the index.
+    pub runs: usize,
+    /// Stored files whose content no longer matches their name.
+    pub corrupted: Vec<String>,
+    /// Index rows naming a file the store does not hold: `run_id path sha256`.
+    pub missing: Vec<String>,
+    /// Stored files no run names (left by an interrupted add; harmless).
+    pub unreferenced: usize,
+    /// Unfinished writes left by an interrupted add (harmless).
+    pub leftovers: usize,
+}
+
+impl CheckReport {
+    /// Whether the archive is consistent.
+    pub fn ok(&self) -> bool {
+        self.corrupted.is_empty() && self.missing.is_empty()
+    }
+
+    /// A report for people.
+    pub fn text(&self) -> String {
+        let mut s = String::new();
+        for c in &self.corrupted {
+            s.push_str(&format!("! CORRUPTED  {c}\n"));
+        }
+        for m in &self.missing {
+            s.push_str(&format!("! MISSING    {m}\n"));
+        }
+        s.push_str(&format!(
+            "{} run(s), {} stored file(s) rehashed, {} unreferenced, {} unfinished write(s)\n",
+            self.runs, self.files_checked, self.unreferenced, self.leftovers
+        ));
+        s.push_str(if self.ok() {
+            "consistent: every stored file matches its hash and every index row points at a stored file\n"
+        } else {
+            "NOT consistent: restore the files named above from a backup\n"
+        });
+        s
+    }
+}
+
+impl Archive {
+    /// Rehashes every stored file and checks every index row against the store.
+    pub async fn check(&self) -> Result<CheckReport> {
+        let mut report = CheckReport::default();
+        let stored = self.store.hashes(&self.pool).await?;
+        let mut intact = std::collections::HashSet::new();
+        for sha in &stored {
+            report.files_checked += 1;
+            match self.store.get(&self.pool, sha).await? {
+                Some(b) if sha256_hex(&b) == *sha => {
+                    intact.insert(sha.clone());
+                }
+                _ => report.corrupted.push(sha.clone()),
+            }
+        }
+        let rows: Vec<(String, String, String)> =
+            sqlx::query_as("SELECT run_id, path, sha256 FROM run_files ORDER BY run_id, path")
+                .fetch_all(&self.pool)
+                .await?;
+        let corrupted: std::collections::HashSet<&String> = report.corrupted.iter().collect();
+        let mut referenced = std::collections::HashSet::new();
+        for (run, path, sha) in &rows {
+            referenced.insert(sha.clone());
+            if !intact.contains(sha) && !corrupted.contains(sha) {
+                report.missing.push(format!("{run} {path} {sha}"));
+            }
+        }
+        // Name the runs a corrupted file belongs to.
+        for c in report.corrupted.iter_mut() {
+            let runs: Vec<String> = rows
+                .iter()
+                .filter(|(_, _, sha)| sha == c)
+                .map(|(run, path, _)| format!("{run}:{path}"))
+                .collect();
+            if !runs.is_empty() {
+                *c = format!("{c} ({})", runs.join(", "));
+            }
+        }
+        report.unreferenced = stored.iter().filter(|s| !referenced.contains(*s)).count();
+        report.leftovers = self.store.leftovers().len();
+        let n: (i64,) = sqlx::query_as("SELECT COUNT(*) FROM runs")
+            .fetch_one(&self.pool)
+            .await?;
+        report.runs = n.0 as usize;
+        Ok(report)
+    }
+}

@@ -1,0 +1,387 @@
+//! `ratecal archive ...`: the calibration archive (add, list, show, export, trend, backup,
+//! check), kept in a folder (SQLite + file store) or on a PostgreSQL server. Exit codes: 0
+//! ok, 1 an error, a refused run or (check) an inconsistent archive, 2 usage.
+
+use clap::{Subcommand, ValueEnum};
+use miette::Report;
+use ratecal_archive::trend::TrendOptions;
+use ratecal_archive::{Archive, Filter, Location};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Arguments of `ratecal archive`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Archive folder or postgres:// URL (default: $RATECAL_ARCHIVE, else ./archive/).
+    #[arg(long, global = true, value_name = "DIR_OR_URL")]
+    archive: Option<String>,
+    /// With a postgres:// archive: keep the stored files in this shared folder instead of
+    /// the database.
+    #[arg(long, global = true, value_name = "DIR")]
+    archive_files: Option<PathBuf>,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum Format {
+    Table,
+    Json,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum TrendFormat {
+    Table,
+    Json,
+    Svg,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum VerdictArg {
+    Pass,
+    Fail,
+    Incomplete,
+    Aborted,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Store and index run folders (each verified first; adding twice changes nothing).
+    Add {
+        /// Run folders.
+        #[arg(required = true)]
+        runs: Vec<PathBuf>,
+    },
+    /// List archived runs, oldest first (dry runs only with --include-dry-runs).
+    List {
+        #[arg(long)]
+        serial: Option<String>,
+        #[arg(long)]
+        model: Option<String>,
+        #[arg(long)]
+        procedure: Option<String>,
+        /// Started on or after (YYYY-MM-DD or RFC 3339).
+        #[arg(long)]
+        since: Option<String>,
+        /// Started on or before (a date includes the whole day).
+        #[arg(long)]
+        until: Option<String>,
+        #[arg(long, value_enum)]
+        verdict: Option<VerdictArg>,
+        #[arg(long)]
+        include_dry_runs: bool,
+        #[arg(long, value_enum, default_value_t = Format::Table)]
+        format: Format,
+    },
+    /// Everything the archive holds about one run (id, unique id prefix, or run name).
+    Show {
+        id: String,
+        #[arg(long, value_enum, default_value_t = Format::Table)]
+        format: Format,
+    },
+    /// Give a run folder back, byte for byte (`ratecal verify` passes on it).
+    Export {
+        id: String,
+        /// New or empty folder.
+        dir: PathBuf,
+    },
+    /// Parameters of one unit across its calibrations: drift and recalibration interval.
+    Trend {
+        serial: String,
+        /// Parameter (dotted name); repeat for several; every parameter without it.
+        #[arg(long = "param")]
+        params: Vec<String>,
+        /// Confidence of the recalibration interval (one-sided).
+        #[arg(long, default_value_t = 0.95)]
+        confidence: f64,
+        #[arg(long)]
+        include_dry_runs: bool,
+        #[arg(long, value_enum, default_value_t = TrendFormat::Table)]
+        format: TrendFormat,
+    },
+    /// A consistent copy (a folder archive) another machine can open.
+    Backup {
+        /// New or empty folder.
+        dest: PathBuf,
+    },
+    /// Recompute every stored file's hash; check every index row points at stored files.
+    Check {
+        #[arg(long, value_enum, default_value_t = Format::Table)]
+        format: Format,
+    },
+}
+
+/// Runs the subcommand.
+pub fn main(args: Args) -> ExitCode {
+    let loc = Location::resolve(args.archive.as_deref(), args.archive_files.clone());
+    let rt = match tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+    {
+        Ok(rt) => rt,
+        Err(e) => {
+            eprintln!("{:?}", miette::miette!("cannot start the runtime: {e}"));
+            return ExitCode::from(1);
+        }
+    };
+    match rt.block_on(run(&loc, args.command)) {
+        Ok(code) => code,
+        Err(report) => {
+            eprintln!("{report:?}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+async fn run(loc: &Location, cmd: Command) -> Result<ExitCode, Report> {
+    if let Command::Trend { confidence, .. } = &cmd
+        && !(confidence.is_finite() && *confidence > 0.5 && *confidence < 1.0)
+    {
+        return Err(miette::miette!(
+            code = "archive::bad_confidence",
+            help = "give a probability between 0.5 and 1, e.g. --confidence 0.95",
+            "--confidence {confidence} is not a confidence level"
+        ));
+    }
+    // Only `add` creates an archive; a command that reads needs one that exists.
+    let archive = if matches!(cmd, Command::Add { .. }) {
+        Archive::open(loc).await?
+    } else {
+        Archive::open_existing(loc).await?
+    };
+    let code = match cmd {
+        Command::Add { runs } => add(&archive, &runs).await,
+        Command::List {
+            serial,
+            model,
+            procedure,
+            since,
+            until,
+            verdict,
+            include_dry_runs,
+            format,
+        } => {
+            let f = Filter {
+                serial,
+                model,
+                procedure,
+                since: since.map(|d| date_arg(&d)).transpose()?,
+                until: until.map(|d| date_arg(&d)).transpose()?,
+                verdict: verdict.map(|v| verdict_name(v).to_string()),
+                include_dry_runs,
+            };
+            let runs = archive.list(&f).await?;
+            match format {
+                Format::Json => println!("{}", to_json(&runs)?),
+                Format::Table => print!("{}", list_table(&runs)),
+            }
+            ExitCode::SUCCESS
+        }
+        Command::Show { id, format } => {
+            let d = archive.show(&id).await?;
+            match format {
+                Format::Json => println!("{}", to_json(&d)?),
+                Format::Table => print!("{}", show_text(&d)),
+            }
+            ExitCode::SUCCESS
+        }
+        Command::Export { id, dir } => {
+            let (id, n) = archive.export(&id, &dir).await?;
+            println!("exported run {id}: {n} file(s) to {}", dir.display());
+            ExitCode::SUCCESS
+        }
+        Command::Trend {
+            serial,
+            params,
+            confidence,
+            include_dry_runs,
+            format,
+        } => {
+            let opt = TrendOptions {
+                params,
+                include_dry_runs,
+                confidence,
+            };
+            let t = archive.trend(&serial, &opt).await?;
+            match format {
+                TrendFormat::Json => println!("{}", to_json(&t)?),
+                TrendFormat::Table => print!("{}", t.text()),
+                TrendFormat::Svg => print!("{}", t.svg()),
+            }
+            ExitCode::SUCCESS
+        }
+        Command::Backup { dest } => {
+            let (runs, files) = archive.backup(&dest).await?;
+            println!(
+                "backup: {runs} run(s), {files} stored file(s) in {} (open it with --archive {})",
+                dest.display(),
+                dest.display()
+            );
+            ExitCode::SUCCESS
+        }
+        Command::Check { format } => {
+            let r = archive.check().await?;
+            match format {
+                Format::Json => println!("{}", to_json(&r)?),
+                Format::Table => print!("{}", r.text()),
+            }
+            if r.ok() {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(1)
+            }
+        }
+    };
+    archive.close().await;
+    Ok(code)
+}
+
+/// Verifies then adds each run folder; a refused folder does not stop the others.
+async fn add(archive: &Archive, runs: &[PathBuf]) -> ExitCode {
+    let mut ok = true;
+    for dir in runs {
+        match add_one(archive, dir).await {
+            Ok(line) => println!("{line}"),
+            Err(e) => {
+                ok = false;
+                eprintln!("{e:?}");
+            }
+        }
+    }
+    if ok {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    }
+}
+
+async fn add_one(archive: &Archive, dir: &Path) -> Result<String, Report> {
+    let report = super::verify::verify_folder(dir).map_err(|e| e.report())?;
+    if !report.intact() {
+        return Err(miette::miette!(
+            code = "archive::altered",
+            help = "the archive keeps runs as they were recorded; archive the original folder",
+            "{} was altered since the run; not archived:\n{}",
+            dir.display(),
+            report.text().trim_end()
+        ));
+    }
+    let added = archive.add(dir).await?;
+    Ok(if added.new {
+        format!(
+            "archived {} as {} ({} file(s))",
+            dir.display(),
+            added.id,
+            added.files
+        )
+    } else {
+        format!("{} is already archived as {}", dir.display(), added.id)
+    })
+}
+
+/// `ratecal run`'s hook: adds the finished run when an archive is named (`--archive` or
+/// `RATECAL_ARCHIVE`); a failure is a warning, never the run's exit code.
+pub fn after_run(archive: Option<&str>, dir: &Path) {
+    if !Location::configured(archive) {
+        return;
+    }
+    let loc = Location::resolve(archive, None);
+    let Ok(rt) = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+    else {
+        eprintln!("warning: the run was not archived (cannot start the runtime)");
+        return;
+    };
+    let res = rt.block_on(async {
+        let a = Archive::open(&loc).await?;
+        let line = add_one(&a, dir).await;
+        a.close().await;
+        line
+    });
+    match res {
+        Ok(line) => println!("{line} in {}", loc.display()),
+        Err(e) => eprintln!("warning: the run was not archived:\n{e:?}"),
+    }
+}
+
+fn verdict_name(v: VerdictArg) -> &'static str {
+    match v {
+        VerdictArg::Pass => "pass",
+        VerdictArg::Fail => "fail",
+        VerdictArg::Incomplete => "incomplete",
+        VerdictArg::Aborted => "aborted",
+    }
+}
+
+/// A `--since`/`--until` date, checked; kept as written (compared as UTC text).
+fn date_arg(d: &str) -> Result<String, Report> {
+    match ratecal_archive::days_from_iso(d) {
+        Some(_) => Ok(d.to_string()),
+        None => Err(ratecal_archive::ArchiveError::BadDate(d.to_string()).into()),
+    }
+}
+
+fn to_json<T: serde::Serialize>(v: &T) -> Result<String, Report> {
+    serde_json::to_string_pretty(v).map_err(|e| miette::miette!("cannot write JSON: {e}"))
+}
+
+fn list_table(runs: &[ratecal_archive::RunSummary]) -> String {
+    let mut s = format!(
+        "{:<16}  {:<12}  {:<12}  {:<20}  {:<8}  {:<20}  {:<10}  {}\n",
+        "ID", "SERIAL", "MODEL", "PROCEDURE", "VERSION", "STARTED", "VERDICT", "DRY RUN"
+    );
+    for r in runs {
+        s.push_str(&format!(
+            "{:<16}  {:<12}  {:<12}  {:<20}  {:<8}  {:<20}  {:<10}  {}\n",
+            r.id,
+            r.serial,
+            r.model,
+            r.procedure,
+            r.version,
+            r.started,
+            r.verdict,
+            if r.dry_run { "yes" } else { "no" }
+        ));
+    }
+    s.push_str(&format!("{} run(s)\n", runs.len()));
+    s
+}
+
+fn show_text(d: &ratecal_archive::RunDetail) -> String {
+    let r = &d.summary;
+    let mut s = format!(
+        "run {} ({})\n  imu: {} serial {}\n  procedure: {} {} (sha256 {})\n  station: {}\n  \
+         operator: {}\n  started: {}\n  ended: {}\n  status: {}, verdict: {}{}\n  environment: {}\n",
+        r.id,
+        r.name,
+        r.model,
+        r.serial,
+        r.procedure,
+        r.version,
+        d.procedure_sha256,
+        r.station,
+        r.operator.as_deref().unwrap_or("-"),
+        r.started,
+        d.ended.as_deref().unwrap_or("-"),
+        d.status,
+        r.verdict,
+        if r.dry_run { " (dry run)" } else { "" },
+        d.environment
+    );
+    s.push_str(&format!("parameters ({}):\n", d.parameters.len()));
+    for p in &d.parameters {
+        s.push_str(&format!(
+            "  {:<28} {:>14.6e} ± {:.2e} {}\n",
+            p.name, p.value, p.u, p.unit
+        ));
+    }
+    s.push_str(&format!("files ({}):\n", d.files.len()));
+    for f in &d.files {
+        s.push_str(&format!(
+            "  {:<28} {:>10} B  {}\n",
+            f.path, f.size, f.sha256
+        ));
+    }
+    s
+}
