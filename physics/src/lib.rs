@@ -9,6 +9,7 @@ mod effects;
 mod frames;
 mod kinematics;
 mod model;
+pub mod nav;
 pub mod units;
 
 pub use effects::{EFFECTS, EffectId, EffectInfo, effect};
