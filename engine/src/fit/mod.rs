@@ -16,6 +16,7 @@ mod lsq;
 mod prep;
 mod repeat;
 mod select;
+pub mod size_effect;
 mod stats;
 mod temp;
 
@@ -197,6 +198,9 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
             }
         },
     );
+    if let Some(ix) = &sel.size_effect {
+        size_effect::fit(rec, ix, &mut out);
+    }
     let allan = allan_block
         .zip(curves.as_ref())
         .and_then(|(b, c)| allan::analyse(b, c, &mut out));
