@@ -47,6 +47,32 @@ pub struct Results {
     /// Everything the analysis could not do as asked, in plain words.
     #[serde(default)]
     pub warnings: Vec<String>,
+    /// The swaying segments' velocity drifts behind the `size_effect.*` parameters.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub size_effect: Option<SizeEffectDrifts>,
+}
+
+/// The size-effect fit's evidence: each oscillation segment's fitted drift rates and its
+/// navigation velocity (plot-ready).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct SizeEffectDrifts {
+    /// One entry per oscillation segment used.
+    pub segments: Vec<SegmentDriftReport>,
+}
+
+/// One oscillation segment of the size-effect fit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SegmentDriftReport {
+    /// Segment id.
+    pub segment: String,
+    /// Swaying period, s.
+    pub period_s: f64,
+    /// East velocity drift (mean acceleration error), m/s^2, and its u.
+    pub east_mps2: [f64; 2],
+    /// North velocity drift, m/s^2, and its u.
+    pub north_mps2: [f64; 2],
+    /// Navigation velocity at about 1 Hz: `[t s, East m/s, North m/s]`.
+    pub velocity: Vec<[f64; 3]>,
 }
 
 /// A parameter estimate, or the statement that the motion did not determine it.

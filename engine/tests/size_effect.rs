@@ -130,7 +130,10 @@ fn control_run(up: usize, r_mm: &[f64; 6]) -> f64 {
         let tk = k as f64 / hz;
         let state = TableState {
             outer: turn(tk - 10.0),
-            inner: AxisMotion { angle: tilt, ..Default::default() },
+            inner: AxisMotion {
+                angle: tilt,
+                ..Default::default()
+            },
         };
         let (a, g) = imu.measure(&state, &geo, &SITE, 20.0);
         t.push(tk);
@@ -141,7 +144,9 @@ fn control_run(up: usize, r_mm: &[f64; 6]) -> f64 {
         0.0, r_mm[0], r_mm[1], r_mm[2], 0.0, r_mm[3], r_mm[4], r_mm[5], 0.0,
     ) * 1e-3;
     let dw = angular_accel(&t, &w);
-    let fc: Vec<Vec3> = (0..t.len()).map(|k| compensate(&f[k], &w[k], &dw[k], &r)).collect();
+    let fc: Vec<Vec3> = (0..t.len())
+        .map(|k| compensate(&f[k], &w[k], &dw[k], &r))
+        .collect();
     let n0 = (10.0 * hz) as usize - 10;
     let mean = |v: &[Vec3]| v[..n0].iter().sum::<Vec3>() / n0 as f64;
     let c0 = align(&mean(&fc), &mean(&w), SITE.gravity_mps2).expect("at rest");

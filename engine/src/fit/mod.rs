@@ -64,6 +64,7 @@ pub(crate) struct Out {
     pub quantities: BTreeMap<String, (f64, f64)>,
     pub accel_model: Option<(Mat3, Vec3)>,
     pub gyro_model: Option<(Mat3, Vec3)>,
+    pub size_effect: Option<results::SizeEffectDrifts>,
 }
 
 impl Out {
@@ -249,6 +250,7 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
         repeatability: None,
         environment: select::environment(rec),
         warnings: Vec::new(),
+        size_effect: out.size_effect.take(),
     };
     res.acceptance = accept::evaluate(plan, &res, &out.quantities, &wh, &mut out.warnings);
     res.warnings = std::mem::take(&mut out.warnings);

@@ -12,7 +12,7 @@ pub use solve::SizeEffect;
 
 use super::Out;
 use crate::recording::Recording;
-use crate::results::Parameter;
+use crate::results::{Parameter, SegmentDriftReport, SizeEffectDrifts};
 
 /// The six coordinates, as `(row i, column j)` of `r_ij` and their results names.
 pub const COORDS: [(usize, usize, &str); 6] = [
@@ -54,5 +54,18 @@ pub(crate) fn fit(rec: &Recording, ix: &[usize], out: &mut Out) {
         out.quantities
             .insert("size_effect.uncertainty".into(), (u, 0.0));
     }
+    out.size_effect = Some(SizeEffectDrifts {
+        segments: est
+            .drifts
+            .iter()
+            .map(|d| SegmentDriftReport {
+                segment: d.id.clone(),
+                period_s: d.period_s,
+                east_mps2: [d.drift_mps2[0], d.u_mps2[0]],
+                north_mps2: [d.drift_mps2[1], d.u_mps2[1]],
+                velocity: d.velocity.clone(),
+            })
+            .collect(),
+    });
     out.warnings.extend(est.warnings);
 }
