@@ -101,7 +101,7 @@ pub(crate) fn solve(drifts: &[SegmentDrift], warnings: &mut Vec<String>) -> Size
     let svd = ak.clone().svd(true, true);
     let sv = &svd.singular_values;
     let (smax, smin) = (sv.max(), sv.min());
-    if !(smin > 1e-9 * smax) {
+    if smin.is_nan() || smin <= 1e-9 * smax {
         warnings.push(
             "size effect: the cycles do not separate the coordinates from the instrumental terms"
                 .into(),
