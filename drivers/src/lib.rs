@@ -24,7 +24,9 @@ pub mod tcp;
 mod traits;
 
 pub use registry::{DRIVERS, DriverKind, Drivers, build};
-pub use station::{DEFAULT_STATION_YAML, Station, StationError, StationInfo, yaml_offset};
+pub use station::{
+    DEFAULT_STATION_YAML, SWAYING_STATION_YAML, Station, StationError, StationInfo, yaml_offset,
+};
 pub use traits::{
     DriverError, DriverErrorKind, ImuDriver, ImuInfo, ImuSample, TableAxisId, TableCommand,
     TableDriver, TableInfo, TableSample,

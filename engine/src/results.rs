@@ -54,6 +54,9 @@ pub struct Results {
     /// Joint fits with effects: their parameter keys in order and correlation matrix.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub fits: BTreeMap<String, JointFit>,
+    /// The swaying segments' velocity drifts behind the `size_effect.*` parameters.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub size_effect: Option<SizeEffectDrifts>,
 }
 
 /// A joint fit's parameters (results.json keys, in order) and their correlation matrix.
@@ -65,6 +68,29 @@ pub struct JointFit {
     pub parameters: Vec<String>,
     /// Correlation coefficients, square, in that order.
     pub correlation: Vec<Vec<f64>>,
+}
+
+/// The size-effect fit's evidence: each oscillation segment's fitted drift rates and its
+/// navigation velocity (plot-ready).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct SizeEffectDrifts {
+    /// One entry per oscillation segment used.
+    pub segments: Vec<SegmentDriftReport>,
+}
+
+/// One oscillation segment of the size-effect fit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SegmentDriftReport {
+    /// Segment id.
+    pub segment: String,
+    /// Swaying period, s.
+    pub period_s: f64,
+    /// East velocity drift (mean acceleration error), m/s^2, and its u.
+    pub east_mps2: [f64; 2],
+    /// North velocity drift, m/s^2, and its u.
+    pub north_mps2: [f64; 2],
+    /// Navigation velocity at about 1 Hz: `[t s, East m/s, North m/s]`.
+    pub velocity: Vec<[f64; 3]>,
 }
 
 /// A parameter estimate, or the statement that the motion did not determine it.

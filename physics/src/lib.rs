@@ -9,6 +9,7 @@ pub mod effects;
 mod frames;
 mod kinematics;
 mod model;
+pub mod nav;
 pub mod units;
 
 pub use effects::{Effect, ImuModel, REGISTRY, Sensor, Signals, effect};

@@ -174,8 +174,12 @@ fn execute_prepared(prep: Prepared, key: Option<&SigningKey>) -> Result<ExitCode
 }
 
 fn prepare_new(args: &Args) -> Result<Prepared, Report> {
-    let st = setup::station(args.station.as_deref(), args.dry_run)?;
     let proc_path = setup::procedure_file(args.procedure.as_deref().unwrap_or(Path::new(".")))?;
+    // Without --station the procedure's geometry picks the embedded station.
+    let builtin = std::fs::read_to_string(&proc_path)
+        .ok()
+        .map(|text| setup::builtin_for(&text));
+    let st = setup::station_for(args.station.as_deref(), args.dry_run, builtin)?;
     let changed = setup::released_unchanged(&proc_path, args.allow_changed)?;
     let pr = setup::procedure(&proc_path, &st.station, None)?;
     let dir = args

@@ -24,6 +24,11 @@ use ratecal_physics::{Geometry, ImuErrors, Mat3, Site, Vec3};
 /// The embedded default station's YAML (a simulated tactical-grade IMU on a simulated table).
 pub const DEFAULT_STATION_YAML: &str = include_str!("../../stations/default.yaml");
 
+/// The embedded swaying station's YAML (a simulated navigation-grade IMU with lever arms on
+/// a table whose outer axis is vertical): the default of procedures with `geometry
+/// vertical_outer`.
+pub const SWAYING_STATION_YAML: &str = include_str!("../../stations/swaying.yaml");
+
 /// A station file that cannot be used, located in the file.
 #[derive(Debug, thiserror::Error, Diagnostic)]
 #[error("{message}")]

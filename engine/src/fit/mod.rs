@@ -19,6 +19,7 @@ mod measured;
 pub(crate) mod prep;
 mod repeat;
 mod select;
+pub mod size_effect;
 mod stats;
 mod temp;
 
@@ -70,6 +71,7 @@ pub(crate) struct Out {
     pub quantities: BTreeMap<String, (f64, f64)>,
     pub accel_model: Option<(Mat3, Vec3)>,
     pub gyro_model: Option<(Mat3, Vec3)>,
+    pub size_effect: Option<results::SizeEffectDrifts>,
 }
 
 impl Out {
@@ -204,6 +206,9 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
             }
         },
     );
+    if let Some(ix) = &sel.size_effect {
+        size_effect::fit(rec, ix, &mut out);
+    }
     let allan = allan_block
         .zip(curves.as_ref())
         .and_then(|(b, c)| allan::analyse(b, c, &mut out));
@@ -255,6 +260,7 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
         environment: select::environment(rec),
         warnings: Vec::new(),
         fits: Default::default(),
+        size_effect: out.size_effect.take(),
     };
     let declared = effects::declared(plan, &opts.with);
     if !declared.is_empty() {

@@ -34,6 +34,8 @@ pub(crate) struct Selection {
     pub warnings: Vec<String>,
     /// Uses per segment.
     pub used_for: HashMap<usize, Vec<String>>,
+    /// Oscillation segments of the size-effect fit (navigated on the raw stream, not prepared).
+    pub size_effect: Option<Vec<usize>>,
 }
 
 impl Selection {
@@ -179,10 +181,15 @@ pub(crate) fn select(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Se
                             sel.allan = Some(b);
                         }
                     }
-                    FitModel::SizeEffect => sel.warnings.push(
-                        "the size-effect fit is not part of `analyze`; its segments are left out"
-                            .into(),
-                    ),
+                    FitModel::SizeEffect => {
+                        for &i in &ix {
+                            sel.used_for
+                                .entry(i)
+                                .or_default()
+                                .push("size_effect".into());
+                        }
+                        sel.size_effect = Some(ix);
+                    }
                 }
             }
             sel.unused = (0..segs.len())

@@ -32,6 +32,7 @@ pub fn draw(input: &ReportInput) -> Plots {
         rate_fit(r).or_else(|| rate_residuals(r, input.manifest.as_ref())),
     );
     named.insert("allan", allan(r));
+    named.insert("size_effect_velocity", size_effect_velocity(r));
     named.insert("temperature", temperature(&input.temperature));
     let findings = match r.get("findings").and_then(Value::as_array) {
         Some(fs) => fs.iter().map(finding).collect(),
@@ -237,6 +238,52 @@ fn rate_residuals(r: &Value, manifest: Option<&Value>) -> Option<String> {
         y_label: "residual (°/s)".into(),
         series,
         zero_line: true,
+        ..Chart::default()
+    }
+    .to_svg()
+}
+
+/// The navigation velocity of each swaying segment, East and North, from its start: the
+/// drift whose rate the size-effect fit uses.
+fn size_effect_velocity(r: &Value) -> Option<String> {
+    let segs = r.get("size_effect")?.get("segments")?.as_array()?;
+    let mut series = Vec::new();
+    for (k, s) in segs.iter().enumerate() {
+        let id = text(s, &["segment"]).unwrap_or("?");
+        let v = s.get("velocity").and_then(Value::as_array)?;
+        let rows: Vec<[f64; 3]> = v
+            .iter()
+            .filter_map(|p| {
+                let p = p.as_array()?;
+                Some([
+                    p.first()?.as_f64()?,
+                    p.get(1)?.as_f64()?,
+                    p.get(2)?.as_f64()?,
+                ])
+            })
+            .collect();
+        let Some(first) = rows.first().copied() else {
+            continue;
+        };
+        for (c, dir) in [(1, "E"), (2, "N")] {
+            let points: Vec<(f64, f64)> = rows
+                .iter()
+                .map(|p| (p[0] - first[0], p[c] - first[c]))
+                .collect();
+            series.push(Series {
+                name: format!("{id} {dir}"),
+                points: thin(&points, 300),
+                err: None,
+                style: Style::Line,
+                color: PALETTE[(2 * k + c - 1) % PALETTE.len()].into(),
+            });
+        }
+    }
+    Chart {
+        title: "Velocity drift while swaying".into(),
+        x_label: "time from the segment's start (s)".into(),
+        y_label: "velocity change (m/s)".into(),
+        series,
         ..Chart::default()
     }
     .to_svg()

@@ -3,7 +3,7 @@
 
 use miette::{IntoDiagnostic, Report, WrapErr, miette};
 use ratecal_drivers::station::{ImuDriverSpec, TableDriverSpec};
-use ratecal_drivers::{DEFAULT_STATION_YAML, Station};
+use ratecal_drivers::{DEFAULT_STATION_YAML, SWAYING_STATION_YAML, Station};
 use ratecal_engine::plan::Plan;
 use ratecal_engine::recording::{
     EnvironmentRecord, FORMAT, Manifest, ManifestStation, Mount, ProcedureRef, RunInfo, TableAxes,
@@ -24,6 +24,35 @@ pub struct LoadedStation {
 /// Reads a station file (or the embedded default); with `dry_run` both drivers become the
 /// simulator, keeping every other key (geometry, IMU model, faults).
 pub fn station(path: Option<&Path>, dry_run: bool) -> Result<LoadedStation, Report> {
+    station_for(path, dry_run, None)
+}
+
+/// The embedded station a procedure runs on without `--station`: the swaying one for a
+/// procedure that declares `geometry vertical_outer`, the default one otherwise.
+pub fn builtin_for(procedure_text: &str) -> (&'static str, &'static str) {
+    use ratecal_grammar::ast::{ProcItem, TopItem};
+    let vertical =
+        ratecal_grammar::parse(procedure_text).is_ok_and(|f| {
+            f.body.items.iter().any(|it| match &it.node {
+                TopItem::Procedure(p) => p.body.items.iter().any(
+                    |pi| matches!(&pi.node, ProcItem::Geometry(g) if g.node == "vertical_outer"),
+                ),
+                _ => false,
+            })
+        });
+    if vertical {
+        (SWAYING_STATION_YAML, "<swaying station>")
+    } else {
+        (DEFAULT_STATION_YAML, "<default station>")
+    }
+}
+
+/// As [`station`], with `builtin` (YAML, name) in place of the embedded default.
+pub fn station_for(
+    path: Option<&Path>,
+    dry_run: bool,
+    builtin: Option<(&str, &str)>,
+) -> Result<LoadedStation, Report> {
     let (yaml, name) = match path {
         Some(p) => (
             std::fs::read_to_string(p)
@@ -31,10 +60,10 @@ pub fn station(path: Option<&Path>, dry_run: bool) -> Result<LoadedStation, Repo
                 .wrap_err_with(|| format!("cannot read station file {}", p.display()))?,
             p.display().to_string(),
         ),
-        None => (
-            DEFAULT_STATION_YAML.to_string(),
-            "<default station>".to_string(),
-        ),
+        None => {
+            let (y, n) = builtin.unwrap_or((DEFAULT_STATION_YAML, "<default station>"));
+            (y.to_string(), n.to_string())
+        }
     };
     let mut station = Station::from_yaml(&yaml, &name).map_err(|e| Report::new(*e))?;
     if dry_run {
