@@ -45,6 +45,7 @@ fn manifest(files: &[(&str, &str)]) -> Manifest {
                 .iter()
                 .map(|(a, b)| (a.to_string(), b.to_string()))
                 .collect(),
+            sync: None,
         }),
     }
 }

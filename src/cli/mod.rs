@@ -4,6 +4,7 @@
 pub mod analyze;
 pub mod check;
 pub mod diff;
+pub mod emulate;
 pub mod fmt;
 pub mod log;
 pub mod procedure;

@@ -46,6 +46,11 @@ pub struct Args {
     operator: Option<String>,
 }
 
+/// Reads a station file (for `ratecal emulate`: every driver simulated, faults kept).
+pub fn station_file(path: &Path) -> Result<setup::LoadedStation, Report> {
+    setup::station(Some(path), true)
+}
+
 /// Runs the subcommand.
 pub fn main(args: Args) -> ExitCode {
     match run(args) {
@@ -81,6 +86,10 @@ fn run(args: Args) -> Result<ExitCode, Report> {
         seed,
     } = prep;
     let simulated = station.describe().simulated;
+    if let Some(t) = link_timeout_s(&station) {
+        // A link that comes back within its timeout must not trip the stall check first.
+        opts.stall_timeout_s = opts.stall_timeout_s.max(t + 0.5);
+    }
     let cancel = Arc::new(AtomicBool::new(false));
     opts.cancel = Some(cancel.clone());
     let mut bar = progress::Bar::new(plan.estimated_duration_s, simulated);
@@ -125,6 +134,20 @@ fn run(args: Args) -> Result<ExitCode, Report> {
     let outcome = outcome
         .map_err(|e| miette::miette!("cannot close the recording in {}: {e}", dir.display()))?;
     Ok(finish(&dir, &plan, &outcome, wall, simulated))
+}
+
+/// The longest timeout of a station's hardware links, s.
+fn link_timeout_s(station: &ratecal_drivers::Station) -> Option<f64> {
+    use ratecal_drivers::station::{ImuDriverSpec as I, TableDriverSpec as T};
+    let table = match &station.table.driver {
+        T::Tcp { timeout, .. } | T::Serial { timeout, .. } => Some(timeout.0),
+        T::Sim | T::Replay { .. } => None,
+    };
+    let imu = match &station.imu.driver {
+        I::Tcp { timeout, .. } | I::Serial { timeout, .. } => Some(timeout.0),
+        I::Sim | I::Replay { .. } => None,
+    };
+    table.into_iter().chain(imu).reduce(f64::max)
 }
 
 fn prepare_new(args: &Args) -> Result<Prepared, Report> {
@@ -269,6 +292,28 @@ fn finish(
         out.segments,
         out.warnings.len()
     );
+    if let Some(sync) = &out.sync {
+        for (name, l) in [("imu", &sync.imu), ("table", &sync.table)] {
+            if let Some(l) = l {
+                println!(
+                    "{name} link: {} samples, {} corrupted (skipped), {} lost, {} reconnects, delay {:.2}/{:.2}/{:.2} ms (min/mean/max)",
+                    l.samples,
+                    l.corrupted,
+                    l.lost,
+                    l.reconnects,
+                    l.latency_min_ms,
+                    l.latency_mean_ms,
+                    l.latency_max_ms
+                );
+            }
+        }
+        if let Some(skew) = sync.table_minus_imu_s {
+            println!(
+                "table-to-IMU sync: table stamps {:+.3} ms relative to the IMU's (estimate)",
+                skew * 1e3
+            );
+        }
+    }
     match &out.status {
         RunStatus::Aborted(a) => {
             println!(

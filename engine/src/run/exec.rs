@@ -5,14 +5,19 @@ use super::live::{ImuRow, Live, TableRow, stability_unmet};
 use super::monitor::{Fire, Monitor};
 use super::{JournalEntry, JournalEvent, Progress, RunOptions, RunOutcome, RunSink, RunStatus};
 use crate::plan::{AbortAction, Acquire, Action, Axis, Node, OnTimeout, Plan, Settle};
-use crate::recording::{AbortRecord, Mount};
+use crate::recording::{AbortRecord, LinkRecord, Mount, SyncRecord};
 use ratecal_drivers::{
-    DriverError, DriverErrorKind, ImuDriver, ImuSample, TableCommand, TableDriver, TableSample,
+    DriverError, DriverErrorKind, ImuDriver, ImuSample, LinkStats, TableCommand, TableDriver,
+    TableSample,
 };
 use std::io;
 use std::sync::atomic::Ordering;
 use std::time::Duration;
 use tokio::time::{Instant, sleep_until};
+
+/// Wall-clock time between flushes of the recording to the disk, s (at most a second of
+/// data is ever only in memory; half of it leaves room for a slow tick).
+const FLUSH_EVERY_S: f64 = 0.5;
 
 /// Why the walk stops early.
 pub(super) enum Stop {
@@ -69,6 +74,7 @@ pub async fn execute(
         warnings: Vec::new(),
         fires: Vec::new(),
         last_progress: f64::NEG_INFINITY,
+        last_flush: std::time::Instant::now(),
         stall_s: opts.stall_timeout_s.max(3.0 / info.sample_hz.max(1e-3)),
         imu_hz: info.sample_hz,
         timeouts_since: None,
@@ -108,6 +114,10 @@ pub async fn execute(
     ex.journal(JournalEvent::End {
         status: status.as_str().into(),
     });
+    let sync = sync_record(ex.table.link_stats(), ex.imu.link_stats());
+    if let Some(s) = &sync {
+        ex.sink.links(s);
+    }
     let t_end = ex.now();
     ex.sink.end(&status)?;
     Ok(RunOutcome {
@@ -119,6 +129,38 @@ pub async fn execute(
         imu_samples: ex.imu_samples,
         table_samples: ex.table_samples,
         warnings: ex.warnings,
+        sync,
+    })
+}
+
+fn link_record(s: &LinkStats) -> LinkRecord {
+    LinkRecord {
+        samples: s.samples,
+        corrupted: s.corrupted,
+        lost: s.lost,
+        reconnects: s.reconnects,
+        latency_min_ms: s.latency_min_s * 1e3,
+        latency_mean_ms: s.latency_mean_s * 1e3,
+        latency_max_ms: s.latency_max_s * 1e3,
+    }
+}
+
+/// Each link's stamps run late by minus its least arrival delay (the anchor's delay above
+/// the least one seen); the table-to-IMU skew is the difference.
+fn sync_record(table: Option<LinkStats>, imu: Option<LinkStats>) -> Option<SyncRecord> {
+    if table.is_none() && imu.is_none() {
+        return None;
+    }
+    let skew = match (&table, &imu) {
+        (Some(t), Some(i)) if t.batches > 0 && i.batches > 0 => {
+            Some(i.latency_min_s - t.latency_min_s)
+        }
+        _ => None,
+    };
+    Some(SyncRecord {
+        table_minus_imu_s: skew,
+        imu: imu.as_ref().map(link_record),
+        table: table.as_ref().map(link_record),
     })
 }
 
@@ -188,6 +230,7 @@ struct Exec<'a> {
     warnings: Vec<String>,
     fires: Vec<Fire>,
     last_progress: f64,
+    last_flush: std::time::Instant,
     stall_s: f64,
     imu_hz: f64,
     timeouts_since: Option<f64>,
@@ -701,6 +744,14 @@ impl Exec<'_> {
         if now - self.last_progress >= 0.5 {
             self.last_progress = now;
             self.progress.time(now);
+        }
+        // Wall-clock time: a simulated run on the paused clock flushes as rarely as a real
+        // one, not every half second of simulated time.
+        if self.last_flush.elapsed().as_secs_f64() >= FLUSH_EVERY_S {
+            self.last_flush = std::time::Instant::now();
+            if let Err(e) = self.sink.flush() {
+                return Err(self.abort("recording error".into(), e.to_string()));
+            }
         }
         Ok(())
     }

@@ -355,6 +355,7 @@ pub fn manifest(name: &str) -> Manifest {
             seed: None,
             station_sha256: None,
             files_sha256: Default::default(),
+            sync: None,
         }),
     }
 }

@@ -170,6 +170,7 @@ pub fn manifest(st: &LoadedStation, proc_: &LoadedProcedure, facts: &RunFacts) -
             station_sha256: Some(sha256_hex(st.yaml.as_bytes())),
             // The import copies are hashed now; the data files when the run ends.
             files_sha256: proc_.imports.hashes(),
+            sync: None,
         }),
     }
 }
