@@ -5,10 +5,9 @@ use super::live::{ImuRow, Live, TableRow, stability_unmet};
 use super::monitor::{Fire, Monitor};
 use super::{JournalEntry, JournalEvent, Progress, RunOptions, RunOutcome, RunSink, RunStatus};
 use crate::plan::{AbortAction, Acquire, Action, Axis, Node, OnTimeout, Plan, Settle};
-use crate::recording::{AbortRecord, LinkRecord, Mount, SyncRecord};
+use crate::recording::{AbortRecord, Mount};
 use ratecal_drivers::{
-    DriverError, DriverErrorKind, ImuDriver, ImuSample, LinkStats, TableCommand, TableDriver,
-    TableSample,
+    DriverError, DriverErrorKind, ImuDriver, ImuSample, TableCommand, TableDriver, TableSample,
 };
 use std::io;
 use std::sync::atomic::Ordering;
@@ -39,6 +38,7 @@ pub async fn execute(
     opts: &RunOptions,
 ) -> io::Result<RunOutcome> {
     let info = imu.info();
+    let table_info = table.info();
     let longest = plan
         .steps
         .iter()
@@ -63,6 +63,7 @@ pub async fn execute(
         imu_buf: Vec::new(),
         table_buf: Vec::new(),
         last_imu_t: opts.t_offset,
+        last_finite_imu_t: opts.t_offset,
         last_table_t: opts.t_offset,
         last_table: None,
         step: None,
@@ -77,6 +78,8 @@ pub async fn execute(
         last_flush: std::time::Instant::now(),
         stall_s: opts.stall_timeout_s.max(3.0 / info.sample_hz.max(1e-3)),
         imu_hz: info.sample_hz,
+        table_hz: table_info.feedback_hz,
+        simulated: info.simulated && table_info.simulated,
         timeouts_since: None,
         warned_nonfinite: false,
     };
@@ -114,7 +117,7 @@ pub async fn execute(
     ex.journal(JournalEvent::End {
         status: status.as_str().into(),
     });
-    let sync = sync_record(ex.table.link_stats(), ex.imu.link_stats());
+    let sync = super::links::sync_record(ex.table.link_stats(), ex.imu.link_stats());
     if let Some(s) = &sync {
         ex.sink.links(s);
     }
@@ -130,37 +133,6 @@ pub async fn execute(
         table_samples: ex.table_samples,
         warnings: ex.warnings,
         sync,
-    })
-}
-
-fn link_record(s: &LinkStats) -> LinkRecord {
-    LinkRecord {
-        samples: s.samples,
-        corrupted: s.corrupted,
-        lost: s.lost,
-        reconnects: s.reconnects,
-        latency_min_ms: s.latency_min_s * 1e3,
-        latency_mean_ms: s.latency_mean_s * 1e3,
-        latency_max_ms: s.latency_max_s * 1e3,
-    }
-}
-
-/// Each link's stamps run late by minus its least arrival delay (the anchor's delay above
-/// the least one seen); the table-to-IMU skew is the difference.
-fn sync_record(table: Option<LinkStats>, imu: Option<LinkStats>) -> Option<SyncRecord> {
-    if table.is_none() && imu.is_none() {
-        return None;
-    }
-    let skew = match (&table, &imu) {
-        (Some(t), Some(i)) if t.batches > 0 && i.batches > 0 => {
-            Some(i.latency_min_s - t.latency_min_s)
-        }
-        _ => None,
-    };
-    Some(SyncRecord {
-        table_minus_imu_s: skew,
-        imu: imu.as_ref().map(link_record),
-        table: table.as_ref().map(link_record),
     })
 }
 
@@ -219,6 +191,8 @@ struct Exec<'a> {
     imu_buf: Vec<ImuSample>,
     table_buf: Vec<TableSample>,
     last_imu_t: f64,
+    /// Time of the latest IMU sample the recording can hold (finite outputs).
+    last_finite_imu_t: f64,
     last_table_t: f64,
     last_table: Option<TableSample>,
     step: Option<usize>,
@@ -233,6 +207,9 @@ struct Exec<'a> {
     last_flush: std::time::Instant,
     stall_s: f64,
     imu_hz: f64,
+    table_hz: f64,
+    /// Both drivers simulated: data is never late.
+    simulated: bool,
     timeouts_since: Option<f64>,
     warned_nonfinite: bool,
 }
@@ -536,6 +513,9 @@ impl Exec<'_> {
         let t_start = self.now();
         self.wait(a.duration_s).await?;
         let t_end = self.now();
+        if !self.simulated {
+            self.await_data(t_end, &id).await?;
+        }
         let mut seg = self
             .cmd
             .segment(id.clone(), t_start, t_end, self.last_table.as_ref());
@@ -549,6 +529,28 @@ impl Exec<'_> {
             t_start,
             t_end,
         });
+        Ok(())
+    }
+
+    /// Waits until both streams have delivered the data of a segment ending at `t_end`
+    /// (hardware delivers it late by its link delay; the recording must cover every segment
+    /// it lists, to half a sample). Gives up, aborting, after the stall time.
+    async fn await_data(&mut self, t_end: f64, id: &str) -> Res {
+        let need_imu = t_end - 0.4 / self.imu_hz.max(1e-3);
+        let need_table = t_end - 0.4 / self.table_hz.max(1e-3);
+        let give_up = self.now() + self.stall_s;
+        while self.last_finite_imu_t < need_imu || self.last_table_t < need_table {
+            if self.now() >= give_up {
+                return Err(self.abort(
+                    format!("the data of segment {id} did not arrive"),
+                    format!(
+                        "IMU up to t = {:.3} s, table up to t = {:.3} s, segment ends at {t_end:.3} s",
+                        self.last_finite_imu_t, self.last_table_t
+                    ),
+                ));
+            }
+            self.tick(None).await?;
+        }
         Ok(())
     }
 
@@ -681,6 +683,12 @@ impl Exec<'_> {
         }
         if let Some(s) = self.imu_buf.last() {
             self.last_imu_t = s.t;
+        }
+        if let Some(s) = self.imu_buf.iter().rev().find(|s| {
+            s.accel.iter().chain(&s.gyro).all(|v| v.is_finite())
+                && s.temp_c.is_none_or(f64::is_finite)
+        }) {
+            self.last_finite_imu_t = s.t;
         }
         if let Some(s) = self.table_buf.last() {
             self.last_table_t = s.t;

@@ -22,6 +22,7 @@ use std::time::Duration;
 mod command;
 mod exec;
 mod journal;
+mod links;
 mod live;
 mod monitor;
 
