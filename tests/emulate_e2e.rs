@@ -202,6 +202,15 @@ fn station_check_against_the_emulator() {
             &["abort:", "ABORTED"],
         ),
         (
+            "table link dropped for good",
+            "  - link_drop: { at: 3 s, link: table, duration: 60 s }",
+            false,
+            None,
+            4,
+            "aborted",
+            &["abort:", "\"safe_state\",\"at_rest\":false"],
+        ),
+        (
             "imu stall",
             "  - stall: { at: 3 s, link: imu, duration: 10 s }",
             false,

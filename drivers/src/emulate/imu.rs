@@ -13,8 +13,8 @@ const PERIOD: Duration = Duration::from_millis(2);
 const CORRUPT_AT: usize = 3 + 12 + 2;
 
 /// Streams frames until the client closes the link or a fault drops it. On a
-/// pseudo-terminal nobody may be reading: frames that cannot be written within 50 ms are
-/// dropped, as a device does, rather than queued.
+/// pseudo-terminal nobody may be reading: frames that cannot be written within 200 ms are
+/// dropped, as a device does, rather than queued (and never end the link).
 pub(super) async fn serve<S: AsyncWrite + Unpin>(mut stream: S, s: &Session, pty: bool) -> End {
     let mut tick = tokio::time::interval(PERIOD);
     tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
@@ -67,10 +67,9 @@ pub(super) async fn serve<S: AsyncWrite + Unpin>(mut stream: S, s: &Session, pty
         }
         let write = stream.write_all(&buf);
         if pty {
-            // A timed-out write is dropped (nobody reads); a failed one ends the link.
-            if let Ok(Err(_)) = tokio::time::timeout(Duration::from_millis(50), write).await {
-                return End::Client;
-            }
+            // A timed-out write is dropped (nobody reads); so is a failed one: a terminal
+            // has no connection to end, the device keeps sending.
+            let _ = tokio::time::timeout(Duration::from_millis(200), write).await;
         } else if write.await.is_err() {
             return End::Client;
         }

@@ -107,6 +107,7 @@ async fn pump(endpoint: Endpoint, timeout: Duration, shared: Arc<Mutex<Shared>>,
                 continue;
             };
             clock.arrival(newest.t, host, batch.len() as u64);
+            lost_at = Instant::now();
             for (c, s) in &batch {
                 if let Some(prev) = counter {
                     let gap = c.wrapping_sub(prev);
@@ -121,7 +122,21 @@ async fn pump(endpoint: Endpoint, timeout: Duration, shared: Arc<Mutex<Shared>>,
                 });
             }
         }
-        lost_at = Instant::now();
+        if lost_at.elapsed() >= timeout {
+            fail(
+                &shared,
+                format!("IMU link ({endpoint}) silent for {timeout:?}"),
+            );
+            return;
+        }
+        // One attempt per 50 ms: a device that accepts and closes at once is not hammered.
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+}
+
+fn fail(shared: &Mutex<Shared>, msg: String) {
+    if let Ok(mut sh) = shared.lock() {
+        sh.error = Some(DriverError::new(DriverErrorKind::Transport, msg));
     }
 }
 

@@ -23,6 +23,7 @@ pub struct LinkTable {
     /// When the link was found broken (the reconnect window runs from there).
     lost_at: Option<Instant>,
     connected_once: bool,
+    last_attempt: Option<Instant>,
 }
 
 impl std::fmt::Debug for LinkTable {
@@ -51,6 +52,7 @@ impl LinkTable {
             clock: ClockMap::default(),
             lost_at: None,
             connected_once: false,
+            last_attempt: None,
         }
     }
 
@@ -62,6 +64,14 @@ impl LinkTable {
             self.lost_at.get_or_insert_with(Instant::now);
         }
         if self.link.is_none() {
+            // At most one connection attempt per 50 ms: a device that accepts and closes at
+            // once must not be hammered.
+            if let Some(at) = self.last_attempt
+                && at.elapsed() < Duration::from_millis(50)
+            {
+                tokio::time::sleep_until(at + Duration::from_millis(50)).await;
+            }
+            self.last_attempt = Some(Instant::now());
             match connect(&self.endpoint, self.timeout).await {
                 Ok(stream) => {
                     let mut l = LineTable::new(stream, self.info.clone(), self.timeout);
@@ -70,7 +80,6 @@ impl LinkTable {
                     }
                     l.set_clock(self.clock.clone(), self.start);
                     self.connected_once = true;
-                    self.lost_at = None;
                     self.link = Some(l);
                 }
                 Err(e) => {
@@ -117,7 +126,12 @@ impl TableDriver for LinkTable {
                         return Err(e);
                     }
                 }
-                r => return r,
+                r => {
+                    if r.is_ok() {
+                        self.lost_at = None;
+                    }
+                    return r;
+                }
             }
         }
     }
@@ -132,7 +146,12 @@ impl TableDriver for LinkTable {
                     Err(e)
                 }
             }
-            r => r,
+            r => {
+                if r.is_ok() {
+                    self.lost_at = None;
+                }
+                r
+            }
         }
     }
 

@@ -1,6 +1,6 @@
 //! The control loop and the walk over the plan's steps.
 
-use super::command::{AxisCmd, CmdState, axis_id};
+use super::command::{AxisCmd, CmdState, axis_id, substitute};
 use super::live::{ImuRow, Live, TableRow, stability_unmet};
 use super::monitor::{Fire, Monitor};
 use super::{JournalEntry, JournalEvent, Progress, RunOptions, RunOutcome, RunSink, RunStatus};
@@ -143,32 +143,6 @@ fn stabilities(n: &Node) -> Vec<f64> {
         Node::Do(_) => Vec::new(),
         Node::Repeat { body, .. } => body.iter().flat_map(stabilities).collect(),
     }
-}
-
-/// Substitutes `{var}` with repeat indices (innermost binding wins); other braces stay.
-fn substitute(template: &str, vars: &[(String, u64)]) -> String {
-    let mut out = String::with_capacity(template.len());
-    let mut rest = template;
-    while let Some(open) = rest.find('{') {
-        out.push_str(&rest[..open]);
-        let after = &rest[open + 1..];
-        match after.find('}') {
-            Some(close) => {
-                let name = &after[..close];
-                match vars.iter().rev().find(|(n, _)| n == name) {
-                    Some((_, v)) => out.push_str(&v.to_string()),
-                    None => out.push_str(&rest[open..open + close + 2]),
-                }
-                rest = &after[close + 1..];
-            }
-            None => {
-                out.push_str(&rest[open..]);
-                rest = "";
-            }
-        }
-    }
-    out.push_str(rest);
-    out
 }
 
 struct Exec<'a> {
@@ -777,7 +751,8 @@ impl Exec<'_> {
             });
         }
         self.cmd = CmdState::default();
-        let give_up = self.now() + self.opts.safe_stop_timeout_s;
+        let started = self.now();
+        let give_up = started + self.opts.safe_stop_timeout_s;
         let mut rest_since: Option<f64> = None;
         let mut errors = 0;
         let at_rest = loop {
@@ -801,22 +776,14 @@ impl Exec<'_> {
             } else {
                 rest_since = None;
             }
-            if now >= give_up {
+            // A table whose feedback stays lost cannot be seen to stop: the command was
+            // sent (or could not be); waiting out the whole safe-stop time helps nobody.
+            if now >= give_up
+                || (now - started > 2.0 * self.stall_s && now - self.last_table_t > self.stall_s)
+            {
                 break false;
             }
         };
         self.journal(JournalEvent::SafeState { at_rest });
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::substitute;
-
-    #[test]
-    fn substitutes_repeat_indices() {
-        let vars = vec![("run".to_string(), 2), ("k".to_string(), 7)];
-        assert_eq!(substitute("bias/{run}/{k}", &vars), "bias/2/7");
-        assert_eq!(substitute("a/{other}/{k", &vars), "a/{other}/{k");
     }
 }
