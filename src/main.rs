@@ -35,6 +35,8 @@ enum Command {
     Fmt(cli::fmt::Args),
     /// Run a procedure on a station (simulated with --dry-run).
     Run(cli::run::Args),
+    /// Serve a station file's simulated station over the hardware protocols, in real time.
+    Emulate(cli::emulate::Args),
     /// Analyse a recording: fits, uncertainties, acceptance.
     Analyze(cli::analyze::Args),
     /// Render a calibration report from a run folder.
@@ -59,6 +61,7 @@ fn main() -> ExitCode {
         Command::Check(a) => cli::check::main(a),
         Command::Fmt(a) => cli::fmt::main(a),
         Command::Run(a) => cli::run::main(a),
+        Command::Emulate(a) => cli::emulate::main(a),
         Command::Analyze(a) => cli::analyze::main(a),
         Command::Report(a) => cli::report::main(a),
         Command::Diff(a) => cli::diff::main(a),

@@ -16,11 +16,14 @@
 //! # }
 //! ```
 
+pub mod emulate;
+pub mod frame;
+pub mod line;
+pub mod link;
 pub mod registry;
 pub mod replay;
 pub mod sim;
 pub mod station;
-pub mod tcp;
 mod traits;
 
 pub use registry::{DRIVERS, DriverKind, Drivers, build};
@@ -28,6 +31,6 @@ pub use station::{
     DEFAULT_STATION_YAML, SWAYING_STATION_YAML, Station, StationError, StationInfo, yaml_offset,
 };
 pub use traits::{
-    DriverError, DriverErrorKind, ImuDriver, ImuInfo, ImuSample, TableAxisId, TableCommand,
-    TableDriver, TableInfo, TableSample,
+    DriverError, DriverErrorKind, ImuDriver, ImuInfo, ImuSample, LinkStats, TableAxisId,
+    TableCommand, TableDriver, TableInfo, TableSample,
 };

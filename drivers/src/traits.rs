@@ -152,6 +152,28 @@ impl DriverError {
     }
 }
 
+/// How a hardware link delivered its samples: counts, and the delay from the (mapped)
+/// device stamp to host arrival, per batch.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LinkStats {
+    /// Samples received.
+    pub samples: u64,
+    /// Batches (reads, feedback replies) received.
+    pub batches: u64,
+    /// Frames refused for a wrong CRC (skipped).
+    pub corrupted: u64,
+    /// Samples missing from the device's counter (lost in transit, or during a stall).
+    pub lost: u64,
+    /// Times the link was rebuilt.
+    pub reconnects: u32,
+    /// Least delay from stamp to arrival, s (negative: the stamps run this much late).
+    pub latency_min_s: f64,
+    /// Mean delay, s.
+    pub latency_mean_s: f64,
+    /// Largest delay, s.
+    pub latency_max_s: f64,
+}
+
 /// A rate table.
 #[async_trait]
 pub trait TableDriver: Send {
@@ -161,6 +183,10 @@ pub trait TableDriver: Send {
     async fn command(&mut self, cmd: TableCommand) -> Result<(), DriverError>;
     /// Appends every feedback sample that became available since the last call.
     async fn read(&mut self, out: &mut Vec<TableSample>) -> Result<(), DriverError>;
+    /// How the link delivered its samples (`None` for a simulated or replayed table).
+    fn link_stats(&self) -> Option<LinkStats> {
+        None
+    }
 }
 
 /// An IMU.
@@ -174,5 +200,9 @@ pub trait ImuDriver: Send {
     /// physics, hardware ignores it.
     async fn remount(&mut self, _rotation: [[f64; 3]; 3]) -> Result<(), DriverError> {
         Ok(())
+    }
+    /// How the link delivered its samples (`None` for a simulated or replayed IMU).
+    fn link_stats(&self) -> Option<LinkStats> {
+        None
     }
 }

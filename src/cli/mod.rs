@@ -5,6 +5,7 @@ pub mod analyze;
 pub mod archive;
 pub mod check;
 pub mod diff;
+pub mod emulate;
 pub mod explain;
 pub mod fmt;
 pub mod key;

@@ -57,6 +57,11 @@ pub struct Args {
     archive: Option<String>,
 }
 
+/// Reads a station file (for `ratecal emulate`: every driver simulated, faults kept).
+pub fn station_file(path: &Path) -> Result<setup::LoadedStation, Report> {
+    setup::station(Some(path), true)
+}
+
 /// Runs the subcommand.
 pub fn main(args: Args) -> ExitCode {
     match run(args) {
@@ -116,6 +121,10 @@ fn execute_prepared(prep: Prepared, key: Option<&SigningKey>) -> Result<ExitCode
         seed,
     } = prep;
     let simulated = station.describe().simulated;
+    if let Some(t) = link_timeout_s(&station) {
+        // A link that comes back within its timeout must not trip the stall check first.
+        opts.stall_timeout_s = opts.stall_timeout_s.max(t + 0.5);
+    }
     let cancel = Arc::new(AtomicBool::new(false));
     opts.cancel = Some(cancel.clone());
     let mut bar = progress::Bar::new(plan.estimated_duration_s, simulated);
@@ -171,6 +180,20 @@ fn execute_prepared(prep: Prepared, key: Option<&SigningKey>) -> Result<ExitCode
         key,
     };
     Ok(end.finish())
+}
+
+/// The longest timeout of a station's hardware links, s.
+fn link_timeout_s(station: &ratecal_drivers::Station) -> Option<f64> {
+    use ratecal_drivers::station::{ImuDriverSpec as I, TableDriverSpec as T};
+    let table = match &station.table.driver {
+        T::Tcp { timeout, .. } | T::Serial { timeout, .. } => Some(timeout.0),
+        T::Sim | T::Replay { .. } => None,
+    };
+    let imu = match &station.imu.driver {
+        I::Tcp { timeout, .. } | I::Serial { timeout, .. } => Some(timeout.0),
+        I::Sim | I::Replay { .. } => None,
+    };
+    table.into_iter().chain(imu).reduce(f64::max)
 }
 
 fn prepare_new(args: &Args) -> Result<Prepared, Report> {

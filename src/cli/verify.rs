@@ -51,7 +51,12 @@ pub fn verify_folder(dir: &Path) -> Result<SealReport, Unverifiable> {
     };
     let seal = std::fs::read_to_string(dir.join(SEAL_FILE)).ok();
     let seal_hash = std::fs::read_to_string(dir.join(SEAL_HASH_FILE)).ok();
-    Ok(verify_seal(seal.as_deref(), seal_hash.as_deref(), &files, None))
+    Ok(verify_seal(
+        seal.as_deref(),
+        seal_hash.as_deref(),
+        &files,
+        None,
+    ))
 }
 
 /// Runs the subcommand.

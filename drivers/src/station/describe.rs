@@ -54,7 +54,6 @@ pub struct Environment {
 impl Station {
     /// The facts a manifest records about this station.
     pub fn describe(&self) -> StationInfo {
-        use super::{ImuDriverSpec, TableDriverSpec};
         StationInfo {
             name: self.name.clone(),
             site: self.site(),
@@ -65,8 +64,7 @@ impl Station {
                 grade: self.imu.grade.clone(),
             },
             table_model: self.table.model.clone(),
-            simulated: matches!(self.table.driver, TableDriverSpec::Sim)
-                && matches!(self.imu.driver, ImuDriverSpec::Sim),
+            simulated: crate::registry::simulated(self),
             environment: self.environment.map(|e| Environment {
                 temperature_c: e.temperature.map(|t| t.0),
                 humidity_pct: e.humidity.map(|h| h.0 * 100.0),

@@ -8,6 +8,8 @@ use super::quantity::{
 };
 use serde::{Deserialize, Serialize};
 
+use super::faults::FaultSpec;
+
 /// A whole station: site, table, mount, IMU, temperature, environment and rehearsed faults.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -47,17 +49,28 @@ pub struct SiteSpec {
     pub gravity_mps2: f64,
 }
 
-/// Which driver runs the table.
+/// Which driver runs the table (the registry, `registry.rs`, lists every kind).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum TableDriverSpec {
     /// The simulated table.
     Sim,
-    /// A table speaking the line protocol of `docs/station.md` over TCP.
+    /// A table speaking the line protocol of `docs/protocols.md` over TCP.
     Tcp {
         /// `host:port`.
         address: String,
-        /// Reply timeout.
+        /// Reply timeout; a link lost for longer aborts the run.
+        #[serde(default = "default_timeout")]
+        timeout: Time,
+    },
+    /// A table speaking the line protocol over a serial port.
+    Serial {
+        /// Device path (`/dev/ttyUSB0`, a pseudo-terminal).
+        port: String,
+        /// Baud rate.
+        #[serde(default = "default_baud")]
+        baud: u32,
+        /// Reply timeout; a link lost for longer aborts the run.
         #[serde(default = "default_timeout")]
         timeout: Time,
     },
@@ -72,12 +85,35 @@ fn default_timeout() -> Time {
     Time(2.0)
 }
 
-/// Which driver runs the IMU.
+fn default_baud() -> u32 {
+    921_600
+}
+
+/// Which driver runs the IMU (the registry, `registry.rs`, lists every kind).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum ImuDriverSpec {
     /// The simulated IMU (needs the simulated table: it senses the table's true motion).
     Sim,
+    /// An IMU streaming the binary frames of `docs/protocols.md` over TCP.
+    Tcp {
+        /// `host:port`.
+        address: String,
+        /// Silence after which the link is rebuilt; a link lost for longer aborts the run.
+        #[serde(default = "default_timeout")]
+        timeout: Time,
+    },
+    /// An IMU streaming binary frames over a serial port.
+    Serial {
+        /// Device path.
+        port: String,
+        /// Baud rate.
+        #[serde(default = "default_baud")]
+        baud: u32,
+        /// Silence after which the link is rebuilt; a link lost for longer aborts the run.
+        #[serde(default = "default_timeout")]
+        timeout: Time,
+    },
     /// Replays the IMU stream of a recording folder.
     Replay {
         /// The recording folder.
@@ -418,83 +454,4 @@ pub struct EnvironmentSpec {
     /// Vibration level.
     #[serde(default)]
     pub vibration: Option<Accel>,
-}
-
-/// Which table axis a fault hits.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum AxisName {
-    /// Outer axis.
-    Outer,
-    /// Inner axis.
-    Inner,
-}
-
-/// What a faulty table axis does.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum TableFaultMode {
-    /// Stops following commands: brakes to rest and stays there.
-    Stuck,
-    /// Runs away: ramps to `rate` and keeps turning whatever it is told.
-    Runaway,
-}
-
-/// What a dropped-out IMU outputs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum DropoutMode {
-    /// NaN on every channel.
-    Nan,
-    /// The last good sample, repeated.
-    Stuck,
-    /// No samples at all.
-    Missing,
-}
-
-/// A rehearsed fault (simulated station only).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case", deny_unknown_fields)]
-pub enum FaultSpec {
-    /// A table axis stops following or runs away at `at`; only a safe stop still works.
-    Table {
-        /// When.
-        at: Time,
-        /// Which axis.
-        axis: AxisName,
-        /// Stuck or runaway.
-        mode: TableFaultMode,
-        /// Runaway rate.
-        #[serde(default = "default_runaway")]
-        rate: Rate,
-    },
-    /// The IMU drops out at `at` for `duration`.
-    ImuDropout {
-        /// When.
-        at: Time,
-        /// How long.
-        duration: Time,
-        /// NaN, stuck or missing samples.
-        mode: DropoutMode,
-    },
-    /// The ambient temperature ramps by `delta` over `ramp`, holds for `duration`, ramps back.
-    TemperatureExcursion {
-        /// When it starts.
-        at: Time,
-        /// Size of the excursion.
-        delta: TempDelta,
-        /// Ramp time (up, and down again).
-        #[serde(default = "default_ramp")]
-        ramp: Time,
-        /// How long it holds at the full excursion.
-        duration: Time,
-    },
-}
-
-fn default_runaway() -> Rate {
-    Rate(20.0)
-}
-
-fn default_ramp() -> Time {
-    Time(60.0)
 }

@@ -2,16 +2,17 @@
 //! Parsing refuses unknown keys and wrong units with a diagnostic located in the file.
 
 mod describe;
+mod faults;
 mod file;
 mod quantity;
 
 pub use describe::{Environment, ImuIdentity, StationInfo};
 
+pub use faults::{AxisName, DropoutMode, FaultSpec, LinkName, TableFaultMode};
 pub use file::{
-    AmbientSpec, AxesSpec, AxisName, DropoutMode, EffectsSpec, EnvironmentSpec, FaultSpec,
-    GSensitivitySpec, ImuDriverSpec, ImuSpec, ImuTemperatureSpec, LeverArmSpec, MisalignmentSpec,
-    MountSpec, SettlingSpec, SiteSpec, Station, TableDriverSpec, TableFaultMode, TableSpec,
-    TemperatureSpec, TimeOffsetSpec,
+    AmbientSpec, AxesSpec, EffectsSpec, EnvironmentSpec, GSensitivitySpec, ImuDriverSpec, ImuSpec,
+    ImuTemperatureSpec, LeverArmSpec, MisalignmentSpec, MountSpec, SettlingSpec, SiteSpec, Station,
+    TableDriverSpec, TableSpec, TemperatureSpec, TimeOffsetSpec,
 };
 pub use quantity::{
     Accel, AccelDensity, Angle, Freq, Pressure, Rate, RateDensity, RateWalk, Ratio, Rotation, Temp,

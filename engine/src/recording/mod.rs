@@ -194,6 +194,9 @@ pub struct RunInfo {
     /// (`--allow-changed`): what changed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub changed_after_release: Option<String>,
+    /// How hardware links delivered their samples, and the table-to-IMU synchronisation.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sync: Option<SyncRecord>,
 }
 
 /// Where a run was interrupted and when it resumed.
@@ -218,6 +221,40 @@ pub struct ResumeRecord {
     pub resumed: String,
     /// Index of the first step the resumed part ran.
     pub from_step: usize,
+}
+
+/// `run.sync`: each hardware link's delivery and the table-to-IMU clock skew estimate.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct SyncRecord {
+    /// How much later the table's stamps run than the IMU's, s (estimated from the least
+    /// arrival delay of each link; both hardware links needed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub table_minus_imu_s: Option<f64>,
+    /// The IMU link.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub imu: Option<LinkRecord>,
+    /// The table link.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub table: Option<LinkRecord>,
+}
+
+/// One hardware link's delivery over the run.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct LinkRecord {
+    /// Samples received.
+    pub samples: u64,
+    /// Frames refused for a wrong CRC (skipped).
+    pub corrupted: u64,
+    /// Samples missing from the device counter.
+    pub lost: u64,
+    /// Times the link was rebuilt.
+    pub reconnects: u32,
+    /// Least delay from the mapped device stamp to host arrival, ms.
+    pub latency_min_ms: f64,
+    /// Mean delay, ms.
+    pub latency_mean_ms: f64,
+    /// Largest delay, ms.
+    pub latency_max_ms: f64,
 }
 
 /// Why and when a run aborted.

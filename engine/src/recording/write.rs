@@ -254,6 +254,15 @@ impl RecordingWriter {
         self.journal.write_all(l.as_bytes())
     }
 
+    /// Flushes the journal and both streams to the OS (without rewriting the manifest).
+    pub fn sync(&mut self) -> io::Result<()> {
+        self.journal.flush()?;
+        self.send_pending()?;
+        let (tx, rx) = mpsc::channel();
+        self.send(Msg::Sync(tx))?;
+        rx.recv().map_err(|_| gone())?
+    }
+
     /// Flushes both streams to the OS and rewrites the manifest atomically
     /// (`manifest.yaml.tmp` then rename).
     pub fn checkpoint(&mut self) -> io::Result<()> {

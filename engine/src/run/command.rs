@@ -191,6 +191,32 @@ pub(crate) fn axis_name(a: Axis) -> &'static str {
     }
 }
 
+/// Substitutes `{var}` with repeat indices (innermost binding wins); other braces stay.
+pub(super) fn substitute(template: &str, vars: &[(String, u64)]) -> String {
+    let mut out = String::with_capacity(template.len());
+    let mut rest = template;
+    while let Some(open) = rest.find('{') {
+        out.push_str(&rest[..open]);
+        let after = &rest[open + 1..];
+        match after.find('}') {
+            Some(close) => {
+                let name = &after[..close];
+                match vars.iter().rev().find(|(n, _)| n == name) {
+                    Some((_, v)) => out.push_str(&v.to_string()),
+                    None => out.push_str(&rest[open..open + close + 2]),
+                }
+                rest = &after[close + 1..];
+            }
+            None => {
+                out.push_str(&rest[open..]);
+                rest = "";
+            }
+        }
+    }
+    out.push_str(rest);
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -253,5 +279,12 @@ mod tests {
             (s.kind, s.axis.as_deref(), s.center_deg),
             (SegmentKind::Oscillation, Some("inner"), Some(10.0))
         );
+    }
+
+    #[test]
+    fn substitutes_repeat_indices() {
+        let vars = vec![("run".to_string(), 2), ("k".to_string(), 7)];
+        assert_eq!(substitute("bias/{run}/{k}", &vars), "bias/2/7");
+        assert_eq!(substitute("a/{other}/{k", &vars), "a/{other}/{k");
     }
 }

@@ -1,6 +1,6 @@
 //! The control loop and the walk over the plan's steps.
 
-use super::command::{AxisCmd, CmdState, axis_id};
+use super::command::{AxisCmd, CmdState, axis_id, substitute};
 use super::live::{ImuRow, Live, TableRow, stability_unmet};
 use super::monitor::{Fire, Monitor};
 use super::{JournalEntry, JournalEvent, Progress, RunOptions, RunOutcome, RunSink, RunStatus};
@@ -13,6 +13,10 @@ use std::io;
 use std::sync::atomic::Ordering;
 use std::time::Duration;
 use tokio::time::{Instant, sleep_until};
+
+/// Wall-clock time between flushes of the recording to the disk, s (at most a second of
+/// data is ever only in memory; half of it leaves room for a slow tick).
+const FLUSH_EVERY_S: f64 = 0.5;
 
 /// Why the walk stops early.
 pub(super) enum Stop {
@@ -34,6 +38,7 @@ pub async fn execute(
     opts: &RunOptions,
 ) -> io::Result<RunOutcome> {
     let info = imu.info();
+    let table_info = table.info();
     let longest = plan
         .steps
         .iter()
@@ -58,6 +63,7 @@ pub async fn execute(
         imu_buf: Vec::new(),
         table_buf: Vec::new(),
         last_imu_t: opts.t_offset,
+        last_finite_imu_t: opts.t_offset,
         last_table_t: opts.t_offset,
         last_table: None,
         step: None,
@@ -69,8 +75,11 @@ pub async fn execute(
         warnings: Vec::new(),
         fires: Vec::new(),
         last_progress: f64::NEG_INFINITY,
+        last_flush: std::time::Instant::now(),
         stall_s: opts.stall_timeout_s.max(3.0 / info.sample_hz.max(1e-3)),
         imu_hz: info.sample_hz,
+        table_hz: table_info.feedback_hz,
+        simulated: info.simulated && table_info.simulated,
         timeouts_since: None,
         warned_nonfinite: false,
     };
@@ -108,6 +117,10 @@ pub async fn execute(
     ex.journal(JournalEvent::End {
         status: status.as_str().into(),
     });
+    let sync = super::links::sync_record(ex.table.link_stats(), ex.imu.link_stats());
+    if let Some(s) = &sync {
+        ex.sink.links(s);
+    }
     let t_end = ex.now();
     ex.sink.end(&status)?;
     Ok(RunOutcome {
@@ -119,6 +132,7 @@ pub async fn execute(
         imu_samples: ex.imu_samples,
         table_samples: ex.table_samples,
         warnings: ex.warnings,
+        sync,
     })
 }
 
@@ -129,32 +143,6 @@ fn stabilities(n: &Node) -> Vec<f64> {
         Node::Do(_) => Vec::new(),
         Node::Repeat { body, .. } => body.iter().flat_map(stabilities).collect(),
     }
-}
-
-/// Substitutes `{var}` with repeat indices (innermost binding wins); other braces stay.
-fn substitute(template: &str, vars: &[(String, u64)]) -> String {
-    let mut out = String::with_capacity(template.len());
-    let mut rest = template;
-    while let Some(open) = rest.find('{') {
-        out.push_str(&rest[..open]);
-        let after = &rest[open + 1..];
-        match after.find('}') {
-            Some(close) => {
-                let name = &after[..close];
-                match vars.iter().rev().find(|(n, _)| n == name) {
-                    Some((_, v)) => out.push_str(&v.to_string()),
-                    None => out.push_str(&rest[open..open + close + 2]),
-                }
-                rest = &after[close + 1..];
-            }
-            None => {
-                out.push_str(&rest[open..]);
-                rest = "";
-            }
-        }
-    }
-    out.push_str(rest);
-    out
 }
 
 struct Exec<'a> {
@@ -177,6 +165,8 @@ struct Exec<'a> {
     imu_buf: Vec<ImuSample>,
     table_buf: Vec<TableSample>,
     last_imu_t: f64,
+    /// Time of the latest IMU sample the recording can hold (finite outputs).
+    last_finite_imu_t: f64,
     last_table_t: f64,
     last_table: Option<TableSample>,
     step: Option<usize>,
@@ -188,8 +178,12 @@ struct Exec<'a> {
     warnings: Vec<String>,
     fires: Vec<Fire>,
     last_progress: f64,
+    last_flush: std::time::Instant,
     stall_s: f64,
     imu_hz: f64,
+    table_hz: f64,
+    /// Both drivers simulated: data is never late.
+    simulated: bool,
     timeouts_since: Option<f64>,
     warned_nonfinite: bool,
 }
@@ -493,6 +487,9 @@ impl Exec<'_> {
         let t_start = self.now();
         self.wait(a.duration_s).await?;
         let t_end = self.now();
+        if !self.simulated {
+            self.await_data(t_end, &id).await?;
+        }
         let mut seg = self
             .cmd
             .segment(id.clone(), t_start, t_end, self.last_table.as_ref());
@@ -506,6 +503,28 @@ impl Exec<'_> {
             t_start,
             t_end,
         });
+        Ok(())
+    }
+
+    /// Waits until both streams have delivered the data of a segment ending at `t_end`
+    /// (hardware delivers it late by its link delay; the recording must cover every segment
+    /// it lists, to half a sample). Gives up, aborting, after the stall time.
+    async fn await_data(&mut self, t_end: f64, id: &str) -> Res {
+        let need_imu = t_end - 0.4 / self.imu_hz.max(1e-3);
+        let need_table = t_end - 0.4 / self.table_hz.max(1e-3);
+        let give_up = self.now() + self.stall_s;
+        while self.last_finite_imu_t < need_imu || self.last_table_t < need_table {
+            if self.now() >= give_up {
+                return Err(self.abort(
+                    format!("the data of segment {id} did not arrive"),
+                    format!(
+                        "IMU up to t = {:.3} s, table up to t = {:.3} s, segment ends at {t_end:.3} s",
+                        self.last_finite_imu_t, self.last_table_t
+                    ),
+                ));
+            }
+            self.tick(None).await?;
+        }
         Ok(())
     }
 
@@ -639,6 +658,12 @@ impl Exec<'_> {
         if let Some(s) = self.imu_buf.last() {
             self.last_imu_t = s.t;
         }
+        if let Some(s) = self.imu_buf.iter().rev().find(|s| {
+            s.accel.iter().chain(&s.gyro).all(|v| v.is_finite())
+                && s.temp_c.is_none_or(f64::is_finite)
+        }) {
+            self.last_finite_imu_t = s.t;
+        }
         if let Some(s) = self.table_buf.last() {
             self.last_table_t = s.t;
             self.last_table = Some(*s);
@@ -702,6 +727,14 @@ impl Exec<'_> {
             self.last_progress = now;
             self.progress.time(now);
         }
+        // Wall-clock time: a simulated run on the paused clock flushes as rarely as a real
+        // one, not every half second of simulated time.
+        if self.last_flush.elapsed().as_secs_f64() >= FLUSH_EVERY_S {
+            self.last_flush = std::time::Instant::now();
+            if let Err(e) = self.sink.flush() {
+                return Err(self.abort("recording error".into(), e.to_string()));
+            }
+        }
         Ok(())
     }
 
@@ -718,7 +751,8 @@ impl Exec<'_> {
             });
         }
         self.cmd = CmdState::default();
-        let give_up = self.now() + self.opts.safe_stop_timeout_s;
+        let started = self.now();
+        let give_up = started + self.opts.safe_stop_timeout_s;
         let mut rest_since: Option<f64> = None;
         let mut errors = 0;
         let at_rest = loop {
@@ -742,22 +776,14 @@ impl Exec<'_> {
             } else {
                 rest_since = None;
             }
-            if now >= give_up {
+            // A table whose feedback stays lost cannot be seen to stop: the command was
+            // sent (or could not be); waiting out the whole safe-stop time helps nobody.
+            if now >= give_up
+                || (now - started > 2.0 * self.stall_s && now - self.last_table_t > self.stall_s)
+            {
                 break false;
             }
         };
         self.journal(JournalEvent::SafeState { at_rest });
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::substitute;
-
-    #[test]
-    fn substitutes_repeat_indices() {
-        let vars = vec![("run".to_string(), 2), ("k".to_string(), 7)];
-        assert_eq!(substitute("bias/{run}/{k}", &vars), "bias/2/7");
-        assert_eq!(substitute("a/{other}/{k", &vars), "a/{other}/{k");
     }
 }

@@ -12,7 +12,7 @@
 //! Time: the recording clock is 0 at the start of the run (or `RunOptions::t_offset` when a
 //! run is resumed); driver time stamps are shifted onto it.
 
-use crate::recording::{AbortRecord, RecordingWriter, Segment};
+use crate::recording::{AbortRecord, RecordingWriter, Segment, SyncRecord};
 use ratecal_drivers::{ImuSample, TableSample};
 use std::io;
 use std::sync::Arc;
@@ -22,6 +22,7 @@ use std::time::Duration;
 mod command;
 mod exec;
 mod journal;
+mod links;
 mod live;
 mod monitor;
 
@@ -41,6 +42,13 @@ pub trait RunSink {
     fn segment(&mut self, segment: Segment) -> io::Result<()>;
     /// The run ended: record its status and close the streams.
     fn end(&mut self, status: &RunStatus) -> io::Result<()>;
+    /// Pushes what is buffered to the disk (called at least every second of a run, so a
+    /// crash or a pulled plug loses at most that).
+    fn flush(&mut self) -> io::Result<()> {
+        Ok(())
+    }
+    /// How the hardware links delivered their samples (called before `end`).
+    fn links(&mut self, _sync: &SyncRecord) {}
 }
 
 /// Hooks the caller implements to follow a run (a progress bar) and to talk to the operator.
@@ -136,6 +144,8 @@ pub struct RunOutcome {
     pub table_samples: u64,
     /// Warnings raised (rules with `warn`, settle timeouts with `warn`).
     pub warnings: Vec<String>,
+    /// Hardware links' delivery and the table-to-IMU synchronisation (`None`: simulated).
+    pub sync: Option<SyncRecord>,
 }
 
 impl RunSink for RecordingWriter {
@@ -155,6 +165,16 @@ impl RunSink for RecordingWriter {
     fn segment(&mut self, segment: Segment) -> io::Result<()> {
         self.manifest_mut().segments.push(segment);
         self.checkpoint()
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.sync()
+    }
+
+    fn links(&mut self, sync: &SyncRecord) {
+        if let Some(run) = self.manifest_mut().run.as_mut() {
+            run.sync = Some(sync.clone());
+        }
     }
 
     fn end(&mut self, status: &RunStatus) -> io::Result<()> {

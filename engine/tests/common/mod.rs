@@ -358,6 +358,7 @@ pub fn manifest(name: &str) -> Manifest {
             failure: None,
             resumes: Vec::new(),
             changed_after_release: None,
+            sync: None,
         }),
     }
 }

@@ -47,6 +47,28 @@ impl End<'_> {
             out.segments,
             out.warnings.len()
         );
+        if let Some(sync) = &out.sync {
+            for (name, l) in [("imu", &sync.imu), ("table", &sync.table)] {
+                if let Some(l) = l {
+                    outln!(
+                        "{name} link: {} samples, {} corrupted (skipped), {} lost, {} reconnects, delay {:.2}/{:.2}/{:.2} ms (min/mean/max)",
+                        l.samples,
+                        l.corrupted,
+                        l.lost,
+                        l.reconnects,
+                        l.latency_min_ms,
+                        l.latency_mean_ms,
+                        l.latency_max_ms
+                    );
+                }
+            }
+            if let Some(skew) = sync.table_minus_imu_s {
+                outln!(
+                    "table-to-IMU sync: table stamps {:+.3} ms relative to the IMU's (estimate)",
+                    skew * 1e3
+                );
+            }
+        }
         for w in &out.warnings {
             outln!("  warning: {w}");
         }

@@ -219,6 +219,7 @@ pub fn manifest(st: &LoadedStation, proc_: &LoadedProcedure, facts: &RunFacts) -
             failure: None,
             resumes: Vec::new(),
             changed_after_release: facts.changed_after_release.clone(),
+            sync: None,
         }),
     }
 }

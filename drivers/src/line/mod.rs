@@ -1,5 +1,5 @@
 //! A table driven over the ratecal line protocol, generic over any async byte stream (TCP,
-//! serial, an in-memory pipe). The protocol is documented in `docs/station.md`:
+//! serial, an in-memory pipe). The protocol is documented in `docs/protocols.md`:
 //!
 //! ```text
 //! -> MOVE <outer_deg> <inner_deg>            <- OK | ERR <code> <message>
@@ -7,6 +7,7 @@
 //! -> STOP <OUTER|INNER>                      <- OK | ERR ...
 //! -> OSC <OUTER|INNER> <center> <amp> <period_s>  <- OK | ERR ...
 //! -> SAFE                                    <- OK | ERR ...
+//! -> STATUS?                                 <- STATUS OK | STATUS FAULT <message>
 //! -> FEED?                                   <- F <t> <outer> <inner> <outer_rate> <inner_rate> [<ambient>]
 //!                                               ... (zero or more) then END | ERR ...
 //! ```
@@ -15,14 +16,13 @@
 //! (`InvalidCommand`); any other `ERR` is an instrument fault (`Instrument`). A silent
 //! instrument is a `Timeout`; a closed or garbled link is a `Transport` failure.
 
-use crate::station::TableSpec;
+use crate::link::ClockMap;
 use crate::{
     DriverError, DriverErrorKind, TableAxisId, TableCommand, TableDriver, TableInfo, TableSample,
 };
 use async_trait::async_trait;
 use std::time::Duration;
 use tokio::io::{AsyncBufReadExt, AsyncRead, AsyncWrite, AsyncWriteExt, BufStream};
-use tokio::net::TcpStream;
 use tokio::time::{Instant, timeout};
 
 fn axis_name(axis: TableAxisId) -> &'static str {
@@ -56,6 +56,49 @@ pub fn encode(cmd: &TableCommand) -> String {
     }
 }
 
+fn axis_of(word: Option<&str>) -> Option<TableAxisId> {
+    match word? {
+        "OUTER" => Some(TableAxisId::Outer),
+        "INNER" => Some(TableAxisId::Inner),
+        _ => None,
+    }
+}
+
+/// The command of a request line (the inverse of [`encode`]); `None` for anything else.
+pub fn decode(line: &str) -> Option<TableCommand> {
+    let mut w = line.split_whitespace();
+    let verb = w.next()?;
+    let mut num = || -> Option<f64> { w.next()?.parse().ok().filter(|v: &f64| v.is_finite()) };
+    let cmd = match verb {
+        "MOVE" => TableCommand::MoveTo {
+            outer_deg: num()?,
+            inner_deg: num()?,
+        },
+        "SAFE" => TableCommand::SafeStop,
+        _ => {
+            let mut w = line.split_whitespace().skip(1);
+            let axis = axis_of(w.next())?;
+            let mut num =
+                || -> Option<f64> { w.next()?.parse().ok().filter(|v: &f64| v.is_finite()) };
+            match verb {
+                "RATE" => TableCommand::Rate {
+                    axis,
+                    rate_dps: num()?,
+                },
+                "STOP" => TableCommand::Stop { axis },
+                "OSC" => TableCommand::Oscillate {
+                    axis,
+                    center_deg: num()?,
+                    amplitude_deg: num()?,
+                    period_s: num()?,
+                },
+                _ => return None,
+            }
+        }
+    };
+    Some(cmd)
+}
+
 fn transport(msg: impl Into<String>) -> DriverError {
     DriverError::new(DriverErrorKind::Transport, msg)
 }
@@ -77,8 +120,8 @@ pub struct LineTable<S> {
     info: TableInfo,
     timeout: Duration,
     start: Instant,
-    /// Instrument time minus local time, fixed at the first feedback sample.
-    clock_offset: Option<f64>,
+    /// Instrument time onto local time (anchored on the first feedback reply).
+    clock: ClockMap,
     broken: bool,
     line: String,
 }
@@ -91,7 +134,7 @@ impl<S: AsyncRead + AsyncWrite + Unpin + Send> LineTable<S> {
             info,
             timeout,
             start: Instant::now(),
-            clock_offset: None,
+            clock: ClockMap::default(),
             broken: false,
             line: String::new(),
         }
@@ -152,7 +195,19 @@ impl<S: AsyncRead + AsyncWrite + Unpin + Send> LineTable<S> {
         self.broken
     }
 
-    fn parse_feedback(&mut self, line: &str) -> Result<TableSample, DriverError> {
+    /// The clock map and link statistics (kept across a rebuilt link).
+    pub fn clock(&self) -> &ClockMap {
+        &self.clock
+    }
+
+    /// Takes over the clock map of an earlier link to the same table, and the host
+    /// clock's origin `start` it maps onto.
+    pub fn set_clock(&mut self, clock: ClockMap, start: Instant) {
+        self.clock = clock;
+        self.start = start;
+    }
+
+    fn parse_feedback(&self, line: &str) -> Result<TableSample, DriverError> {
         let fields: Vec<f64> = line[1..]
             .split_whitespace()
             .map(str::parse)
@@ -164,10 +219,8 @@ impl<S: AsyncRead + AsyncWrite + Unpin + Send> LineTable<S> {
                 fields.len()
             )));
         }
-        let local = self.start.elapsed().as_secs_f64();
-        let offset = *self.clock_offset.get_or_insert(fields[0] - local);
         Ok(TableSample {
-            t: fields[0] - offset,
+            t: fields[0],
             outer_deg: fields[1],
             inner_deg: fields[2],
             outer_rate_dps: fields[3],
@@ -218,78 +271,14 @@ impl<S: AsyncRead + AsyncWrite + Unpin + Send> TableDriver for LineTable<S> {
                 }
             })
             .await?;
-        out.extend(got);
+        if let Some(newest) = got.last() {
+            let host = self.start.elapsed().as_secs_f64();
+            self.clock.arrival(newest.t, host, got.len() as u64);
+        }
+        out.extend(got.into_iter().map(|s| TableSample {
+            t: self.clock.map(s.t),
+            ..s
+        }));
         Ok(())
-    }
-}
-
-/// The TCP table of a station: connects on first use and reconnects after a failure.
-#[derive(Debug)]
-pub struct TcpTable {
-    address: String,
-    info: TableInfo,
-    timeout: Duration,
-    link: Option<LineTable<TcpStream>>,
-}
-
-impl TcpTable {
-    /// A table at `address` (`host:port`); nothing is opened until the first call.
-    pub fn new(address: String, spec: TableSpec, timeout_s: f64) -> Self {
-        let info = TableInfo {
-            model: spec.model,
-            max_rate_dps: spec.max_rate.0,
-            max_accel_dps2: spec.max_accel_dps2,
-            feedback_hz: spec.feedback_rate.0,
-            simulated: false,
-        };
-        TcpTable {
-            address,
-            info,
-            timeout: Duration::from_secs_f64(timeout_s),
-            link: None,
-        }
-    }
-
-    async fn link(&mut self) -> Result<&mut LineTable<TcpStream>, DriverError> {
-        if self.link.as_ref().is_some_and(LineTable::is_broken) {
-            self.link = None;
-        }
-        if self.link.is_none() {
-            let stream = match timeout(self.timeout, TcpStream::connect(&self.address)).await {
-                Ok(Ok(s)) => s,
-                Ok(Err(e)) => {
-                    return Err(transport(format!(
-                        "cannot connect to table at {}: {e}",
-                        self.address
-                    )));
-                }
-                Err(_) => {
-                    return Err(DriverError::new(
-                        DriverErrorKind::Timeout,
-                        format!(
-                            "no connection to table at {} within {:?}",
-                            self.address, self.timeout
-                        ),
-                    ));
-                }
-            };
-            self.link = Some(LineTable::new(stream, self.info.clone(), self.timeout));
-        }
-        Ok(self.link.as_mut().expect("just connected"))
-    }
-}
-
-#[async_trait]
-impl TableDriver for TcpTable {
-    fn info(&self) -> TableInfo {
-        self.info.clone()
-    }
-
-    async fn command(&mut self, cmd: TableCommand) -> Result<(), DriverError> {
-        self.link().await?.command(cmd).await
-    }
-
-    async fn read(&mut self, out: &mut Vec<TableSample>) -> Result<(), DriverError> {
-        self.link().await?.read(out).await
     }
 }

@@ -1,6 +1,6 @@
 //! The line-protocol table driver against an in-memory fake instrument.
 
-use ratecal_drivers::tcp::LineTable;
+use ratecal_drivers::line::LineTable;
 use ratecal_drivers::{DriverErrorKind, TableAxisId, TableCommand, TableDriver, TableInfo};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -73,8 +73,9 @@ async fn commands_and_feedback_follow_the_protocol() {
         (1.5, -2.0, Some(20.1))
     );
     assert_eq!(fb[1].ambient_c, None);
-    // The instrument clock is mapped onto the station clock at the first sample.
-    assert!(fb[0].t.abs() < 1e-9 && (fb[1].t - 0.02).abs() < 1e-9);
+    // The instrument clock is mapped onto the host clock at the newest sample of the first
+    // reply (the least delayed one).
+    assert!((fb[0].t + 0.02).abs() < 1e-9 && fb[1].t.abs() < 1e-9);
 }
 
 #[tokio::test(start_paused = true)]
@@ -135,6 +136,43 @@ async fn silence_is_a_timeout() {
     );
 }
 
+#[test]
+fn requests_decode_to_the_commands_they_encode() {
+    use ratecal_drivers::line::{decode, encode};
+    for c in [
+        TableCommand::MoveTo {
+            outer_deg: 90.0,
+            inner_deg: -0.125,
+        },
+        TableCommand::Rate {
+            axis: TableAxisId::Inner,
+            rate_dps: 1e-3,
+        },
+        TableCommand::Stop {
+            axis: TableAxisId::Outer,
+        },
+        TableCommand::Oscillate {
+            axis: TableAxisId::Outer,
+            center_deg: 0.0,
+            amplitude_deg: 10.0,
+            period_s: 2.5,
+        },
+        TableCommand::SafeStop,
+    ] {
+        assert_eq!(decode(&encode(&c)), Some(c));
+    }
+    for bad in [
+        "",
+        "MOVE 1",
+        "RATE SIDEWAYS 3",
+        "OSC OUTER 1 2",
+        "MOVE nan 0",
+        "HELLO",
+    ] {
+        assert_eq!(decode(bad), None, "{bad}");
+    }
+}
+
 #[tokio::test(start_paused = true)]
 async fn a_closed_link_is_a_transport_failure() {
     let (a, b) = tokio::io::duplex(64);
@@ -157,7 +195,7 @@ async fn real_table_answers() {
             "  driver: { replay: { recording: . } }\n  model: SIM",
         );
     let s = ratecal_drivers::Station::from_yaml(&text, "hw.yaml").unwrap();
-    let mut t = ratecal_drivers::tcp::TcpTable::new("127.0.0.1:5025".into(), s.table.clone(), 2.0);
+    let (mut t, _) = ratecal_drivers::build(&s, 1).unwrap();
     let mut fb = Vec::new();
     t.read(&mut fb).await.unwrap();
 }

@@ -1,0 +1,35 @@
+//! What the hardware links report at the end of a run, as the manifest's `run.sync`.
+
+use crate::recording::{LinkRecord, SyncRecord};
+use ratecal_drivers::LinkStats;
+
+fn link_record(s: &LinkStats) -> LinkRecord {
+    LinkRecord {
+        samples: s.samples,
+        corrupted: s.corrupted,
+        lost: s.lost,
+        reconnects: s.reconnects,
+        latency_min_ms: s.latency_min_s * 1e3,
+        latency_mean_ms: s.latency_mean_s * 1e3,
+        latency_max_ms: s.latency_max_s * 1e3,
+    }
+}
+
+/// Each link's stamps run late by minus its least arrival delay (the anchor's delay above
+/// the least one seen); the table-to-IMU skew is the difference.
+pub(super) fn sync_record(table: Option<LinkStats>, imu: Option<LinkStats>) -> Option<SyncRecord> {
+    if table.is_none() && imu.is_none() {
+        return None;
+    }
+    let skew = match (&table, &imu) {
+        (Some(t), Some(i)) if t.batches > 0 && i.batches > 0 => {
+            Some(i.latency_min_s - t.latency_min_s)
+        }
+        _ => None,
+    };
+    Some(SyncRecord {
+        table_minus_imu_s: skew,
+        imu: imu.as_ref().map(link_record),
+        table: table.as_ref().map(link_record),
+    })
+}

@@ -1,0 +1,282 @@
+//! `procedures/station-check` in real time against `ratecal emulate` over loopback: a clean
+//! run over TCP and over pseudo-terminals, and one run per fault type (each ends cleanly:
+//! exit 4, the manifest says why and when, the recording is one `ratecal analyze` reads;
+//! the faults a run survives are counted in `run.sync`). The scenarios run side by side
+//! (they mostly wait on the clock), so the whole file takes about one run's time.
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+const BIN: &str = env!("CARGO_BIN_EXE_ratecal");
+
+fn repo() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A running emulator, stopped (by its own pid) when dropped.
+struct Emulator(Child);
+
+impl Drop for Emulator {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// The default station at 200 Hz with these faults, emulated; returns the emulator and
+/// the connecting station file.
+fn emulate(dir: &Path, faults: &str, pty: bool) -> (Emulator, PathBuf) {
+    let yaml = std::fs::read_to_string(repo().join("drivers/stations/default.yaml"))
+        .unwrap()
+        .replace("sample_rate: 100 Hz", "sample_rate: 200 Hz")
+        .replace("faults: []", &format!("faults:\n{faults}"));
+    let station = dir.join("emulated.yaml");
+    std::fs::write(&station, yaml).unwrap();
+    let conn = dir.join("connect.yaml");
+    let mut cmd = Command::new(BIN);
+    cmd.arg("emulate")
+        .arg("--station")
+        .arg(&station)
+        .arg("--write-station")
+        .arg(&conn)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null());
+    if pty {
+        cmd.arg("--pty");
+    }
+    let child = Emulator(cmd.spawn().unwrap());
+    let t0 = Instant::now();
+    while !conn.exists() {
+        assert!(
+            t0.elapsed() < Duration::from_secs(20),
+            "the emulator did not start"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    (child, conn)
+}
+
+/// What a scenario saw.
+struct Seen {
+    name: &'static str,
+    code: i32,
+    output: String,
+    manifest: String,
+    analyze_code: i32,
+}
+
+fn run_scenario(name: &'static str, faults: &str, pty: bool, interrupt_at: Option<f64>) -> Seen {
+    let tmp = tempfile::tempdir().unwrap();
+    let (_emu, conn) = emulate(tmp.path(), faults, pty);
+    let out = tmp.path().join("run");
+    let child = Command::new(BIN)
+        .args(["run", "procedures/station-check", "--station"])
+        .arg(&conn)
+        .arg("--out")
+        .arg(&out)
+        .current_dir(repo())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    if let Some(t) = interrupt_at {
+        std::thread::sleep(Duration::from_secs_f64(t));
+        // Twice: the second Ctrl-C must not skip the safe stop, nor change the exit code.
+        for _ in 0..2 {
+            let _ = Command::new("kill")
+                .args(["-INT", &child.id().to_string()])
+                .status();
+            std::thread::sleep(Duration::from_millis(100));
+        }
+    }
+    let o: Output = child.wait_with_output().unwrap();
+    // The journal and the report ride along with the manifest: the journal records the
+    // safe stop, the report the synchronisation.
+    let manifest = ["manifest.yaml", "journal.jsonl", "report.md"]
+        .iter()
+        .map(|f| std::fs::read_to_string(out.join(f)).unwrap_or_default())
+        .collect::<String>();
+    let analyze = Command::new(BIN)
+        .arg("analyze")
+        .arg(&out)
+        .current_dir(repo())
+        .output()
+        .unwrap();
+    Seen {
+        name,
+        code: o.status.code().unwrap_or(-1),
+        output: format!(
+            "{}{}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        ),
+        manifest,
+        analyze_code: analyze.status.code().unwrap_or(-1),
+    }
+}
+
+/// Checks one scenario; returns what is wrong.
+fn check(s: &Seen, code: i32, status: &str, needles: &[&str]) -> Vec<String> {
+    let mut wrong = Vec::new();
+    let ctx = || {
+        format!(
+            "{}\n--- output\n{}\n--- manifest\n{}",
+            s.name, s.output, s.manifest
+        )
+    };
+    if s.code != code {
+        wrong.push(format!("exit {} (expected {code}): {}", s.code, ctx()));
+    }
+    if !s.manifest.contains(&format!("status: {status}")) {
+        wrong.push(format!("status is not {status}: {}", ctx()));
+    }
+    for n in needles {
+        if *n == "corrupted > 0" {
+            let counted = s
+                .output
+                .lines()
+                .find_map(|l| l.strip_prefix("imu link: "))
+                .and_then(|l| l.split(", ").nth(1)?.split(' ').next()?.parse::<u64>().ok());
+            if counted.is_none_or(|c| c == 0) {
+                wrong.push(format!("no corrupted frame counted: {}", ctx()));
+            }
+        } else if !s.manifest.contains(n) && !s.output.contains(n) {
+            wrong.push(format!("`{n}` missing: {}", ctx()));
+        }
+    }
+    // The recording kept is one analyze reads (3: the verdict of an aborted run).
+    if ![0, 3].contains(&s.analyze_code) {
+        wrong.push(format!("analyze exit {}: {}", s.analyze_code, ctx()));
+    }
+    wrong
+}
+
+#[test]
+fn station_check_against_the_emulator() {
+    type Scenario = (
+        &'static str,
+        &'static str,
+        bool,
+        Option<f64>,
+        i32,
+        &'static str,
+        &'static [&'static str],
+    );
+    let scenarios: Vec<Scenario> = vec![
+        (
+            "clean over tcp",
+            "  []",
+            false,
+            None,
+            0,
+            "completed",
+            &["table_minus_imu_s", "imu link: ", "Table-to-IMU sync"],
+        ),
+        #[cfg(unix)]
+        (
+            "clean over pty",
+            "  []",
+            true,
+            None,
+            0,
+            "completed",
+            &["table_minus_imu_s"],
+        ),
+        (
+            "link back within its timeout, corrupted frames",
+            "  - link_drop: { at: 3 s, link: table, duration: 0.3 s }\n  - link_drop: { at: 6 s, link: imu }\n  - corrupt_frames: { at: 2 s, duration: 5 s, every: 10 }",
+            false,
+            None,
+            0,
+            "completed",
+            &["reconnects: 1", "corrupted > 0"],
+        ),
+        (
+            "imu link dropped for good",
+            "  - link_drop: { at: 3 s, link: imu, duration: 60 s }",
+            false,
+            None,
+            4,
+            "aborted",
+            &["abort:", "ABORTED"],
+        ),
+        (
+            "table link dropped for good",
+            "  - link_drop: { at: 3 s, link: table, duration: 60 s }",
+            false,
+            None,
+            4,
+            "aborted",
+            &["abort:", "\"safe_state\",\"at_rest\":false"],
+        ),
+        (
+            "imu stall",
+            "  - stall: { at: 3 s, link: imu, duration: 10 s }",
+            false,
+            None,
+            4,
+            "aborted",
+            &["abort:"],
+        ),
+        (
+            "table stall",
+            "  - stall: { at: 3 s, link: table, duration: 10 s }",
+            false,
+            None,
+            4,
+            "aborted",
+            &["abort:"],
+        ),
+        (
+            "table fault flag",
+            "  - table_fault_flag: { at: 3 s }",
+            false,
+            None,
+            4,
+            "aborted",
+            &["Instrument", "FAULT"],
+        ),
+        (
+            "imu saturation",
+            "  - imu_saturation: { at: 3 s, duration: 5 s }",
+            false,
+            None,
+            4,
+            "aborted",
+            &["imu.output abnormal"],
+        ),
+        (
+            "simulated table fault",
+            "  - table: { at: 3 s, axis: outer, mode: stuck }",
+            false,
+            None,
+            4,
+            "aborted",
+            &["abort:"],
+        ),
+        (
+            "ctrl-c twice",
+            "  []",
+            false,
+            Some(4.0),
+            4,
+            "aborted",
+            &["Ctrl-C", "\"safe_state\",\"at_rest\":true"],
+        ),
+    ];
+    let handles: Vec<_> = scenarios
+        .into_iter()
+        .map(|(name, faults, pty, int, code, status, needles)| {
+            std::thread::spawn(move || {
+                let seen = run_scenario(name, faults, pty, int);
+                check(&seen, code, status, needles)
+            })
+        })
+        .collect();
+    let wrong: Vec<String> = handles
+        .into_iter()
+        .flat_map(|h| h.join().unwrap())
+        .collect();
+    assert!(wrong.is_empty(), "{}", wrong.join("\n\n"));
+}
