@@ -53,30 +53,34 @@ pub(crate) fn locate(rec: &Recording, data: &Data, step: &Step) -> Vec<Located> 
         .collect()
 }
 
-/// Candidates that, fitted beside `effect`, leave some of its parameters undetermined:
-/// their columns are (nearly) collinear with its own, so this recording cannot tell the
-/// two apart.
+/// Candidates that, fitted beside `effect`, lose parameters to it (or it to them): their
+/// columns are (nearly) collinear with its own, so this recording cannot tell the two
+/// apart.
 pub(crate) fn confusions(data: &Data, terms: &Terms, effect: usize) -> Vec<String> {
     let lay = &data.layout;
     let work = data.working();
-    let (alone, un_alone) = fit(data, terms, &work, &work);
-    let _ = alone;
-    let mine: Vec<usize> = lay
-        .columns_of(effect)
-        .filter(|g| !un_alone.contains(g))
-        .collect();
+    let mut without = terms.clone();
+    without.effects.retain(|e| *e != effect);
+    let mine: Vec<usize> = lay.columns_of(effect).collect();
     let mut out = Vec::new();
     for e in 0..lay.effects.len() {
         if lay.effects[e].nominal() || terms.effects.contains(&e) {
             continue;
         }
-        let mut t = terms.clone();
-        t.effects.push(e);
-        let (f, un) = fit(data, &t, &work, &work);
-        let lost = mine.iter().any(|g| un.contains(g));
+        let theirs: Vec<usize> = lay.columns_of(e).collect();
+        let mut alone = without.clone();
+        alone.effects.push(e);
+        let (_, un_alone) = fit(data, &alone, &work, &work);
+        let mut both = terms.clone();
+        both.effects.push(e);
+        let (f, un) = fit(data, &both, &work, &work);
+        let lost = theirs
+            .iter()
+            .any(|g| un.contains(g) && !un_alone.contains(g));
         let tight = mine.iter().any(|&g| {
-            lay.columns_of(e)
-                .any(|h| f.estimated.contains(&h) && f.corr(g, h).abs() > 0.95)
+            theirs
+                .iter()
+                .any(|&h| f.estimated.contains(&h) && f.corr(g, h).abs() > 0.95)
         });
         if lost || tight {
             out.push(lay.effects[e].id().to_string());

@@ -160,6 +160,14 @@ pub(crate) fn solve(req: &FitRequest) -> Fit {
                 };
             }
         }
+        // The three axes of a sensor share one wander intensity: each channel alone sees
+        // too few long lags to estimate it (a zero would make slow regressors look exact).
+        for sensor in [0..3, 3..6] {
+            let q = sensor.clone().map(|c| noise[c].q).sum::<f64>() / 3.0;
+            for c in sensor {
+                noise[c].q = q;
+            }
+        }
         if pass == 1 {
             theta = full;
         }
@@ -234,7 +242,8 @@ fn stacked(facs: &[DMatrix<f64>], lay: &Layout, cols: &[usize], w: &[f64; 6]) ->
 }
 
 /// Local indices of the columns of a factor that are zero or linearly dependent on the
-/// others (after scaling every column to unit norm), in ascending order.
+/// columns before them (after scaling every column to unit norm), in ascending order. The
+/// order matters: a term added to a model is the one found wanting, never the model's own.
 fn rank_deficient(r: &DMatrix<f64>, p: usize) -> Vec<usize> {
     if p == 0 {
         return Vec::new();
@@ -247,15 +256,13 @@ fn rank_deficient(r: &DMatrix<f64>, p: usize) -> Vec<usize> {
     let good: Vec<usize> = (0..p).filter(|j| !bad.contains(j)).collect();
     if !good.is_empty() {
         let scaled = DMatrix::from_fn(p, good.len(), |i, j| rp[(i, good[j])] / norms[good[j]]);
-        let qr = scaled.col_piv_qr();
-        let rr = qr.r();
-        let mut order = DMatrix::from_fn(1, good.len(), |_, j| j as f64);
-        qr.p().permute_columns(&mut order);
+        // Without pivoting, R[i][i] is what column i adds beyond the columns before it.
+        let rr = scaled.qr().r();
         let k = rr.nrows().min(rr.ncols());
-        for i in 0..good.len() {
+        for (i, &g) in good.iter().enumerate() {
             let d = if i < k { rr[(i, i)].abs() } else { 0.0 };
             if d < 1e-7 {
-                bad.push(good[order[(0, i)] as usize]);
+                bad.push(g);
             }
         }
     }
