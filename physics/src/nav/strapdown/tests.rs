@@ -1,6 +1,6 @@
 use super::*;
 use crate::nav::sway_coefficient;
-use crate::{AxisMotion, DEG, Geometry, TableState, ideal_outputs};
+use crate::{AxisMotion, DEG, Geometry, ImuErrors, TableState};
 use std::f64::consts::PI;
 
 const SITE: Site = Site {
@@ -28,10 +28,15 @@ fn samples(
     let (mut t, mut w, mut f) = (Vec::new(), Vec::new(), Vec::new());
     for k in 0..n {
         let tk = k as f64 / hz;
-        let out = ideal_outputs(&motion(tk), geo, &SITE, lever);
+        // An error-free IMU with these sensing points: what ideal sensors read.
+        let imu = ImuErrors {
+            lever_m: *lever,
+            ..Default::default()
+        };
+        let (s, w_dps) = imu.measure(&motion(tk), geo, &SITE, imu.t_ref_c);
         t.push(tk);
-        w.push(out.w_ib_dps * DEG);
-        f.push(out.s);
+        w.push(w_dps * DEG);
+        f.push(s);
     }
     (t, w, f)
 }
