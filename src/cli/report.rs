@@ -177,12 +177,17 @@ pub fn read_run(dir: &Path) -> miette::Result<ReportInput> {
         Ok(rec) => TemperatureSeries::from_recording(&rec),
         Err(_) => TemperatureSeries::default(),
     };
+    // `ratecal explain` keeps its findings beside the run: the report gains a section.
+    let explain = std::fs::read_to_string(dir.join("explain.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok());
     Ok(ReportInput {
         results,
         manifest,
         plan,
         temperature,
         ratecal_version: env!("CARGO_PKG_VERSION").to_string(),
+        explain,
     })
 }
 

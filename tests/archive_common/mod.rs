@@ -88,6 +88,38 @@ run:
         serde_json::to_string_pretty(&results).unwrap(),
     )
     .unwrap();
+    seal(dir);
+}
+
+/// Seals the folder as `ratecal run` does last (every file's SHA-256 in seal.json).
+pub fn seal(dir: &Path) {
+    use ratecal_engine::audit::seal::{SEAL_FILE, SEAL_HASH_FILE, Seal};
+    let mut files: Vec<(String, Vec<u8>)> = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                let rel = p
+                    .strip_prefix(dir)
+                    .unwrap()
+                    .to_string_lossy()
+                    .replace('\\', "/");
+                if rel != SEAL_FILE && rel != SEAL_HASH_FILE {
+                    files.push((rel, std::fs::read(&p).unwrap()));
+                }
+            }
+        }
+    }
+    let seal = Seal::new(
+        "2026-01-01T00:00:00Z",
+        files.iter().map(|(p, b)| (p.as_str(), b.as_slice())),
+    );
+    let json = seal.to_json();
+    std::fs::write(dir.join(SEAL_FILE), &json).unwrap();
+    std::fs::write(dir.join(SEAL_HASH_FILE), Seal::hash_line(&json)).unwrap();
 }
 
 /// `ratecal ARGS` in `cwd`, with no archive from the environment.

@@ -128,6 +128,7 @@ pub fn build(input: &ReportInput) -> Value {
         "allan": results.get("allan").cloned().unwrap_or(Value::Null),
         "sync": sync,
         "warnings": results.get("warnings").cloned().unwrap_or(json!([])),
+        "explain": input.explain.clone().unwrap_or(Value::Null),
         "findings": results.get("findings").cloned().unwrap_or(json!([])),
         "summary": summary,
         "history": history(&run),

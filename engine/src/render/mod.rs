@@ -44,6 +44,8 @@ pub struct ReportInput {
     pub temperature: TemperatureSeries,
     /// Version of ratecal rendering the report.
     pub ratecal_version: String,
+    /// explain.json (`ratecal-explain/1`) when `ratecal explain` was run on the folder.
+    pub explain: Option<serde_json::Value>,
 }
 
 impl ReportInput {
@@ -63,6 +65,7 @@ impl ReportInput {
                 .map(TemperatureSeries::from_recording)
                 .unwrap_or_default(),
             ratecal_version: ratecal_version.to_string(),
+            explain: None,
         }
     }
 }

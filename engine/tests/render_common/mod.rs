@@ -44,6 +44,7 @@ pub fn full() -> ReportInput {
         plan: Some(plan),
         temperature: temperatures(),
         ratecal_version: "0.1.0".into(),
+        explain: None,
     }
 }
 
@@ -56,6 +57,7 @@ pub fn foreign() -> ReportInput {
         plan: None,
         temperature: TemperatureSeries::default(),
         ratecal_version: "0.1.0".into(),
+        explain: None,
     }
 }
 
@@ -67,5 +69,6 @@ pub fn minimal() -> ReportInput {
         plan: None,
         temperature: TemperatureSeries::default(),
         ratecal_version: "0.1.0".into(),
+        explain: None,
     }
 }
