@@ -17,16 +17,7 @@ use std::time::{Duration, Instant};
 
 fn recording() -> PathBuf {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/analyze-bench-recording");
-    if !dir.join("manifest.yaml").exists() {
-        std::fs::create_dir_all(&dir).unwrap();
-        let mut spec = fit_support::SimSpec::tactical(42);
-        spec.block_s = 900.0;
-        spec.temp = Some((22.0, 1.5));
-        // About 28 minutes in all, like the standard procedure with its settling times.
-        spec.settle_s = 40.0;
-        let windows = fit_support::standard_windows(spec.block_s);
-        fit_support::write(&dir, &spec, &windows);
-    }
+    fit_support::bench_recording(&dir);
     dir
 }
 

@@ -256,7 +256,7 @@ async fn add(archive: &Archive, runs: &[PathBuf]) -> ExitCode {
 }
 
 async fn add_one(archive: &Archive, dir: &Path) -> Result<String, Report> {
-    let report = super::verify::verify_folder(dir).map_err(|e| e.report())?;
+    let report = super::verify::verify_folder(dir, None)?;
     if !report.intact() {
         return Err(miette::miette!(
             code = "archive::altered",

@@ -4,8 +4,9 @@
 //! signed by that key. Exit 0 intact, 1 altered, unknown files, a missing or malformed seal,
 //! or not signed by the key; 2 error (no such run folder, unreadable key).
 
+use ed25519_dalek::VerifyingKey;
 use ratecal_engine::audit::seal::{SEAL_FILE, SEAL_HASH_FILE, verify_seal};
-use ratecal_engine::audit::verify::VerifyReport as SealReport;
+use ratecal_engine::audit::verify::VerifyReport;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -19,34 +20,22 @@ pub struct Args {
     key: Option<PathBuf>,
 }
 
-/// Why a folder cannot be verified at all.
-pub enum Unverifiable {
-    /// Not a run folder (no manifest, no seal).
-    NotARun(miette::Report),
-}
-
-impl Unverifiable {
-    /// The diagnostic.
-    pub fn report(self) -> miette::Report {
-        match self {
-            Unverifiable::NotARun(r) => r,
-        }
-    }
-}
-
-/// Every file of a run folder against its seal (no key): what `ratecal verify` and
-/// `ratecal archive add` check.
-pub fn verify_folder(dir: &Path) -> Result<SealReport, Unverifiable> {
+/// Every file of a run folder against its seal (and its signature with `key`): what
+/// `ratecal verify` and `ratecal archive add` check. Errs when `dir` is no run folder.
+pub fn verify_folder(
+    dir: &Path,
+    key: Option<&VerifyingKey>,
+) -> Result<VerifyReport, miette::Report> {
     let is_run = dir.join("manifest.yaml").is_file() || dir.join(SEAL_FILE).is_file();
     let files = match super::seal::folder_files(dir) {
         Ok(f) if is_run => f,
         Ok(_) | Err(_) => {
-            return Err(Unverifiable::NotARun(miette::miette!(
+            return Err(miette::miette!(
                 code = "verify::not_a_run",
                 help = "give the folder `ratecal run --out` wrote",
                 "{} is not a run folder (no manifest.yaml, no seal.json)",
                 dir.display()
-            )));
+            ));
         }
     };
     let seal = std::fs::read_to_string(dir.join(SEAL_FILE)).ok();
@@ -55,7 +44,7 @@ pub fn verify_folder(dir: &Path) -> Result<SealReport, Unverifiable> {
         seal.as_deref(),
         seal_hash.as_deref(),
         &files,
-        None,
+        key,
     ))
 }
 
@@ -74,25 +63,15 @@ pub fn main(args: Args) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let is_run = dir.join("manifest.yaml").is_file() || dir.join(SEAL_FILE).is_file();
-    let files = match super::seal::folder_files(dir) {
-        Ok(f) if is_run => f,
-        Ok(_) | Err(_) => {
-            let e = miette::miette!(
-                code = "verify::not_a_run",
-                help = "give the folder `ratecal run --out` wrote",
-                "{} is not a run folder (no manifest.yaml, no seal.json)",
-                dir.display()
-            );
+    let report = match verify_folder(dir, key.as_ref()) {
+        Ok(r) => r,
+        Err(e) => {
             errln!("{e:?}");
             return ExitCode::from(2);
         }
     };
-    let seal = std::fs::read_to_string(dir.join(SEAL_FILE)).ok();
-    let seal_hash = std::fs::read_to_string(dir.join(SEAL_HASH_FILE)).ok();
-    let report = verify_seal(seal.as_deref(), seal_hash.as_deref(), &files, key.as_ref());
     outln!("{}", report.text().trim_end());
-    if seal.is_none() {
+    if !dir.join(SEAL_FILE).is_file() {
         errln!(
             "help: a run folder is sealed when its run ends; a folder without {SEAL_FILE} \
              cannot be shown to be unaltered"

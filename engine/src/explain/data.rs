@@ -73,12 +73,6 @@ impl Data {
                 ex
             })
             .collect();
-        if std::env::var_os("RATECAL_DEBUG_EXCITATION").is_some() {
-            for (a, ex) in accs.iter().zip(&excitation) {
-                let row: Vec<String> = ex.iter().map(|v| format!("{v:.1e}")).collect();
-                eprintln!("{} {}", rec.manifest.segments[a.seg].id, row.join(" "));
-            }
-        }
         Data {
             layout,
             accs,

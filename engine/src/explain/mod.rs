@@ -23,7 +23,6 @@ pub use text::render_text;
 use crate::recording::Recording;
 use data::Data;
 use model::{Terms, fit, rms, seed_segments};
-use ratecal_physics::effects::EarthRate;
 use std::collections::BTreeMap;
 
 /// What explain may be told besides the recording.
@@ -86,21 +85,10 @@ pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Expla
         findings.push(finding(rec, &data, step, &terms));
     }
     let work = data.working();
-    let (last, _) = match steps.last() {
-        Some(s) => (s.after.clone(), ()),
-        None => (fit(&data, &start, &work, &work).0, ()),
+    let last = match steps.last() {
+        Some(s) => s.after.clone(),
+        None => fit(&data, &start, &work, &work).0,
     };
-    if std::env::var_os("RATECAL_DEBUG_EXPLAIN").is_some() {
-        eprintln!("noise {:?}\nrejected {:?}", last.noise, rejected);
-        for st in &steps {
-            eprintln!(
-                "step {} chi2 {} dof {}",
-                lay.effects[st.effect].id(),
-                st.chi2,
-                st.dof
-            );
-        }
-    }
     let floor = |cs: std::ops::Range<usize>| {
         let v: Vec<f64> = cs.map(|c| last.noise[c].sigma.powi(2)).collect();
         (v.iter().sum::<f64>() / v.len() as f64).sqrt()
@@ -156,25 +144,15 @@ fn finding(rec: &Recording, data: &Data, step: &select::Step, terms: &Terms) -> 
         };
         parameters.insert(p.name.to_string(), out);
     }
-    if fx.id() == "earth_rate" {
-        let r = lay.columns_of(step.effect);
-        let (n, u) = (r.start, r.start + 1);
-        if step.after.estimated.contains(&n) && step.after.estimated.contains(&u) {
-            let c = &step.after.cov;
-            let (lat, ulat) = EarthRate::latitude_deg(
-                step.after.theta[n],
-                step.after.theta[u],
-                [[c[(n, n)], c[(n, u)]], [c[(u, n)], c[(u, u)]]],
-            );
-            parameters.insert(
-                "latitude_deg".into(),
-                ParamOut::Estimate {
-                    value: lat,
-                    u: ulat,
-                    unit: "deg".into(),
-                },
-            );
-        }
+    if let Some((lat, ulat)) = model::latitude(data, &step.after, step.effect) {
+        parameters.insert(
+            "latitude_deg".into(),
+            ParamOut::Estimate {
+                value: lat,
+                u: ulat,
+                unit: "deg".into(),
+            },
+        );
     }
     let all: Vec<usize> = (0..data.accs.len()).collect();
     let evidence = Evidence {

@@ -188,3 +188,22 @@ pub(crate) fn seed_segments(rec: &Recording, data: &Data) -> (Vec<usize>, Vec<us
         .collect();
     (accel, gyro)
 }
+
+/// The latitude (deg, with its u) that a fit's Earth-rate components give, when the layout
+/// effect `e` is `earth_rate` and both components were estimated.
+pub(crate) fn latitude(data: &Data, fit: &Fit, e: usize) -> Option<(f64, f64)> {
+    if data.layout.effects[e].id() != "earth_rate" {
+        return None;
+    }
+    let r = data.layout.columns_of(e);
+    let (n, u) = (r.start, r.start + 1);
+    if !(fit.estimated.contains(&n) && fit.estimated.contains(&u)) {
+        return None;
+    }
+    let c = &fit.cov;
+    Some(EarthRate::latitude_deg(
+        fit.theta[n],
+        fit.theta[u],
+        [[c[(n, n)], c[(n, u)]], [c[(u, n)], c[(u, u)]]],
+    ))
+}

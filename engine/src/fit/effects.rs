@@ -7,7 +7,7 @@
 
 use super::select::Selection;
 use crate::explain::data::Data;
-use crate::explain::model::{Terms, fit};
+use crate::explain::model::{Terms, fit, latitude};
 use crate::plan::Plan;
 use crate::recording::Recording;
 use crate::results::{JointFit, Parameter, Results};
@@ -27,19 +27,14 @@ pub(crate) fn declared(plan: Option<&Plan>, with: &[String]) -> Vec<String> {
     v
 }
 
-const AXES: [&str; 3] = ["x", "y", "z"];
-
 /// The results.json key of a column: the nominal terms under their existing names.
-fn key(id: &str, param: &str, p: usize) -> String {
+fn key(id: &str, param: &str) -> String {
     match id {
         "accel_bias" => format!("accel.bias.{param}"),
         "accel_scale" => format!("accel.scale.{param}"),
         "gyro_bias" => format!("gyro.bias.{param}"),
         "gyro_scale" => format!("gyro.scale.{param}"),
-        _ => {
-            let _ = p;
-            format!("{id}.{param}")
-        }
+        _ => format!("{id}.{param}"),
     }
 }
 
@@ -153,9 +148,9 @@ pub(crate) fn apply(rec: &Recording, sel: &Selection, effects: &[String], res: &
         if fx.nominal() && !touched {
             continue;
         }
-        for (p, g) in lay.columns_of(e).enumerate() {
+        for g in lay.columns_of(e) {
             let prm = lay.param(g);
-            let mut k = key(fx.id(), prm.name, p);
+            let mut k = key(fx.id(), prm.name);
             if fx.id().ends_with("_misalignment") && nominal.contains(&fx.id()) {
                 // A full model's misalignment keeps its name: gyro.misalignment.xy.
                 let s = if fx.id().starts_with("accel") {
@@ -175,24 +170,13 @@ pub(crate) fn apply(rec: &Recording, sel: &Selection, effects: &[String], res: &
             };
             res.parameters.insert(k, value);
         }
-        if fx.id() == "earth_rate" {
-            let r = lay.columns_of(e);
-            let (n, u) = (r.start, r.start + 1);
-            if f.estimated.contains(&n) && f.estimated.contains(&u) {
-                let c = &f.cov;
-                let (lat, ul) = EarthRate::latitude_deg(
-                    f.theta[n],
-                    f.theta[u],
-                    [[c[(n, n)], c[(n, u)]], [c[(u, n)], c[(u, u)]]],
-                );
-                res.parameters.insert(
-                    "earth_rate.latitude_deg".into(),
-                    Parameter::estimate(lat, ul, "deg"),
-                );
-            }
+        if let Some((lat, ul)) = latitude(&data, &f, e) {
+            res.parameters.insert(
+                "earth_rate.latitude_deg".into(),
+                Parameter::estimate(lat, ul, "deg"),
+            );
         }
     }
-    let _ = AXES;
     let correlation = order
         .iter()
         .map(|&a| order.iter().map(|&b| f.corr(a, b)).collect())

@@ -285,31 +285,22 @@ fn moving_accel_residuals(data: &BTreeMap<usize, SegData>, out: &mut Out) {
         .quantities
         .get("accel.residual.std")
         .map_or(0.0, |q| q.0);
-    let mut worst: Option<(f64, String, usize)> = None;
-    for s in data.values() {
-        if s.kind == crate::recording::SegmentKind::Static {
-            continue;
-        }
-        for ax in 0..3 {
-            let r: Vec<f64> = (0..s.t.len())
-                .map(|i| {
-                    s.accel[ax][i] - b[ax] - (0..3).map(|j| k[(ax, j)] * s.f_ref[j][i]).sum::<f64>()
-                })
-                .collect();
-            let st = residual_stats(s, "accel", ax, &r, &s.keep_a, "m/s^2");
-            if worst.as_ref().is_none_or(|w| st.mean.abs() > w.0) {
-                worst = Some((st.mean.abs(), s.id.clone(), ax));
-            }
-            out.residuals.push(st);
-        }
-    }
-    if let Some((m, id, ax)) = worst
+    let moving: Vec<&SegData> = data
+        .values()
+        .filter(|s| s.kind != crate::recording::SegmentKind::Static)
+        .collect();
+    let first = out.residuals.len();
+    accel::model_residuals(&moving, accel::Sensor::Accel, &k, &b, out);
+    let worst = out.residuals[first..]
+        .iter()
+        .max_by(|a, b| a.mean.abs().total_cmp(&b.mean.abs()))
+        .map(|r| (r.mean.abs(), r.segment.clone(), r.channel.clone()));
+    if let Some((m, id, axis)) = worst
         && noise > 0.0
         && m > 5.0 * noise
     {
         out.warnings.push(format!(
-                "accelerometer {} residual on moving segment {id}: mean {m:.4} m/s^2, {:.0} times the static noise: the model leaves out motion-dependent physics (a lever arm, a time offset); see `ratecal explain` or `--with lever_arm`",
-                AXES[ax],
+                "accelerometer {axis} residual on moving segment {id}: mean {m:.4} m/s^2, {:.0} times the static noise: the model leaves out motion-dependent physics (a lever arm, a time offset); see `ratecal explain` or `--with lever_arm`",
                 m / noise
             ));
     }

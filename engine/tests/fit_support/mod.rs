@@ -262,3 +262,18 @@ pub fn truth_params(truth: &Truth) -> Vec<(String, f64)> {
     }
     v
 }
+
+/// The benches' recording (`benches/analyze.rs`, `benches/explain.rs`): the standard plan
+/// with a 15-minute gyro block at 100 Hz, about 28 minutes with settling, written to `dir`
+/// once.
+pub fn bench_recording(dir: &Path) {
+    if !dir.join("manifest.yaml").exists() {
+        std::fs::create_dir_all(dir).unwrap();
+        let mut spec = SimSpec::tactical(42);
+        spec.block_s = 900.0;
+        spec.temp = Some((22.0, 1.5));
+        spec.settle_s = 40.0;
+        let windows = standard_windows(spec.block_s);
+        write(dir, &spec, &windows);
+    }
+}

@@ -54,19 +54,12 @@ impl Effect for Bias {
     }
 
     fn sensors(&self) -> &'static [Sensor] {
-        match self.sensor {
-            Sensor::Accel => &[Sensor::Accel],
-            Sensor::Gyro => &[Sensor::Gyro],
-        }
+        self.sensor.only()
     }
 
     fn regressors(&self, _s: &Signals, out: &mut [Partials]) {
         for (i, p) in out.iter_mut().enumerate() {
-            *p = Partials::default();
-            match self.sensor {
-                Sensor::Accel => p.accel[i] = 1.0,
-                Sensor::Gyro => p.gyro[i] = 1.0,
-            }
+            *p = Partials::axis(self.sensor, i, 1.0);
         }
     }
 }

@@ -55,12 +55,7 @@ impl Effect for GSensitivity {
     fn regressors(&self, s: &Signals, out: &mut [Partials]) {
         for i in 0..3 {
             for j in 0..3 {
-                let mut v = crate::Vec3::zeros();
-                v[i] = s.f_b[j] / s.g;
-                out[3 * i + j] = Partials {
-                    gyro: v,
-                    ..Default::default()
-                };
+                out[3 * i + j] = Partials::axis(Sensor::Gyro, i, s.f_b[j] / s.g);
             }
         }
     }

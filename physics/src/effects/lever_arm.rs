@@ -88,12 +88,7 @@ impl Effect for LeverArm {
         let m = s.lever_matrix();
         for i in 0..3 {
             for j in 0..3 {
-                let mut a = crate::Vec3::zeros();
-                a[i] = m[(i, j)] * 1e-3;
-                out[3 * i + j] = Partials {
-                    accel: a,
-                    ..Default::default()
-                };
+                out[3 * i + j] = Partials::axis(Sensor::Accel, i, m[(i, j)] * 1e-3);
             }
         }
     }

@@ -109,10 +109,7 @@ impl Effect for Misalignment {
     }
 
     fn sensors(&self) -> &'static [Sensor] {
-        match self.sensor {
-            Sensor::Accel => &[Sensor::Accel],
-            Sensor::Gyro => &[Sensor::Gyro],
-        }
+        self.sensor.only()
     }
 
     fn regressors(&self, s: &Signals, out: &mut [Partials]) {
@@ -121,18 +118,7 @@ impl Effect for Misalignment {
             Sensor::Gyro => s.w_ib_dps(),
         };
         for (k, &(i, j)) in PAIRS.iter().enumerate() {
-            let mut v = crate::Vec3::zeros();
-            v[i] = input[j] * 1e-3;
-            out[k] = match self.sensor {
-                Sensor::Accel => Partials {
-                    accel: v,
-                    ..Default::default()
-                },
-                Sensor::Gyro => Partials {
-                    gyro: v,
-                    ..Default::default()
-                },
-            };
+            out[k] = Partials::axis(self.sensor, i, input[j] * 1e-3);
         }
     }
 }

@@ -37,6 +37,14 @@ pub enum Sensor {
 }
 
 impl Sensor {
+    /// This sensor alone: the `sensors()` of an effect on one triad.
+    pub fn only(self) -> &'static [Sensor] {
+        match self {
+            Sensor::Accel => &[Sensor::Accel],
+            Sensor::Gyro => &[Sensor::Gyro],
+        }
+    }
+
     /// `accel` or `gyro`.
     pub fn name(self) -> &'static str {
         match self {
@@ -70,6 +78,16 @@ pub struct Partials {
 }
 
 impl Partials {
+    /// `v` on axis `i` of `sensor`, zero on every other output.
+    pub fn axis(sensor: Sensor, i: usize, v: f64) -> Self {
+        let mut p = Partials::default();
+        match sensor {
+            Sensor::Accel => p.accel[i] = v,
+            Sensor::Gyro => p.gyro[i] = v,
+        }
+        p
+    }
+
     /// The partials of one sensor.
     pub fn of(&self, s: Sensor) -> &Vec3 {
         match s {

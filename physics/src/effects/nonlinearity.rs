@@ -43,8 +43,7 @@ impl Effect for Nonlinearity {
     fn regressors(&self, s: &Signals, out: &mut [Partials]) {
         let w = s.w_ib_dps();
         for (i, p) in out.iter_mut().enumerate() {
-            *p = Partials::default();
-            p.gyro[i] = 1e-6 * w[i] * w[i].abs();
+            *p = Partials::axis(Sensor::Gyro, i, 1e-6 * w[i] * w[i].abs());
         }
     }
 }

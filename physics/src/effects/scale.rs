@@ -64,10 +64,7 @@ impl Effect for Scale {
     }
 
     fn sensors(&self) -> &'static [Sensor] {
-        match self.sensor {
-            Sensor::Accel => &[Sensor::Accel],
-            Sensor::Gyro => &[Sensor::Gyro],
-        }
+        self.sensor.only()
     }
 
     fn regressors(&self, s: &Signals, out: &mut [Partials]) {
@@ -76,11 +73,7 @@ impl Effect for Scale {
             Sensor::Gyro => s.w_ib_dps(),
         };
         for (i, p) in out.iter_mut().enumerate() {
-            *p = Partials::default();
-            match self.sensor {
-                Sensor::Accel => p.accel[i] = input[i] * 1e-6,
-                Sensor::Gyro => p.gyro[i] = input[i] * 1e-6,
-            }
+            *p = Partials::axis(self.sensor, i, input[i] * 1e-6);
         }
     }
 }

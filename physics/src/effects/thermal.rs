@@ -48,19 +48,12 @@ impl Effect for ThermalDrift {
     }
 
     fn sensors(&self) -> &'static [Sensor] {
-        match self.sensor {
-            Sensor::Accel => &[Sensor::Accel],
-            Sensor::Gyro => &[Sensor::Gyro],
-        }
+        self.sensor.only()
     }
 
     fn regressors(&self, s: &Signals, out: &mut [Partials]) {
         for (i, p) in out.iter_mut().enumerate() {
-            *p = Partials::default();
-            match self.sensor {
-                Sensor::Accel => p.accel[i] = s.dtemp_c,
-                Sensor::Gyro => p.gyro[i] = s.dtemp_c,
-            }
+            *p = Partials::axis(self.sensor, i, s.dtemp_c);
         }
     }
 }

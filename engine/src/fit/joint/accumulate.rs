@@ -3,11 +3,11 @@
 //! output channel the triangular factor of `[X y]` plus one-second block sums.
 
 use super::tri::Tri;
-use super::{CHANNELS, Layout, channel};
+use super::{Layout, channel};
 use crate::fit::prep::unwrap;
 use crate::recording::Recording;
 use nalgebra::{DMatrix, DVector};
-use ratecal_physics::effects::{Partials, Sensor, Signals};
+use ratecal_physics::effects::{Partials, Signals};
 use ratecal_physics::{AxisMotion, DEG, Geometry, Site, TableState};
 
 /// Length of the blocks kept for the noise analysis, s.
@@ -207,13 +207,4 @@ pub(crate) fn seg_rss(acc: &SegAcc, layout: &Layout, c: usize, theta: &DVector<f
     }
     v[cols.len()] = -1.0;
     (&acc.r[c] * v).norm_squared()
-}
-
-/// The sensor of a channel name, for messages.
-#[allow(dead_code)]
-pub(crate) fn sensor_of(name: &str) -> Option<Sensor> {
-    CHANNELS
-        .iter()
-        .position(|c| *c == name)
-        .map(|c| channel(c).0)
 }

@@ -31,7 +31,7 @@ pub(crate) fn estimate(accs: &[&SegAcc], c: usize, theta_c: &[f64], sigma: f64) 
     // White-equivalent variance of a sample from adjacent one-second blocks.
     let (mut num, mut den) = (0.0, 0.0);
     // Random walk from ten-second groups.
-    let mut groups: Vec<(f64, f64, usize, f64)> = Vec::new(); // (segment-local order, t, n, mean)
+    let mut groups: Vec<(f64, f64, usize, f64)> = Vec::new(); // (span in blocks, t, n, mean)
     let mut pairs = Vec::new();
     for acc in accs {
         let means: Vec<(f64, usize, f64)> = acc
