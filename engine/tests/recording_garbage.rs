@@ -850,3 +850,25 @@ fn a_segment_past_the_last_feedback_sample_is_analysed() {
     let rec = r.expect("the segment is within half a step of the table stream");
     let _ = ratecal_engine::fit::analyze(&rec, None);
 }
+
+/// CR CR LF line endings (found by the property above): the message and the snippet name
+/// the same line, and the column of the bad cell.
+#[test]
+fn cr_cr_lf_rows_are_located_on_their_line() {
+    let [manifest, imu, table] = valid();
+    let text = String::from_utf8(imu).unwrap();
+    let mut rows: Vec<String> = text.lines().map(String::from).collect();
+    let mut cells: Vec<&str> = rows[10].split(',').collect();
+    cells[3] = "0x10";
+    rows[10] = cells.join(",");
+    let imu = rows.join("\r\r\n").into_bytes();
+    assert!(check(&[Some(&manifest), Some(&imu), Some(&table)]).is_none());
+    let tmp = tempfile::tempdir().unwrap();
+    for (name, bytes) in FILES.iter().zip([&manifest, &imu, &table]) {
+        std::fs::write(tmp.path().join(name), bytes).unwrap();
+    }
+    let e = recording::read(tmp.path()).unwrap_err();
+    // Ten CR CR LF endings before the row: each a lone CR and a CRLF, twenty breaks.
+    let shown = render(&e);
+    assert!(shown.contains("imu.csv:21:17"), "{shown}");
+}

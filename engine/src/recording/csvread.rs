@@ -119,15 +119,16 @@ fn io(file: &str, e: csv::Error) -> RecordingError {
     }
 }
 
-/// Where the record at `pos` starts. After a CRLF the csv crate puts a record's start on
-/// the LF (and counts its line one short): the row starts after it.
+/// Where the record at `pos` starts. After a CR the csv crate may put a record's start on
+/// the line-end bytes that follow it (the LF of a CRLF, the second CR of a CR CR LF): a
+/// record never starts with a line end, so the row starts after them.
 fn record_start(bytes: &[u8], pos: &csv::Position) -> usize {
     let start = (pos.byte() as usize).min(bytes.len());
-    if bytes.get(start) == Some(&b'\n') && start > 0 && bytes[start - 1] == b'\r' {
-        start + 1
-    } else {
-        start
-    }
+    start
+        + bytes[start..]
+            .iter()
+            .take_while(|&&b| b == b'\r' || b == b'\n')
+            .count()
 }
 
 /// Byte offset where data row `row` starts (0-based, after the header, blank lines not
