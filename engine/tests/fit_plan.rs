@@ -91,6 +91,9 @@ fn plan() -> Plan {
                 DecisionRule::GuardBanded,
             ),
             accept("accel.residual.std", q(0.0001, "g"), DecisionRule::Simple),
+            accept("gyro.noise.std", q(0.005, "deg/s"), DecisionRule::Simple),
+            accept("accel.residual.mean", q(0.0005, "g"), DecisionRule::Simple),
+            accept("gyro.residual.mean", q(0.01, "deg/s"), DecisionRule::Simple),
             Accept {
                 over_runs: Some(3),
                 ..accept("repeatability.cv", q(1.0, "%"), DecisionRule::Simple)
@@ -139,6 +142,19 @@ fn plan_fits_and_acceptance() {
     assert_eq!(by("accel.residual.std <= 0.0001 g").verdict, Verdict::Fail);
     assert_eq!(by("gyro.residual.std").verdict, Verdict::Pass);
     assert_eq!(by("gyro.residual.std").rule, "guard_banded");
+    // The gyro block's white noise is 0.004 deg/s per sample (the walk adds next to nothing
+    // over a sample).
+    let n = by("gyro.noise.std");
+    assert_eq!(n.verdict, Verdict::Pass);
+    assert!((n.value.unwrap() / 0.004 - 1.0).abs() < 0.05, "{n:?}");
+    // The model fits its segments: the largest mean residual is a few u of the noise mean
+    // of a segment (0.0025 m/s^2 / sqrt(1000) = 8e-5 m/s^2; 0.004 deg/s / sqrt(1000)).
+    let m = by("accel.residual.mean");
+    assert_eq!(m.verdict, Verdict::Pass);
+    assert!(m.value.unwrap() < 4.0 * 8e-5 / 9.80665, "{m:?}");
+    let g = by("gyro.residual.mean");
+    assert_eq!(g.verdict, Verdict::Pass);
+    assert!(g.value.unwrap() < 0.002, "{g:?}");
     let r = by("repeatability.cv");
     assert_eq!(r.verdict, Verdict::Deferred);
     assert!(r.reason.as_ref().unwrap().contains("3 runs"));

@@ -4,9 +4,9 @@
 //! be evaluated, an aborted run), 1 input error, 2 usage error (clap).
 
 use super::procedure::{self, FsSources};
-use ratecal_engine::check::{CheckOptions, NoImports, check_text};
+use ratecal_engine::check::{CheckOptions, check_text};
 use ratecal_engine::fit::{self, Options};
-use ratecal_engine::plan::{Plan, segment_matches};
+use ratecal_engine::plan::Plan;
 use ratecal_engine::recording;
 use ratecal_engine::results::{Parameter, Results, RunVerdict};
 use std::path::PathBuf;
@@ -21,8 +21,7 @@ pub struct Args {
     runs: Vec<PathBuf>,
     /// Procedure whose fit statements and thresholds apply: a file, a procedure folder
     /// (newest version) or folder@version; a checked plan as JSON is accepted too. Without
-    /// it, the bundled standard procedure's fits apply when its segment names match,
-    /// otherwise segments are chosen by kind.
+    /// it, segments are chosen by kind (spec/recording-format.md) and no thresholds apply.
     #[arg(long, value_name = "PROCEDURE")]
     procedure: Option<PathBuf>,
     /// Catalogue effects to add to whatever model applies, fitted jointly with it
@@ -55,7 +54,6 @@ pub fn main(args: Args) -> ExitCode {
             }
         }
     }
-    let plan = plan.or_else(|| default_plan(&runs[0].1));
     let opts = Options {
         with: args.with.clone(),
         ..Options::default()
@@ -123,48 +121,20 @@ pub(crate) fn load_plan(
     }
 }
 
-/// The bundled standard procedure, shipped in the binary.
-const STANDARD: &str = include_str!("../../procedures/imu-2d-standard/1.0.0.rcal");
-
-/// Without `--procedure`: the standard procedure's fit statements (not its thresholds, which
-/// the user did not ask for) when its segment patterns match the recording; otherwise the
-/// analysis picks segments by kind.
-fn default_plan(rec: &recording::Recording) -> Option<Plan> {
-    let mut plan = check_text(
-        "imu-2d-standard/1.0.0.rcal",
-        STANDARD,
-        &NoImports,
-        &CheckOptions::default(),
-    )
-    .ok()?
-    .plan;
-    let ids: Vec<&str> = rec
-        .manifest
-        .segments
-        .iter()
-        .map(|s| s.id.as_str())
-        .collect();
-    let all_match = plan.fits.iter().all(|f| {
-        f.segments
-            .iter()
-            .any(|p| ids.iter().any(|id| segment_matches(p, id)))
-    });
-    if !all_match {
-        return None;
-    }
-    plan.accepts.clear();
-    plan.verifications.clear();
-    plan.environment.clear();
-    Some(plan)
-}
-
 /// A short human summary on standard error (standard output may hold the JSON).
 fn summary(r: &Results) {
-    errln!(
-        "ratecal analyze: {} ({})",
-        r.recording.paths.join(", "),
-        r.model.selection
-    );
+    errln!("ratecal analyze: {}", r.recording.paths.join(", "));
+    match &r.model.procedure {
+        Some(p) if r.model.selection == "procedure" => {
+            errln!("model: the fits of procedure {} {}", p.name, p.version)
+        }
+        _ => errln!(
+            "model: segments chosen by kind (no --procedure: no procedure's fits or thresholds apply)"
+        ),
+    }
+    for f in &r.model.fits {
+        errln!("  fit {f}");
+    }
     for (name, p) in &r.parameters {
         match p {
             Parameter::Estimate { value, u, unit } => {

@@ -1,7 +1,7 @@
 //! The recording accumulated once for every model explain will try: every segment, every
 //! registry effect's columns, and which segments are held out.
 
-use crate::fit::joint::{Layout, SegAcc, accumulate};
+use crate::fit::joint::{Layout, SegAcc, accumulate, excitation};
 use crate::fit::prep::geometries;
 use crate::recording::{Recording, SegmentKind};
 use ratecal_physics::REGISTRY;
@@ -36,7 +36,7 @@ impl Data {
         let segs = &rec.manifest.segments;
         let accs: Vec<SegAcc> = (0..segs.len())
             .into_par_iter()
-            .map(|i| accumulate(rec, i, &geos[i], &layout, t_ref))
+            .map(|i| accumulate(rec, i, &geos[i], &layout, t_ref, None))
             .filter(|a| a.n > 0)
             .collect();
         let longest = accs
@@ -59,20 +59,7 @@ impl Data {
             }
         }
         held.sort_unstable();
-        let excitation: Vec<Vec<f64>> = accs
-            .iter()
-            .map(|a| {
-                let mut ex = vec![0.0f64; layout.cols.len()];
-                for c in 0..6 {
-                    let r = &a.r[c];
-                    for (k, &g) in layout.by_channel[c].iter().enumerate() {
-                        let rms = r.column(k).norm() / (a.n.max(1) as f64).sqrt();
-                        ex[g] = ex[g].max(rms);
-                    }
-                }
-                ex
-            })
-            .collect();
+        let excitation: Vec<Vec<f64>> = accs.iter().map(|a| excitation(&layout, a)).collect();
         Data {
             layout,
             accs,

@@ -56,6 +56,7 @@ pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Expla
             .iter()
             .map(|(id, v)| (index(id), v.clone()))
             .collect(),
+        skip: Vec::new(),
     };
     let all: Vec<usize> = (0..data.accs.len()).collect();
     let (sa, sg) = seed_segments(rec, &data);
@@ -73,7 +74,7 @@ pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Expla
     let (nom, _) = fit(&data, &start, &sa, &sg);
     let nominal_out = Nominal {
         model: nominal.name.clone(),
-        terms: start.names(&data),
+        terms: start.names(&data.layout),
         rms: rms(&data, &nom, &all),
         holdout_rms: rms(&data, &nom, &data.held),
     };
@@ -94,7 +95,7 @@ pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Expla
         (v.iter().sum::<f64>() / v.len() as f64).sqrt()
     };
     let final_ = Final {
-        terms: terms.names(&data),
+        terms: terms.names(&data.layout),
         rms: rms(&data, &last, &all),
         holdout_rms: rms(&data, &last, &data.held),
         noise_floor: Rms {

@@ -2,10 +2,11 @@
 //! of segments per sensor.
 
 use super::data::Data;
-use crate::fit::joint::{Fit, FitRequest, rss_on, solve};
+pub(crate) use crate::fit::joint::Terms;
+use crate::fit::joint::{Fit, fit_terms, latitude_of, rss_on};
 use crate::plan::Plan;
 use crate::recording::{Recording, SegmentKind};
-use ratecal_physics::effects::{EarthRate, Sensor};
+use ratecal_physics::effects::EarthRate;
 
 /// The model a recording is compared with before anything is added.
 #[derive(Debug, Clone)]
@@ -72,87 +73,22 @@ impl NominalModel {
     }
 }
 
-/// Effects (layout indices) and fixed values of a model under test.
-#[derive(Debug, Clone, Default)]
-pub(crate) struct Terms {
-    /// Fitted effects.
-    pub effects: Vec<usize>,
-    /// Effects held at values.
-    pub fixed: Vec<(usize, Vec<f64>)>,
-}
-
-impl Terms {
-    /// The ids, fitted then fixed (`earth_rate (fixed)`).
-    pub(crate) fn names(&self, data: &Data) -> Vec<String> {
-        let l = &data.layout;
-        self.effects
-            .iter()
-            .map(|&e| l.effects[e].id().to_string())
-            .chain(
-                self.fixed
-                    .iter()
-                    .map(|(e, _)| format!("{} (fixed)", l.effects[*e].id())),
-            )
-            .collect()
-    }
-}
-
-/// Fits terms over segments (indices into `data.accs`) for each sensor. Columns of an
-/// effect that these segments barely excite (below a thousandth of the effect's most
-/// excited column) are left out as unobservable.
+/// Fits terms over segments (indices into `data.accs`) for each sensor (see
+/// [`fit_terms`]).
 pub(crate) fn fit(
     data: &Data,
     terms: &Terms,
     accel: &[usize],
     gyro: &[usize],
 ) -> (Fit, Vec<usize>) {
-    let lay = &data.layout;
-    let mut cols = Vec::new();
-    let mut weak = Vec::new();
-    for &e in &terms.effects {
-        let range = lay.columns_of(e);
-        let ex: Vec<f64> = range
-            .clone()
-            .map(|g| {
-                let sensors = lay.effects[e].sensors();
-                let mut m = 0.0f64;
-                for (s, segs) in [(Sensor::Accel, accel), (Sensor::Gyro, gyro)] {
-                    if sensors.contains(&s) {
-                        for &i in segs {
-                            m = m.max(data.excitation[i][g]);
-                        }
-                    }
-                }
-                m
-            })
-            .collect();
-        let top = ex.iter().copied().fold(0.0, f64::max);
-        for (k, g) in range.enumerate() {
-            if ex[k] > 1e-3 * top && top > 0.0 {
-                cols.push(g);
-            } else {
-                weak.push(g);
-            }
-        }
-    }
-    let mut fixed = Vec::new();
-    for (e, v) in &terms.fixed {
-        for (k, g) in lay.columns_of(*e).enumerate() {
-            fixed.push((g, v[k]));
-        }
-    }
-    let req = FitRequest {
-        layout: lay,
-        cols,
-        fixed,
-        accel: accel.iter().map(|&i| &data.accs[i]).collect(),
-        gyro: gyro.iter().map(|&i| &data.accs[i]).collect(),
-    };
-    let f = solve(&req);
-    let mut unobs = f.unobservable.clone();
-    unobs.extend(weak);
-    unobs.sort_unstable();
-    (f, unobs)
+    fit_terms(
+        &data.layout,
+        &data.accs,
+        &data.excitation,
+        terms,
+        accel,
+        gyro,
+    )
 }
 
 /// Residual RMS per sensor of a fit over segments.
@@ -192,18 +128,5 @@ pub(crate) fn seed_segments(rec: &Recording, data: &Data) -> (Vec<usize>, Vec<us
 /// The latitude (deg, with its u) that a fit's Earth-rate components give, when the layout
 /// effect `e` is `earth_rate` and both components were estimated.
 pub(crate) fn latitude(data: &Data, fit: &Fit, e: usize) -> Option<(f64, f64)> {
-    if data.layout.effects[e].id() != "earth_rate" {
-        return None;
-    }
-    let r = data.layout.columns_of(e);
-    let (n, u) = (r.start, r.start + 1);
-    if !(fit.estimated.contains(&n) && fit.estimated.contains(&u)) {
-        return None;
-    }
-    let c = &fit.cov;
-    Some(EarthRate::latitude_deg(
-        fit.theta[n],
-        fit.theta[u],
-        [[c[(n, n)], c[(n, u)]], [c[(u, n)], c[(u, u)]]],
-    ))
+    latitude_of(&data.layout, fit, e)
 }

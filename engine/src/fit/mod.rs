@@ -11,17 +11,15 @@
 mod accel;
 mod accept;
 mod allan;
-mod effects;
 mod gyro;
 pub(crate) mod joint;
-mod lsq;
 mod measured;
+mod models;
 pub(crate) mod prep;
 mod repeat;
 mod select;
 pub mod size_effect;
 mod stats;
-mod temp;
 
 pub use allan::overlapping_adev;
 pub use measured::format_measured;
@@ -151,75 +149,13 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
 
     // The Allan curves (the costly part of the noise analysis) run beside the fits.
     let allan_block = sel.allan.and_then(|i| data.get(&i));
-    let (curves, ()) = rayon::join(
+    let declared = models::declared(plan, &opts.with);
+    let temperature = sel.temp_requested && temperature_varies(rec, &sel.temp_segments);
+    let (curves, fitted) = rayon::join(
         || allan_block.map(allan::curves),
-        || {
-            if let Some((ix, full)) = &sel.accel {
-                let segs = get(ix);
-                if *full {
-                    accel::fit_full(&segs, &mut out)
-                } else {
-                    accel::fit_seed(&segs, &mut out)
-                }
-            }
-            let block = sel.gyro_bias.and_then(|i| data.get(&i));
-            if let Some((ix, axes)) = &sel.gyro_scale {
-                let segs = get(ix);
-                let mut scratch = Out::default();
-                let first = match block {
-                    // A first bias for the scale fit: the block mean of output minus reference.
-                    Some(b) => fallback_bias(&[b]),
-                    None => fallback_bias(&segs),
-                };
-                let s = gyro::fit_scale(&segs, axes, first, &mut scratch);
-                let b = match block {
-                    Some(b) => gyro::fit_bias(b, &s, &mut out),
-                    None => {
-                        out.warnings.push(
-                            "no static block for the gyro bias: bias taken from the rate points"
-                                .into(),
-                        );
-                        first
-                    }
-                };
-                gyro::fit_scale(&segs, axes, b, &mut out);
-            } else if let Some(b) = block {
-                let (bias, _) = gyro::fit_bias(b, &Vec3::zeros(), &mut out);
-                out.gyro_model = Some((Mat3::identity(), bias));
-            }
-            // The bias wanders: as a constant of the IMU over this run, its uncertainty holds the
-            // random walk over half the run, at the rate the segment means show.
-            if let (Some(_), Some(model)) = (block, &out.gyro_model) {
-                let all: Vec<&SegData> = data.values().collect();
-                let q2 = gyro::wander_q2(&all, model);
-                let half_run = (rec.imu.t[rec.imu.t.len() - 1] - rec.imu.t[0]) / 2.0;
-                for (ax, name) in AXES.iter().enumerate() {
-                    if let Some(Parameter::Estimate { u, .. }) =
-                        out.params.get_mut(&format!("gyro.bias.{name}"))
-                    {
-                        *u = (*u * *u + q2[ax] * half_run).sqrt();
-                    }
-                }
-            }
-            if let Some(ix) = &sel.gyro_full {
-                gyro::fit_full(&get(ix), &mut out);
-            }
-        },
+        || models::fit(rec, &sel, &data, &declared, temperature, &mut out),
     );
-    if let Some(ix) = &sel.size_effect {
-        size_effect::fit(rec, ix, &mut out);
-    }
-    let allan = allan_block
-        .zip(curves.as_ref())
-        .and_then(|(b, c)| allan::analyse(b, c, &mut out));
-    let static_segs: Vec<&SegData> = get(&sel.temp_segments);
-    let temp_done = match (&out.accel_model, &out.gyro_model) {
-        (Some(a), Some(g)) if !static_segs.is_empty() => {
-            temp::fit(&static_segs, &a.clone(), &g.clone(), &mut out)
-        }
-        _ => false,
-    };
-    if sel.temp_requested && !temp_done {
+    if sel.temp_requested && !temperature {
         for s in ["accel", "gyro"] {
             for ax in AXES {
                 out.unobservable(
@@ -229,6 +165,32 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
             }
         }
     }
+    out.accel_model = fitted.accel;
+    out.gyro_model = fitted.gyro;
+    if let Some((k, b)) = out.accel_model {
+        let segs = sel.accel.as_ref().map_or(Vec::new(), |(ix, _)| get(ix));
+        let worst = accel::model_residuals(&segs, accel::Sensor::Accel, &k, &b, &mut out);
+        out.quantities.insert("accel.residual.std".into(), worst);
+    }
+    if let Some((k, b)) = out.gyro_model {
+        let mut ix: Vec<usize> = sel.gyro_bias.iter().copied().collect();
+        ix.extend(sel.gyro_scale.iter().flat_map(|(s, _)| s.iter().copied()));
+        ix.extend(sel.gyro_full.iter().flatten().copied());
+        ix.sort_unstable();
+        ix.dedup();
+        let worst = accel::model_residuals(&get(&ix), accel::Sensor::Gyro, &k, &b, &mut out);
+        out.quantities.insert("gyro.residual.std".into(), worst);
+        if let Some(block) = sel.gyro_bias.and_then(|i| data.get(&i)) {
+            gyro::block_noise(block, &k, &b, &mut out);
+        }
+    }
+    residual_means(&mut out);
+    if let Some(ix) = &sel.size_effect {
+        size_effect::fit(rec, ix, &mut out);
+    }
+    let allan = allan_block
+        .zip(curves.as_ref())
+        .and_then(|(b, c)| allan::analyse(b, c, &mut out));
     // results.json always lists bias and scale of both sensors on every axis.
     for s in ["accel", "gyro"] {
         for what in ["bias", "scale"] {
@@ -262,10 +224,10 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
         fits: Default::default(),
         size_effect: out.size_effect.take(),
     };
-    let declared = effects::declared(plan, &opts.with);
-    if !declared.is_empty() {
-        effects::apply(rec, &sel, &declared, &mut res);
-    }
+    res.fits = fitted.fits;
+    res.model
+        .fits
+        .extend(fitted.description.iter().map(|d| format!("joint {d}")));
     res.acceptance = accept::evaluate(plan, &res, &out.quantities, &wh, &mut out.warnings);
     let mut w = std::mem::take(&mut out.warnings);
     w.append(&mut res.warnings);
@@ -306,19 +268,38 @@ fn moving_accel_residuals(data: &BTreeMap<usize, SegData>, out: &mut Out) {
     }
 }
 
-/// Bias per axis from the rate points when there is no static block: mean of output minus
-/// reference, uncertainty from their scatter.
-fn fallback_bias(segs: &[&SegData]) -> (Vec3, Vec3) {
-    let mut b = Vec3::zeros();
-    let mut u = Vec3::zeros();
-    for ax in 0..3 {
-        let d: Vec<f64> = segs
-            .iter()
-            .map(|s| stats::mean(&s.gyro[ax], &s.keep_g) - stats::mean(&s.w_ref[ax], &s.keep_g))
-            .collect();
-        let keep = vec![true; d.len()];
-        b[ax] = stats::mean(&d, &keep);
-        u[ax] = stats::std(&d, &keep) / (d.len().max(1) as f64).sqrt();
+/// Whether the IMU temperature varied by at least 1 degC across these segments: a thermal
+/// coefficient needs a temperature span to be determined.
+fn temperature_varies(rec: &Recording, segs: &[usize]) -> bool {
+    let Some(temp) = &rec.imu.temp else {
+        return false;
+    };
+    let (mut lo, mut hi) = (f64::MAX, f64::MIN);
+    for &i in segs {
+        let s = &rec.manifest.segments[i];
+        let a = rec.imu.t.partition_point(|&t| t < s.t_start);
+        let b = rec.imu.t.partition_point(|&t| t <= s.t_end);
+        for &v in temp[a..b].iter().filter(|v| v.is_finite()) {
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
     }
-    (b, u)
+    hi - lo >= 1.0
+}
+
+/// The largest mean residual of each sensor's fitted segments (`accel.residual.mean`,
+/// `gyro.residual.mean`), with the standard uncertainty of that mean from its samples.
+fn residual_means(out: &mut Out) {
+    for sensor in ["accel", "gyro"] {
+        let worst = out
+            .residuals
+            .iter()
+            .filter(|r| r.sensor == sensor && r.n > 1)
+            .max_by(|a, b| a.mean.abs().total_cmp(&b.mean.abs()));
+        if let Some(r) = worst {
+            let u = r.std / (r.n as f64).sqrt();
+            out.quantities
+                .insert(format!("{sensor}.residual.mean"), (r.mean.abs(), u));
+        }
+    }
 }

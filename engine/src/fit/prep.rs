@@ -22,8 +22,6 @@ pub(crate) struct SegData<'a> {
     pub accel: [Cow<'a, [f64]>; 3],
     /// Gyro outputs per axis, deg/s (filtered if asked).
     pub gyro: [Cow<'a, [f64]>; 3],
-    /// IMU temperature, degC.
-    pub temp: Option<&'a [f64]>,
     /// Specific-force reference at the IMU reference point, body axes, m/s^2.
     pub f_ref: [Vec<f64>; 3],
     /// Inertial-rate reference (table motion and Earth rate), body axes, deg/s.
@@ -97,7 +95,6 @@ pub(crate) fn prepare<'a>(
     let n = t.len();
     let accel = std::array::from_fn(|k| Cow::Borrowed(&imu.accel[k][a..b]));
     let gyro = std::array::from_fn(|k| Cow::Borrowed(&imu.gyro[k][a..b]));
-    let temp = imu.temp.as_ref().map(|tc| &tc[a..b]);
     // The references of a long segment are computed in two halves side by side.
     let mut f_ref: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; n]);
     let mut w_ref: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; n]);
@@ -142,7 +139,6 @@ pub(crate) fn prepare<'a>(
         t,
         accel,
         gyro,
-        temp,
         f_ref,
         w_ref,
         keep_a: vec![true; n],
@@ -249,11 +245,30 @@ fn references(
         .min(tab.t.len().saturating_sub(2));
     // Table state at feedback sample `j` plus a fraction `w` of the step to `j + 1`,
     // through the kinematics of ratecal_physics: (specific force m/s^2, rate deg/s).
+    // A static segment is at rest and a rate segment turns at its mean feedback rate: the
+    // feedback's rate ripple is the table's measurement noise, not motion the IMU felt (it
+    // would otherwise leak into the gyro residuals and their noise figures).
+    let steady = match kind {
+        SegmentKind::Static => Some((0.0, 0.0)),
+        SegmentKind::Rate => {
+            let lo = tab.t.partition_point(|&x| x < t[0]);
+            let hi = tab.t.partition_point(|&x| x <= t[t.len() - 1]);
+            let m = |r: &[f64]| {
+                if hi > lo {
+                    r[lo..hi].iter().sum::<f64>() / (hi - lo) as f64
+                } else {
+                    0.0
+                }
+            };
+            Some((m(&tab.outer_rate), m(&tab.inner_rate)))
+        }
+        SegmentKind::Oscillation => None,
+    };
     let refs_at = |j: usize, w: f64| -> (Vec3, Vec3) {
         let j = j.min(tab.t.len() - 2);
         let lerp = |x: &[f64]| x[j] + w * (x[j + 1] - x[j]);
         let lerp_angle = |x: &[f64]| x[j] + w * unwrap(x[j + 1] - x[j]);
-        let state = TableState {
+        let mut state = TableState {
             outer: AxisMotion {
                 angle: lerp_angle(&tab.outer) * DEG,
                 rate: lerp(&tab.outer_rate) * DEG,
@@ -265,6 +280,12 @@ fn references(
                 accel: rate_derivative(&tab.t, &tab.inner_rate, j) * DEG,
             },
         };
+        if let Some((ro, ri)) = steady {
+            state.outer.rate = ro * DEG;
+            state.inner.rate = ri * DEG;
+            state.outer.accel = 0.0;
+            state.inner.accel = 0.0;
+        }
         let snap = state.snapshot(geo, &site);
         (snap.f_b(&Vec3::zeros()), snap.w_ib() / DEG)
     };

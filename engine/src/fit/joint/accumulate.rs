@@ -4,7 +4,7 @@
 
 use super::tri::Tri;
 use super::{Layout, channel};
-use crate::fit::prep::unwrap;
+use crate::fit::prep::{SegData, unwrap};
 use crate::recording::Recording;
 use nalgebra::{DMatrix, DVector};
 use ratecal_physics::effects::{Partials, Signals};
@@ -69,18 +69,22 @@ pub(crate) fn state_at(rec: &Recording, j: &mut usize, t: f64) -> TableState {
 }
 
 /// Accumulates one segment. `t_ref_c` is the temperature the thermal terms refer to.
+/// With the segment's preprocessed data (`prepped`, over the same samples), the outputs
+/// are its (filtered) ones and the samples it flagged as outliers are left out.
 pub(crate) fn accumulate(
     rec: &Recording,
     seg: usize,
     geo: &Geometry,
     layout: &Layout,
     t_ref_c: f64,
+    prepped: Option<&SegData>,
 ) -> SegAcc {
     let s = &rec.manifest.segments[seg];
     let site: Site = rec.manifest.station.site;
     let imu = &rec.imu;
     let a = imu.t.partition_point(|&t| t < s.t_start);
     let b = imu.t.partition_point(|&t| t <= s.t_end);
+    let prepped = prepped.filter(|d| d.t.len() == b - a);
     let ncol = layout.cols.len();
     let at_rest = s.kind == crate::recording::SegmentKind::Static;
     let steady = s.kind == crate::recording::SegmentKind::Rate;
@@ -126,6 +130,9 @@ pub(crate) fn accumulate(
         if rec.table.t.len() < 2 {
             break;
         }
+        if prepped.is_some_and(|d| !d.keep_a[i - a] || !d.keep_g[i - a]) {
+            continue;
+        }
         if t > block_end && cur.n > 0 {
             cur.t /= cur.n as f64;
             blocks.push(std::mem::replace(&mut cur, new_block(layout)));
@@ -156,13 +163,23 @@ pub(crate) fn accumulate(
         }
         let base_a = sig.f_b;
         let base_g = sig.w_b_dps();
+        let (acc, gyr) = match prepped {
+            Some(d) => (
+                [d.accel[0][i - a], d.accel[1][i - a], d.accel[2][i - a]],
+                [d.gyro[0][i - a], d.gyro[1][i - a], d.gyro[2][i - a]],
+            ),
+            None => (
+                [imu.accel[0][i], imu.accel[1][i], imu.accel[2][i]],
+                [imu.gyro[0][i], imu.gyro[1][i], imu.gyro[2][i]],
+            ),
+        };
         let out = [
-            imu.accel[0][i] - base_a.x,
-            imu.accel[1][i] - base_a.y,
-            imu.accel[2][i] - base_a.z,
-            imu.gyro[0][i] - base_g.x,
-            imu.gyro[1][i] - base_g.y,
-            imu.gyro[2][i] - base_g.z,
+            acc[0] - base_a.x,
+            acc[1] - base_a.y,
+            acc[2] - base_a.z,
+            gyr[0] - base_g.x,
+            gyr[1] - base_g.y,
+            gyr[2] - base_g.z,
         ];
         if out.iter().any(|v| !v.is_finite()) {
             continue;

@@ -10,10 +10,12 @@
 mod accumulate;
 mod noise;
 mod solve;
+mod terms;
 mod tri;
 
 pub(crate) use accumulate::{SegAcc, accumulate, seg_rss};
 pub(crate) use solve::{Fit, FitRequest, rss_on, solve};
+pub(crate) use terms::{Terms, excitation, excites, fit_terms, latitude_of};
 
 use ratecal_physics::effects::{Effect, Param, Sensor};
 
