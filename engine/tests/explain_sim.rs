@@ -6,54 +6,18 @@
 
 mod common;
 
-use common::manifest;
 use common::plans::standard;
-use ratecal_drivers::{DEFAULT_STATION_YAML, Station, registry};
+use common::sim::{record, station};
+use ratecal_drivers::Station;
 use ratecal_engine::explain::{self, Explanation, NominalModel, Options, ParamOut};
-use ratecal_engine::recording::{self, Columns, RecordingWriter};
-use ratecal_engine::run::{NoProgress, RunOptions, RunStatus, execute};
+use ratecal_engine::recording;
 
 /// The configured white noise of the default station at 100 Hz: accel m/s^2, gyro deg/s.
 const NOISE: (f64, f64) = (2e-6 * 9.80665 * 10.0, 0.003);
 
-fn station(effects: &str, extra: &[(&str, &str)]) -> Station {
-    let mut yaml = DEFAULT_STATION_YAML.replace("effects: {}", &format!("effects: {effects}"));
-    for (a, b) in extra {
-        assert!(yaml.contains(a), "{a}");
-        yaml = yaml.replace(a, b);
-    }
-    Station::from_yaml(&yaml, "test.yaml").unwrap()
-}
-
 fn simulate(st: &Station, seed: u64) -> Explanation {
-    let rt = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .start_paused(true)
-        .build()
-        .unwrap();
     let dir = tempfile::tempdir().unwrap();
-    rt.block_on(async {
-        let (mut table, mut imu) = registry::build(st, seed).unwrap();
-        let plan = standard(600.0);
-        let mut m = manifest(&plan.name);
-        m.station.site = st.site();
-        let cols = Columns {
-            imu_temp: true,
-            ambient: true,
-        };
-        let mut w = RecordingWriter::create(dir.path(), m, cols).unwrap();
-        let out = execute(
-            &plan,
-            table.as_mut(),
-            imu.as_mut(),
-            &mut w,
-            &mut NoProgress,
-            &RunOptions::default(),
-        )
-        .await
-        .unwrap();
-        assert_eq!(out.status, RunStatus::Completed, "{:?}", out.warnings);
-    });
+    record(st, &standard(600.0), seed, dir.path());
     let rec = recording::read(dir.path()).unwrap();
     explain::explain(&rec, &NominalModel::seed(), &Options::default())
 }

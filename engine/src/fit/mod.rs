@@ -8,7 +8,6 @@
 // Numeric loops index several parallel channel arrays at once; iterators would hide that.
 #![allow(clippy::needless_range_loop)]
 
-mod accel;
 mod accept;
 mod allan;
 mod gyro;
@@ -17,6 +16,7 @@ mod measured;
 mod models;
 pub(crate) mod prep;
 mod repeat;
+mod residuals;
 mod select;
 pub mod size_effect;
 mod stats;
@@ -80,27 +80,6 @@ impl Out {
     }
 }
 
-pub(crate) fn residual_stats(
-    s: &SegData,
-    sensor: &str,
-    ax: usize,
-    r: &[f64],
-    keep: &[bool],
-    unit: &str,
-) -> ResidualStats {
-    let (mean, std, slope) = stats::mean_std_slope(s.t, r, keep);
-    ResidualStats {
-        segment: s.id.clone(),
-        sensor: sensor.into(),
-        channel: AXES[ax].into(),
-        n: keep.iter().filter(|k| **k).count(),
-        mean,
-        std,
-        slope_per_s: slope,
-        unit: unit.into(),
-    }
-}
-
 /// Analyses one recording with default options.
 pub fn analyze(rec: &Recording, plan: Option<&Plan>) -> Results {
     analyze_with(rec, plan, &Options::default())
@@ -145,7 +124,6 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
         sync.max_angle_error_deg = sync.max_angle_error_deg.max(sy.max_angle_error_deg);
         out.warnings.extend(w);
     }
-    let get = |ix: &[usize]| ix.iter().filter_map(|i| data.get(i)).collect::<Vec<_>>();
 
     // The Allan curves (the costly part of the noise analysis) run beside the fits.
     let allan_block = sel.allan.and_then(|i| data.get(&i));
@@ -167,24 +145,22 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
     }
     out.accel_model = fitted.accel;
     out.gyro_model = fitted.gyro;
-    if let Some((k, b)) = out.accel_model {
-        let segs = sel.accel.as_ref().map_or(Vec::new(), |(ix, _)| get(ix));
-        let worst = accel::model_residuals(&segs, accel::Sensor::Accel, &k, &b, &mut out);
-        out.quantities.insert("accel.residual.std".into(), worst);
-    }
-    if let Some((k, b)) = out.gyro_model {
-        let mut ix: Vec<usize> = sel.gyro_bias.iter().copied().collect();
-        ix.extend(sel.gyro_scale.iter().flat_map(|(s, _)| s.iter().copied()));
-        ix.extend(sel.gyro_full.iter().flatten().copied());
-        ix.sort_unstable();
-        ix.dedup();
-        let worst = accel::model_residuals(&get(&ix), accel::Sensor::Gyro, &k, &b, &mut out);
-        out.quantities.insert("gyro.residual.std".into(), worst);
-        if let Some(block) = sel.gyro_bias.and_then(|i| data.get(&i)) {
-            gyro::block_noise(block, &k, &b, &mut out);
+    for sensor in ["accel", "gyro"] {
+        let fitted_of = fitted
+            .residuals
+            .iter()
+            .filter(|(r, f)| *f && r.sensor == sensor);
+        if fitted_of.clone().next().is_some() {
+            let worst = residuals::pooled_worst(fitted_of.map(|(r, _)| r));
+            out.quantities
+                .insert(format!("{sensor}.residual.std"), worst);
         }
     }
-    residual_means(&mut out);
+    residual_means(&fitted.residuals, &mut out);
+    if let (Some((k, b)), Some(block)) = (out.gyro_model, sel.gyro_bias.and_then(|i| data.get(&i)))
+    {
+        gyro::block_noise(block, &k, &b, &mut out);
+    }
     if let Some(ix) = &sel.size_effect {
         size_effect::fit(rec, ix, &mut out);
     }
@@ -202,7 +178,8 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
             }
         }
     }
-    moving_accel_residuals(&data, &mut out);
+    out.residuals = fitted.residuals.iter().map(|(r, _)| r.clone()).collect();
+    unfitted_residual_warnings(&fitted.residuals, &mut out);
     let (verification, wh) = accept::verify(&sel, &data, &out, rec);
     let segments = sel.uses(rec, &data);
     let mut res = Results {
@@ -236,35 +213,42 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
     res
 }
 
-/// The accelerometer model checked on the segments that move (rate and oscillation),
-/// which the seed model does not fit: their residuals join the results, and a mean
-/// residual far beyond the static fit's noise is a warning (a lever arm, a time offset).
-fn moving_accel_residuals(data: &BTreeMap<usize, SegData>, out: &mut Out) {
-    let Some((k, b)) = out.accel_model else {
-        return;
-    };
-    let noise = out
-        .quantities
-        .get("accel.residual.std")
-        .map_or(0.0, |q| q.0);
-    let moving: Vec<&SegData> = data
-        .values()
-        .filter(|s| s.kind != crate::recording::SegmentKind::Static)
-        .collect();
-    let first = out.residuals.len();
-    accel::model_residuals(&moving, accel::Sensor::Accel, &k, &b, out);
-    let worst = out.residuals[first..]
-        .iter()
-        .max_by(|a, b| a.mean.abs().total_cmp(&b.mean.abs()))
-        .map(|r| (r.mean.abs(), r.segment.clone(), r.channel.clone()));
-    if let Some((m, id, axis)) = worst
-        && noise > 0.0
-        && m > 5.0 * noise
-    {
-        out.warnings.push(format!(
-                "accelerometer {axis} residual on moving segment {id}: mean {m:.4} m/s^2, {:.0} times the static noise: the model leaves out motion-dependent physics (a lever arm, a time offset); see `ratecal explain` or `--with lever_arm`",
-                m / noise
+/// Residuals on the segments a sensor's fit did not use (the accelerometers on the rate
+/// and oscillation segments of the seed model): a mean residual far beyond the fit's noise
+/// is a warning that the model leaves physics out.
+fn unfitted_residual_warnings(rs: &[(ResidualStats, bool)], out: &mut Out) {
+    for (sensor, physics) in [
+        (
+            "accel",
+            "motion-dependent physics (a lever arm, a time offset)",
+        ),
+        (
+            "gyro",
+            "attitude-dependent physics (g-sensitivity, a misalignment)",
+        ),
+    ] {
+        let noise = out
+            .quantities
+            .get(&format!("{sensor}.residual.std"))
+            .map_or(0.0, |q| q.0);
+        let worst = rs
+            .iter()
+            .filter(|(r, fitted)| !*fitted && r.sensor == sensor && r.n > 1)
+            .map(|(r, _)| r)
+            .max_by(|a, b| a.mean.abs().total_cmp(&b.mean.abs()));
+        if let Some(r) = worst
+            && noise > 0.0
+            && r.mean.abs() > 5.0 * noise
+        {
+            out.warnings.push(format!(
+                "{sensor} {} residual on segment {}, which the {sensor} fit does not use: mean {:.4} {}, {:.0} times the fit's noise: the model leaves out {physics}; see `ratecal explain`",
+                r.channel,
+                r.segment,
+                r.mean,
+                r.unit,
+                r.mean.abs() / noise
             ));
+        }
     }
 }
 
@@ -289,12 +273,12 @@ fn temperature_varies(rec: &Recording, segs: &[usize]) -> bool {
 
 /// The largest mean residual of each sensor's fitted segments (`accel.residual.mean`,
 /// `gyro.residual.mean`), with the standard uncertainty of that mean from its samples.
-fn residual_means(out: &mut Out) {
+fn residual_means(rs: &[(ResidualStats, bool)], out: &mut Out) {
     for sensor in ["accel", "gyro"] {
-        let worst = out
-            .residuals
+        let worst = rs
             .iter()
-            .filter(|r| r.sensor == sensor && r.n > 1)
+            .filter(|(r, fitted)| *fitted && r.sensor == sensor && r.n > 1)
+            .map(|(r, _)| r)
             .max_by(|a, b| a.mean.abs().total_cmp(&b.mean.abs()));
         if let Some(r) = worst {
             let u = r.std / (r.n as f64).sqrt();

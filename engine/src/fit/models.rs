@@ -13,7 +13,7 @@ use super::prep::{SegData, geometries};
 use super::select::Selection;
 use super::{AXES, Out};
 use crate::recording::Recording;
-use crate::results::{JointFit, Parameter};
+use crate::results::{JointFit, Parameter, ResidualStats};
 use ratecal_physics::effects::{EarthRate, Sensor};
 use ratecal_physics::{Mat3, Vec3};
 use std::collections::BTreeMap;
@@ -27,6 +27,9 @@ pub(crate) struct Models {
     pub fits: BTreeMap<String, JointFit>,
     /// One line per sensor: which terms over how many segments.
     pub description: Vec<String>,
+    /// Residuals of every segment with samples, per channel of each fitted sensor, and
+    /// whether the sensor's fit used the segment.
+    pub residuals: Vec<(ResidualStats, bool)>,
 }
 
 /// The effects a plan's fits and the command line declare (registry ids, deduplicated).
@@ -161,7 +164,8 @@ pub(crate) fn fit(
             .extend((0..3).filter(|a| !axes.contains(a)).map(|a| first + a));
     }
 
-    // The segments the fits use; with added effects, every segment (to widen to).
+    // The segments the fits use; every segment is accumulated (an added effect widens a
+    // fit to those exciting it, and residuals are reported on all of them).
     let accel_segs: Vec<usize> = sel.accel.iter().flat_map(|(ix, _)| ix.clone()).collect();
     let gyro_segs: Vec<usize> = sel
         .gyro_bias
@@ -171,9 +175,7 @@ pub(crate) fn fit(
         .chain(sel.gyro_full.iter().flat_map(|ix| ix.iter().copied()))
         .collect();
     let nseg = rec.manifest.segments.len();
-    let wanted: Vec<usize> = (0..nseg)
-        .filter(|i| !added.is_empty() || accel_segs.contains(i) || gyro_segs.contains(i))
-        .collect();
+    let wanted: Vec<usize> = (0..nseg).collect();
     let geos = geometries(rec);
     let t_ref = mean_temperature(rec);
     let accs: Vec<SegAcc> = {
@@ -288,6 +290,18 @@ pub(crate) fn fit(
                     .collect(),
             },
         );
+    }
+    for (si, set) in [&accel, &gyro].into_iter().enumerate() {
+        if set.is_empty() {
+            continue;
+        }
+        for (i, a) in accs.iter().enumerate() {
+            let id = &rec.manifest.segments[a.seg].id;
+            for c in 3 * si..3 * si + 3 {
+                let r = super::residuals::of_segment(a, &layout, c, &f.theta, id);
+                models.residuals.push((r, set.contains(&i)));
+            }
+        }
     }
     if sel.accel.is_some() {
         models.accel = Some((k[0], b[0]));

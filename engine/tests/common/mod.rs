@@ -5,6 +5,7 @@
 #![allow(dead_code)]
 
 pub mod plans;
+pub mod sim;
 
 use async_trait::async_trait;
 use ratecal_drivers::{
