@@ -79,17 +79,28 @@ pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Expla
         holdout_rms: rms(&data, &nom, &data.held),
     };
     let (steps, rejected) = select::forward(&data, &start, opts.alpha);
-    let mut findings = Vec::new();
-    let mut terms = start.clone();
-    for step in &steps {
-        terms.effects.push(step.effect);
-        findings.push(finding(rec, &data, step, &terms));
-    }
     let work = data.working();
     let last = match steps.last() {
         Some(s) => s.after.clone(),
         None => fit(&data, &start, &work, &work).0,
     };
+    // Each finding's parameters come from the final model, every finding in it: an effect
+    // found early was fitted without those found after it, which its estimate may have
+    // partly absorbed.
+    let mut findings = Vec::new();
+    let mut terms = start.clone();
+    for step in &steps {
+        terms.effects.push(step.effect);
+    }
+    for step in &steps {
+        findings.push(finding(
+            rec,
+            &data,
+            step,
+            &terms,
+            steps.last().unwrap_or(step),
+        ));
+    }
     let floor = |cs: std::ops::Range<usize>| {
         let v: Vec<f64> = cs.map(|c| last.noise[c].sigma.powi(2)).collect();
         (v.iter().sum::<f64>() / v.len() as f64).sqrt()
@@ -124,28 +135,34 @@ pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Expla
     }
 }
 
-/// One accepted step as a finding.
-fn finding(rec: &Recording, data: &Data, step: &select::Step, terms: &Terms) -> Finding {
+/// One accepted step as a finding, its parameters from the final step's model.
+fn finding(
+    rec: &Recording,
+    data: &Data,
+    step: &select::Step,
+    terms: &Terms,
+    last: &select::Step,
+) -> Finding {
     let lay = &data.layout;
     let fx = lay.effects[step.effect];
     let mut parameters = BTreeMap::new();
     for g in lay.columns_of(step.effect) {
         let p = lay.param(g);
-        let out = if step.unobservable.contains(&g) {
+        let out = if last.unobservable.contains(&g) || !last.after.estimated.contains(&g) {
             ParamOut::Unobservable {
                 observable: false,
                 needs: p.needs.to_string(),
             }
         } else {
             ParamOut::Estimate {
-                value: step.after.theta[g],
-                u: step.after.u(g),
+                value: last.after.theta[g],
+                u: last.after.u(g),
                 unit: p.unit.to_string(),
             }
         };
         parameters.insert(p.name.to_string(), out);
     }
-    if let Some((lat, ulat)) = model::latitude(data, &step.after, step.effect) {
+    if let Some((lat, ulat)) = model::latitude(data, &last.after, step.effect) {
         parameters.insert(
             "latitude_deg".into(),
             ParamOut::Estimate {

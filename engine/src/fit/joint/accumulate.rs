@@ -4,7 +4,7 @@
 
 use super::tri::Tri;
 use super::{Layout, channel};
-use crate::fit::prep::{SegData, unwrap};
+use crate::fit::prep::{SegData, steady_rates, unwrap};
 use crate::recording::Recording;
 use nalgebra::{DMatrix, DVector};
 use ratecal_physics::effects::{Partials, Signals};
@@ -89,19 +89,8 @@ pub(crate) fn accumulate(
     let at_rest = s.kind == crate::recording::SegmentKind::Static;
     let steady = s.kind == crate::recording::SegmentKind::Rate;
     let mean_rates = {
-        let tab = &rec.table;
-        let (lo, hi) = (
-            tab.t.partition_point(|&x| x < s.t_start),
-            tab.t.partition_point(|&x| x <= s.t_end),
-        );
-        let m = |r: &[f64]| {
-            if hi > lo {
-                r[lo..hi].iter().sum::<f64>() / (hi - lo) as f64 * DEG
-            } else {
-                0.0
-            }
-        };
-        (m(&tab.outer_rate), m(&tab.inner_rate))
+        let (o, i) = steady_rates(rec, s.t_start, s.t_end);
+        (o * DEG, i * DEG)
     };
     let mut tris: Vec<Tri> = (0..6)
         .map(|c| Tri::new(layout.by_channel[c].len() + 1))
@@ -149,7 +138,7 @@ pub(crate) fn accumulate(
         } else if steady {
             // A rate segment turns at a constant rate: the feedback's ripple is measurement
             // noise (differencing it would invent angular accelerations), so the rates are
-            // the segment's mean feedback rates.
+            // the segment's steady rates from the angle feedback.
             state.outer.rate = mean_rates.0;
             state.inner.rate = mean_rates.1;
             state.outer.accel = 0.0;
