@@ -20,6 +20,7 @@ pub use model::NominalModel;
 pub use output::{Evidence, Explanation, FORMAT, Final, Finding, Located, Nominal, ParamOut, Rms};
 pub use text::render_text;
 
+use crate::fit::joint::Fit;
 use crate::recording::Recording;
 use data::Data;
 use model::{Terms, fit, rms, seed_segments};
@@ -84,23 +85,19 @@ pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Expla
         Some(s) => s.after.clone(),
         None => fit(&data, &start, &work, &work).0,
     };
-    // Each finding's parameters come from the final model, every finding in it: an effect
-    // found early was fitted without those found after it, which its estimate may have
-    // partly absorbed.
-    let mut findings = Vec::new();
+    // Each finding's parameters come from the final model, every finding in it, refitted
+    // on every segment once the held-out ones have confirmed it: an effect found early was
+    // fitted without those found after it (which its estimate may have partly absorbed),
+    // and a held-out segment may be the one that determines a parameter best.
     let mut terms = start.clone();
     for step in &steps {
         terms.effects.push(step.effect);
     }
-    for step in &steps {
-        findings.push(finding(
-            rec,
-            &data,
-            step,
-            &terms,
-            steps.last().unwrap_or(step),
-        ));
-    }
+    let whole = fit(&data, &terms, &all, &all);
+    let findings: Vec<Finding> = steps
+        .iter()
+        .map(|step| finding(rec, &data, step, &terms, &whole))
+        .collect();
     let floor = |cs: std::ops::Range<usize>| {
         let v: Vec<f64> = cs.map(|c| last.noise[c].sigma.powi(2)).collect();
         (v.iter().sum::<f64>() / v.len() as f64).sqrt()
@@ -135,34 +132,36 @@ pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Expla
     }
 }
 
-/// One accepted step as a finding, its parameters from the final step's model.
+/// One accepted step as a finding, its parameters from the final model fitted on every
+/// segment (`whole`: the fit and its unobservable columns).
 fn finding(
     rec: &Recording,
     data: &Data,
     step: &select::Step,
     terms: &Terms,
-    last: &select::Step,
+    whole: &(Fit, Vec<usize>),
 ) -> Finding {
+    let (last, unobservable) = whole;
     let lay = &data.layout;
     let fx = lay.effects[step.effect];
     let mut parameters = BTreeMap::new();
     for g in lay.columns_of(step.effect) {
         let p = lay.param(g);
-        let out = if last.unobservable.contains(&g) || !last.after.estimated.contains(&g) {
+        let out = if unobservable.contains(&g) || !last.estimated.contains(&g) {
             ParamOut::Unobservable {
                 observable: false,
                 needs: p.needs.to_string(),
             }
         } else {
             ParamOut::Estimate {
-                value: last.after.theta[g],
-                u: last.after.u(g),
+                value: last.theta[g],
+                u: last.u(g),
                 unit: p.unit.to_string(),
             }
         };
         parameters.insert(p.name.to_string(), out);
     }
-    if let Some((lat, ulat)) = model::latitude(data, &last.after, step.effect) {
+    if let Some((lat, ulat)) = model::latitude(data, last, step.effect) {
         parameters.insert(
             "latitude_deg".into(),
             ParamOut::Estimate {

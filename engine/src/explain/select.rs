@@ -17,8 +17,6 @@ pub(crate) struct Step {
     pub before: Fit,
     /// After.
     pub after: Fit,
-    /// Unobservable columns after.
-    pub unobservable: Vec<usize>,
     /// Wald statistic, dof, p-value, threshold.
     pub chi2: f64,
     /// Degrees of freedom.
@@ -160,7 +158,7 @@ pub(crate) fn forward(
                 break;
             }
         }
-        let (e, f, un, chi2, dof, p, _) = tried.into_iter().nth(b).expect("chosen");
+        let (e, f, _, chi2, dof, p, _) = tried.into_iter().nth(b).expect("chosen");
         last_p.remove(lay.effects[e].id());
         terms.effects.push(e);
         candidates.retain(|x| *x != e);
@@ -168,7 +166,6 @@ pub(crate) fn forward(
             effect: e,
             before: base,
             after: f,
-            unobservable: un,
             chi2,
             dof,
             p,
