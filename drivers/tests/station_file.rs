@@ -67,17 +67,29 @@ fn effects_map_to_the_physics_parameters() {
         "  effects:\n    accel_misalignment: { xy_mrad: 0.4, zx_mrad: -0.6 }\n    gyro_misalignment: { yz_mrad: 2 }\n    g_sensitivity: { xz_dps_per_g: 0.0098156 }\n    lever_arm: { ryx_mm: 3 }\n    time_offset: { tau_ms: 2.5 }\n    gyro_scale_nonlinearity: { y: 7 }",
     );
     let s = Station::from_yaml(&text, "lab.yaml").unwrap();
-    let e = s.imu_errors();
-    assert!((e.k_a[(0, 0)] - (1.0 + 350e-6)).abs() < 1e-15);
-    assert!((e.k_a[(0, 1)] - 0.4e-3).abs() < 1e-15);
-    assert!((e.k_a[(2, 0)] + 0.6e-3).abs() < 1e-15);
-    assert!((e.k_g[(1, 2)] - 2e-3).abs() < 1e-15);
-    assert!((e.k_g[(1, 1)] - (1.0 - 310e-6)).abs() < 1e-15);
-    // 0.0098156 deg/s per g at g = 9.8156 m/s^2 is 0.001 deg/s per m/s^2.
-    assert!((e.g_sens[(0, 2)] - 0.001).abs() < 1e-15);
-    assert!((e.lever_m[(1, 0)] - 0.003).abs() < 1e-15);
-    assert!((e.b_a[0] - 1.2e-3 * 9.80665).abs() < 1e-15);
-    assert_eq!(e.gyro_nonlinearity[1], 7.0);
+    let m = s.imu_model();
+    let of = |id: &str| {
+        m.terms
+            .iter()
+            .find(|t| t.effect.id() == id)
+            .unwrap_or_else(|| panic!("{id} missing"))
+            .values
+            .clone()
+    };
+    // Each effect's values in the registry's parameter order, in its units.
+    assert_eq!(of("accel_misalignment"), [0.4, 0.0, 0.0, 0.0, -0.6, 0.0]);
+    assert_eq!(of("gyro_misalignment"), [0.0, 0.0, 0.0, 2.0, 0.0, 0.0]);
+    assert_eq!(of("g_sensitivity")[2], 0.0098156);
+    assert_eq!(of("lever_arm")[3], 3.0);
+    assert_eq!(of("time_offset"), [2.5]);
+    assert_eq!(of("gyro_scale_nonlinearity"), [0.0, 7.0, 0.0]);
+    assert!((of("accel_scale")[0] - 350.0).abs() < 1e-9);
+    assert!((of("gyro_scale")[1] + 310.0).abs() < 1e-9);
+    assert!((of("accel_bias")[0] - 1.2e-3 * 9.80665).abs() < 1e-15);
+    // The Earth's rate at the site is a term like the others; effects absent are absent.
+    assert_eq!(of("earth_rate"), ratecal_physics::effects::EarthRate::values(55.70));
+    assert!(m.terms.iter().all(|t| t.effect.id() != "lever_arm" || t.values.len() == 9));
+    assert!(m.terms.iter().all(|t| t.effect.id() != "gyro_thermal_drift"));
     assert_eq!(s.time_offset_s(), 0.0025);
 }
 

@@ -65,7 +65,7 @@ impl SimImu {
         let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x1_0000_0000_1A1B);
         // Start the Gauss-Markov bias in its stationary distribution.
         let gm = [0; 3].map(|_| sigma_gm * rng.sample::<f64, _>(StandardNormal));
-        let model = station.imu_errors().model(&station.site());
+        let model = station.imu_model();
         let dropouts = station
             .faults
             .iter()

@@ -2,6 +2,7 @@
 //! carry their units (see `quantity.rs`), keys whose name ends in a unit take bare numbers.
 //! `docs/station.md` documents every key.
 
+use super::effects::EffectsSpec;
 use super::quantity::{
     Accel, AccelDensity, Angle, Freq, Pressure, Rate, RateDensity, RateWalk, Ratio, Rotation, Temp,
     TempDelta, TempRate, Time, UnitVec, damping, finite, fraction, frequency, positive,
@@ -263,90 +264,6 @@ pub struct ImuSpec {
 fn default_correlation() -> Time {
     Time(300.0)
 }
-
-/// Catalogue effects (spec/physics.md), canonical ids and parameter names.
-/// `earth_rate` is not here: the Earth's rotation is site physics, always on.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct EffectsSpec {
-    /// Accelerometer sensing points, mm.
-    #[serde(default)]
-    pub lever_arm: LeverArmSpec,
-    /// IMU stamps lag the motion.
-    #[serde(default)]
-    pub time_offset: TimeOffsetSpec,
-    /// Off-diagonal terms of `K_a`, mrad.
-    #[serde(default)]
-    pub accel_misalignment: MisalignmentSpec,
-    /// Off-diagonal terms of `K_g`, mrad.
-    #[serde(default)]
-    pub gyro_misalignment: MisalignmentSpec,
-    /// Gyro sensitivity to specific force, deg/s per g.
-    #[serde(default)]
-    pub g_sensitivity: GSensitivitySpec,
-    /// Gyro bias per degC, deg/s per degC.
-    #[serde(default)]
-    pub gyro_thermal_drift: AxesSpec,
-    /// Accelerometer bias per degC, m/s^2 per degC.
-    #[serde(default)]
-    pub accel_thermal_drift: AxesSpec,
-    /// Gyro scale nonlinearity, ppm per deg/s.
-    #[serde(default)]
-    pub gyro_scale_nonlinearity: AxesSpec,
-}
-
-macro_rules! params {
-    ($(#[$doc:meta])* $name:ident { $($field:ident),* }) => {
-        $(#[$doc])*
-        #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-        #[serde(deny_unknown_fields)]
-        pub struct $name {
-            $(
-                #[doc = concat!("`", stringify!($field), "` (see spec/physics.md).")]
-                #[serde(default, deserialize_with = "finite")]
-                pub $field: f64,
-            )*
-        }
-    };
-}
-
-params!(
-    /// `lever_arm`: `r<i><j>_mm` = j-component of accelerometer i's sensing point, mm.
-    LeverArmSpec { rxx_mm, rxy_mm, rxz_mm, ryx_mm, ryy_mm, ryz_mm, rzx_mm, rzy_mm, rzz_mm });
-/// `time_offset`: the sample stamped t measured the motion at t - tau.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct TimeOffsetSpec {
-    /// `tau_ms` (see spec/physics.md), at most a minute either way.
-    #[serde(default, deserialize_with = "time_offset_ms")]
-    pub tau_ms: f64,
-}
-
-/// `deserialize_with` helper for `tau_ms`: within a minute either way (an offset of 1e300
-/// ms evaluates the motion at 1e297 s, where `s^2` overflows: NaN outputs).
-fn time_offset_ms<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
-    let v = finite(d)?;
-    if v.abs() <= 60_000.0 {
-        Ok(v)
-    } else {
-        Err(serde::de::Error::custom(format!(
-            "must be within a minute either way (-60000 to 60000 ms), found {}",
-            super::quantity::shown(v)
-        )))
-    }
-}
-params!(
-    /// Misalignment: `<i><j>_mrad` = K[i][j] * 1000.
-    MisalignmentSpec { xy_mrad, xz_mrad, yx_mrad, yz_mrad, zx_mrad, zy_mrad });
-params!(
-/// `g_sensitivity`: `<i><j>_dps_per_g` = G[i][j] * g.
-GSensitivitySpec {
-    xx_dps_per_g, xy_dps_per_g, xz_dps_per_g, yx_dps_per_g, yy_dps_per_g, yz_dps_per_g,
-    zx_dps_per_g, zy_dps_per_g, zz_dps_per_g
-});
-params!(
-    /// Per-axis coefficients `x`, `y`, `z` in the effect's unit.
-    AxesSpec { x, y, z });
 
 /// Lab air and IMU internal temperature.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -2,6 +2,7 @@
 //! Parsing refuses unknown keys and wrong units with a diagnostic located in the file.
 
 mod describe;
+mod effects;
 mod faults;
 mod file;
 mod quantity;
@@ -9,10 +10,10 @@ mod quantity;
 pub use describe::{Environment, ImuIdentity, StationInfo};
 
 pub use faults::{AxisName, DropoutMode, FaultSpec, LinkName, TableFaultMode};
+pub use effects::EffectsSpec;
 pub use file::{
-    AmbientSpec, AxesSpec, EffectsSpec, EnvironmentSpec, GSensitivitySpec, ImuDriverSpec, ImuSpec,
-    ImuTemperatureSpec, LeverArmSpec, MisalignmentSpec, MountSpec, SettlingSpec, SiteSpec, Station,
-    TableDriverSpec, TableSpec, TemperatureSpec, TimeOffsetSpec,
+    AmbientSpec, EnvironmentSpec, ImuDriverSpec, ImuSpec, ImuTemperatureSpec, MountSpec,
+    SettlingSpec, SiteSpec, Station, TableDriverSpec, TableSpec, TemperatureSpec,
 };
 pub use quantity::{
     Accel, AccelDensity, Angle, Freq, Pressure, Rate, RateDensity, RateWalk, Ratio, Rotation, Temp,
@@ -20,7 +21,8 @@ pub use quantity::{
 };
 
 use miette::{Diagnostic, NamedSource, SourceSpan};
-use ratecal_physics::{Geometry, ImuErrors, Mat3, Site, Vec3};
+use ratecal_physics::effects::ImuModel;
+use ratecal_physics::{Geometry, Mat3, Site, Vec3};
 
 /// The embedded default station's YAML (a simulated tactical-grade IMU on a simulated table).
 pub const DEFAULT_STATION_YAML: &str = include_str!("../../stations/default.yaml");
@@ -88,54 +90,35 @@ impl Station {
         }
     }
 
-    /// The IMU's deterministic errors in the physics crate's units.
-    pub fn imu_errors(&self) -> ImuErrors {
+    /// The IMU's deterministic errors as registry terms: the nominal ones (biases, scale
+    /// factors), the Earth's rate at the site, and every catalogue effect the file sets.
+    pub fn imu_model(&self) -> ImuModel {
         let imu = &self.imu;
-        let fx = &imu.effects;
-        let diag = |s: [Ratio; 3]| Mat3::from_diagonal(&Vec3::new(s[0].0, s[1].0, s[2].0));
-        let mis = |m: &MisalignmentSpec| {
-            Mat3::new(
-                0.0, m.xy_mrad, m.xz_mrad, m.yx_mrad, 0.0, m.yz_mrad, m.zx_mrad, m.zy_mrad, 0.0,
-            ) * 1e-3
-        };
-        let l = &fx.lever_arm;
-        let gs = &fx.g_sensitivity;
-        let axes = |a: &AxesSpec| Vec3::new(a.x, a.y, a.z);
-        ImuErrors {
-            k_a: Mat3::identity() + diag(imu.accel_scale) + mis(&fx.accel_misalignment),
-            b_a: Vec3::new(
-                imu.accel_bias[0].0,
-                imu.accel_bias[1].0,
-                imu.accel_bias[2].0,
-            ),
-            k_g: Mat3::identity() + diag(imu.gyro_scale) + mis(&fx.gyro_misalignment),
-            b_g: Vec3::new(imu.gyro_bias[0].0, imu.gyro_bias[1].0, imu.gyro_bias[2].0),
-            g_sens: Mat3::new(
-                gs.xx_dps_per_g,
-                gs.xy_dps_per_g,
-                gs.xz_dps_per_g,
-                gs.yx_dps_per_g,
-                gs.yy_dps_per_g,
-                gs.yz_dps_per_g,
-                gs.zx_dps_per_g,
-                gs.zy_dps_per_g,
-                gs.zz_dps_per_g,
-            ) / self.site.gravity_mps2,
-            lever_m: Mat3::new(
-                l.rxx_mm, l.rxy_mm, l.rxz_mm, l.ryx_mm, l.ryy_mm, l.ryz_mm, l.rzx_mm, l.rzy_mm,
-                l.rzz_mm,
-            ) * 1e-3,
-            gyro_thermal: axes(&fx.gyro_thermal_drift),
-            accel_thermal: axes(&fx.accel_thermal_drift),
+        let mut m = ImuModel {
+            terms: Vec::new(),
             t_ref_c: self.temperature.reference.0,
-            gyro_nonlinearity: axes(&fx.gyro_scale_nonlinearity),
-            tau_s: self.time_offset_s(),
+        };
+        let v3 = |x: [f64; 3]| x.to_vec();
+        m.push("accel_bias", v3(imu.accel_bias.map(|a| a.0)));
+        m.push("accel_scale", v3(imu.accel_scale.map(|r| r.0 * 1e6)));
+        m.push("gyro_bias", v3(imu.gyro_bias.map(|r| r.0)));
+        m.push("gyro_scale", v3(imu.gyro_scale.map(|r| r.0 * 1e6)));
+        let site = self.site();
+        m.push(
+            "earth_rate",
+            ratecal_physics::effects::EarthRate::values(site.latitude_deg).to_vec(),
+        );
+        for e in ratecal_physics::effects::catalogue() {
+            if self.imu.effects.0.contains_key(e.id()) {
+                m.push(e.id(), self.imu.effects.values(e));
+            }
         }
+        m
     }
 
     /// The IMU's time offset `tau`, s.
     pub fn time_offset_s(&self) -> f64 {
-        self.imu.effects.time_offset.tau_ms * 1e-3
+        self.imu.effects.value("time_offset", "tau_ms") * 1e-3
     }
 
     /// The same station with every random term switched off (white noise, bias wander,
