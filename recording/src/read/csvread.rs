@@ -4,7 +4,7 @@
 // A refused recording is built once per read: the error's size costs nothing.
 #![allow(clippy::result_large_err)]
 
-use super::error::{RecordingError, empty_stream, line_col_bytes};
+use crate::error::{RecordingError, empty_stream, line_col_bytes};
 use miette::{NamedSource, SourceSpan};
 
 /// Columns of one CSV file, in the order they were asked for; `None` for an absent
