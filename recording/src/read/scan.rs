@@ -34,8 +34,6 @@ pub(crate) const SKIP: usize = usize::MAX;
 /// Receives parsed rows (the wanted cells in slot order).
 pub(crate) trait RowSink: Send {
     fn push(&mut self, row: &[f64; MAX_SLOTS]);
-    /// Appends another part (the rows after this one's).
-    fn append(&mut self, other: Self);
 }
 
 /// Reads the header line of `path`: field names, and the offset after it.
@@ -107,7 +105,10 @@ pub(crate) fn scan_range<S: RowSink>(
         start
     };
     f.seek(SeekFrom::Start(from)).map_err(|_| GiveUp)?;
-    let mut buf = vec![0u8; CHUNK];
+    // A short range (a time span, an index block) needs no more than itself and the end
+    // of its last line; the buffer grows if a line is longer.
+    let wanted = end.saturating_sub(from).saturating_add(4096);
+    let mut buf = vec![0u8; CHUNK.min(wanted as usize)];
     let mut filled = 0;
     let mut base = from; // file offset of buf[0]
     let mut skip_partial = from < start;
@@ -362,6 +363,9 @@ mod tests {
         fn push(&mut self, row: &[f64; MAX_SLOTS]) {
             self.0.push(row[..self.1].to_vec());
         }
+    }
+
+    impl Rows {
         fn append(&mut self, other: Self) {
             self.0.extend(other.0);
         }
