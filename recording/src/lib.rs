@@ -48,5 +48,5 @@ pub use manifest::{
     AbortRecord, EnvironmentRecord, FORMAT, LinkRecord, Manifest, ManifestStation, Mount,
     ProcedureRef, ResumeRecord, RunInfo, Segment, SegmentKind, SyncRecord, TableAxes,
 };
-pub use read::{parse_manifest, read, read_imu, read_table};
+pub use read::{OpenRecording, SpanRows, parse_manifest, read, read_imu, read_table};
 pub use write::{Columns, RecordingWriter, manifest_yaml, push_fixed, rfc3339, sha256_hex};

@@ -6,15 +6,20 @@
 mod check;
 mod csvread;
 mod fast;
+mod index;
 mod manifest;
+mod number;
 mod scan;
+mod span;
 mod stream;
 mod validate;
 
 pub use manifest::parse_manifest;
+pub use span::{OpenRecording, SpanRows};
 
 use crate::error::RecordingError;
-use crate::{ImuStream, Recording, TableStream};
+use crate::{ImuStream, Manifest, Recording, TableStream};
+use check::Extent;
 use csvread::read_columns;
 use std::path::Path;
 use stream::Stream;
@@ -23,11 +28,7 @@ use stream::Stream;
 /// promises: columns present, numbers finite, time strictly increasing, segments inside
 /// both streams and not empty.
 pub fn read(dir: &Path) -> Result<Recording, RecordingError> {
-    let manifest_path = dir.join("manifest.yaml");
-    let manifest_bytes = std::fs::read(&manifest_path).map_err(|e| io_error(&manifest_path, e))?;
-    let manifest_name = manifest_path.display().to_string();
-    let manifest_text = String::from_utf8_lossy(&manifest_bytes).into_owned();
-    let manifest = parse_manifest(&manifest_name, &manifest_text)?;
+    let (manifest_name, manifest_text, manifest) = read_manifest(dir)?;
 
     let imu_path = dir.join(ImuStream::FILE);
     let table_path = dir.join(TableStream::FILE);
@@ -42,12 +43,29 @@ pub fn read(dir: &Path) -> Result<Recording, RecordingError> {
     };
     check::check_time(&imu_path, &imu.t)?;
     check::check_time(&table_path, &table.t)?;
-    check::check_segments(&manifest_name, &manifest_text, &manifest, &imu, &table)?;
+    check::check_segments(
+        &manifest_name,
+        &manifest_text,
+        &manifest,
+        Extent::of(&imu.t),
+        Extent::of(&table.t),
+        |a, b| check::holds_sample(&imu.t, a, b),
+    )?;
     Ok(Recording {
         manifest,
         imu,
         table,
     })
+}
+
+/// `dir/manifest.yaml`: its name as errors show it, its text, and the parsed manifest.
+fn read_manifest(dir: &Path) -> Result<(String, String, Manifest), RecordingError> {
+    let path = dir.join("manifest.yaml");
+    let bytes = std::fs::read(&path).map_err(|e| io_error(&path, e))?;
+    let name = path.display().to_string();
+    let text = String::from_utf8_lossy(&bytes).into_owned();
+    let manifest = parse_manifest(&name, &text)?;
+    Ok((name, text, manifest))
 }
 
 fn io_error(path: &Path, e: std::io::Error) -> RecordingError {
