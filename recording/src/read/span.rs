@@ -37,8 +37,8 @@ pub struct SpanRows {
 impl Recording {
     /// Opens `dir` for reading by time span. It checks what [`crate::read`] checks, with
     /// the same located errors, except the cells outside the time column, which are
-    /// checked when a span holding them is read (a stream the fast path gives up on, with
-    /// quoted cells or CR CR LF line ends, is read whole once here, and checked whole).
+    /// checked when a span holding them is read (a stream whose time column the range
+    /// parser gives up on, quoted cells for one, is read whole once here, and checked whole).
     pub fn open(dir: &Path) -> Result<OpenRecording, RecordingError> {
         let (manifest_name, manifest_text, manifest) = read_manifest(dir)?;
         let mut starts: Vec<f64> = manifest.segments.iter().map(|s| s.t_start).collect();
