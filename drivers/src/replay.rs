@@ -9,63 +9,14 @@ use crate::{
     TableInfo, TableSample,
 };
 use async_trait::async_trait;
+use ratecal_recording::{RecordingError, read_imu, read_table};
 use std::path::Path;
 use tokio::time::Instant;
 
-fn bad(msg: String) -> DriverError {
-    DriverError::new(DriverErrorKind::Transport, msg)
-}
-
-/// Reads a CSV stream: for each row, the named columns (`None` for a missing optional one).
-fn read_columns(
-    path: &Path,
-    required: &[&str],
-    optional: &[&str],
-) -> Result<Vec<Vec<Option<f64>>>, DriverError> {
-    let shown = path.display();
-    let mut rdr = csv::Reader::from_path(path).map_err(|e| bad(format!("{shown}: {e}")))?;
-    let headers = rdr
-        .headers()
-        .map_err(|e| bad(format!("{shown}: {e}")))?
-        .clone();
-    let mut idx = Vec::new();
-    for name in required {
-        let i = headers.iter().position(|h| h.trim() == *name);
-        idx.push(Some(
-            i.ok_or_else(|| bad(format!("{shown}:1: no `{name}` column")))?,
-        ));
-    }
-    for name in optional {
-        idx.push(headers.iter().position(|h| h.trim() == *name));
-    }
-    let mut rows = Vec::new();
-    let mut record = csv::StringRecord::new();
-    let mut line = 1;
-    while rdr
-        .read_record(&mut record)
-        .map_err(|e| bad(format!("{shown}: {e}")))?
-    {
-        line += 1;
-        let mut row = Vec::with_capacity(idx.len());
-        for i in &idx {
-            let cell = match i {
-                Some(i) => {
-                    let text = record.get(*i).unwrap_or("").trim();
-                    let v = text.parse::<f64>().map_err(|_| {
-                        bad(format!(
-                            "{shown}:{line}:{}: `{text}` is not a number",
-                            i + 1
-                        ))
-                    })?;
-                    Some(v)
-                }
-                None => None,
-            };
-            row.push(cell);
-        }
-        rows.push(row);
-    }
-    Ok(rows)
+/// A stream the recording crate refused, as a driver error (its message names the file,
+/// line and column).
+fn bad(e: RecordingError) -> DriverError {
+    DriverError::new(DriverErrorKind::Transport, e.to_string())
 }
 
 /// A stream of samples replayed against the tokio clock.
@@ -96,21 +47,16 @@ pub struct ReplayTable {
 impl ReplayTable {
     /// Opens `folder/table.csv`.
     pub fn open(folder: &str, station: &Station) -> Result<Self, DriverError> {
-        let rows = read_columns(
-            &Path::new(folder).join("table.csv"),
-            &["t", "outer", "inner", "outer_rate", "inner_rate"],
-            &["ambient"],
-        )?;
-        let t0 = rows.first().and_then(|r| r[0]).unwrap_or(0.0);
-        let samples = rows
-            .iter()
-            .map(|r| TableSample {
-                t: r[0].unwrap_or(0.0) - t0,
-                outer_deg: r[1].unwrap_or(f64::NAN),
-                inner_deg: r[2].unwrap_or(f64::NAN),
-                outer_rate_dps: r[3].unwrap_or(f64::NAN),
-                inner_rate_dps: r[4].unwrap_or(f64::NAN),
-                ambient_c: r[5],
+        let s = read_table(&Path::new(folder).join("table.csv")).map_err(bad)?;
+        let t0 = s.t.first().copied().unwrap_or(0.0);
+        let samples = (0..s.t.len())
+            .map(|i| TableSample {
+                t: s.t[i] - t0,
+                outer_deg: s.outer[i],
+                inner_deg: s.inner[i],
+                outer_rate_dps: s.outer_rate[i],
+                inner_rate_dps: s.inner_rate[i],
+                ambient_c: s.ambient.as_ref().map(|a| a[i]),
             })
             .collect();
         let t = &station.table;
@@ -160,24 +106,19 @@ impl ReplayImu {
     /// there is one, so that both streams keep their common clock.
     pub fn open(folder: &str, station: &Station) -> Result<Self, DriverError> {
         let dir = Path::new(folder);
-        let rows = read_columns(
-            &dir.join("imu.csv"),
-            &["t", "ax", "ay", "az", "gx", "gy", "gz"],
-            &["temp"],
-        )?;
-        let t0 = read_columns(&dir.join("table.csv"), &["t"], &[])
+        let s = read_imu(&dir.join("imu.csv")).map_err(bad)?;
+        let t0 = read_table(&dir.join("table.csv"))
             .ok()
-            .and_then(|r| r.first().and_then(|r| r[0]))
-            .or_else(|| rows.first().and_then(|r| r[0]))
+            .and_then(|table| table.t.first().copied())
+            .or_else(|| s.t.first().copied())
             .unwrap_or(0.0);
-        let v = |r: &[Option<f64>], i: usize| r[i].unwrap_or(f64::NAN);
-        let samples = rows
-            .iter()
-            .map(|r| ImuSample {
-                t: v(r, 0) - t0,
-                accel: [v(r, 1), v(r, 2), v(r, 3)],
-                gyro: [v(r, 4), v(r, 5), v(r, 6)],
-                temp_c: r[7],
+        let row = |c: &[Vec<f64>; 3], i: usize| [c[0][i], c[1][i], c[2][i]];
+        let samples = (0..s.t.len())
+            .map(|i| ImuSample {
+                t: s.t[i] - t0,
+                accel: row(&s.accel, i),
+                gyro: row(&s.gyro, i),
+                temp_c: s.temp.as_ref().map(|c| c[i]),
             })
             .collect();
         let imu = &station.imu;

@@ -50,35 +50,9 @@ pub enum TableCommand {
     SafeStop,
 }
 
-/// One table feedback sample.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TableSample {
-    /// Time since the station's start, s.
-    pub t: f64,
-    /// Measured outer angle, deg.
-    pub outer_deg: f64,
-    /// Measured inner angle, deg.
-    pub inner_deg: f64,
-    /// Measured outer rate, deg/s.
-    pub outer_rate_dps: f64,
-    /// Measured inner rate, deg/s.
-    pub inner_rate_dps: f64,
-    /// Lab air temperature, degC, if the station measures it.
-    pub ambient_c: Option<f64>,
-}
-
-/// One IMU sample.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ImuSample {
-    /// Time stamp since the station's start, s.
-    pub t: f64,
-    /// Accelerometer outputs, m/s^2.
-    pub accel: [f64; 3],
-    /// Gyro outputs, deg/s.
-    pub gyro: [f64; 3],
-    /// Internal temperature, degC.
-    pub temp_c: Option<f64>,
-}
+// The samples are the recording format's rows: defined with it, so that the replay driver
+// and the recording writer share them without the format depending on the drivers.
+pub use ratecal_recording::{ImuSample, TableSample};
 
 /// Static facts about a table.
 #[derive(Debug, Clone, PartialEq)]

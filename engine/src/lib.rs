@@ -8,7 +8,8 @@ pub mod check;
 pub mod explain;
 pub mod fit;
 pub mod plan;
-pub mod recording;
+/// The recording format lives in its own crate; `crate::recording` names it here.
+pub use ratecal_recording as recording;
 pub mod render;
 pub mod results;
 pub mod run;

@@ -6,7 +6,7 @@
 
 use libfuzzer_sys::fuzz_target;
 use miette::Diagnostic;
-use ratecal_engine::recording::{self, RecordingError};
+use ratecal_recording::{self as recording, RecordingError};
 
 fuzz_target!(|data: &[u8]| {
     let mut parts = split(data);
@@ -20,8 +20,8 @@ fuzz_target!(|data: &[u8]| {
             for t in [&rec.imu.t, &rec.table.t] {
                 assert!(t.len() >= 2 && t.windows(2).all(|w| w[1] > w[0]));
             }
-            assert!(rec.imu.accel.as_flattened().iter().all(|x| x.is_finite()));
-            assert!(rec.imu.gyro.as_flattened().iter().all(|x| x.is_finite()));
+            assert!(rec.imu.accel.iter().flatten().all(|x| x.is_finite()));
+            assert!(rec.imu.gyro.iter().flatten().all(|x| x.is_finite()));
             for s in &rec.manifest.segments {
                 assert!(s.t_start.is_finite() && s.t_end > s.t_start);
                 assert!(rec.imu.t.iter().any(|&t| t >= s.t_start && t <= s.t_end));

@@ -217,25 +217,5 @@ fn help_for(message: &str) -> String {
     HELP.into()
 }
 
-/// Byte offset of 1-based `line` and character `column` in a YAML text, lines broken as
-/// YAML (and miette) break them: LF, CRLF or a bare CR. Turns the line and column that
-/// serde-saphyr reports into a span (station files here, recording manifests in the engine).
-pub fn yaml_offset(text: &str, line: u64, column: u64) -> usize {
-    let b = text.as_bytes();
-    let mut start = 0;
-    for _ in 1..line {
-        match b[start..].iter().position(|&c| c == b'\n' || c == b'\r') {
-            Some(p) => {
-                start += p + 1;
-                if b[start - 1] == b'\r' && b.get(start) == Some(&b'\n') {
-                    start += 1;
-                }
-            }
-            None => return text.len(),
-        }
-    }
-    text[start..]
-        .char_indices()
-        .nth(column.saturating_sub(1) as usize)
-        .map_or(text.len(), |(i, _)| start + i)
-}
+// One YAML locator for manifests and station files: the recording crate's.
+pub use ratecal_recording::yaml_offset;

@@ -1,25 +1,10 @@
-//! The recording folder of `spec/recording-format.md`: the contract between measuring and
-//! analysing. `run` writes one (`write`), `fit` reads any (`read`), whoever wrote it.
+//! `manifest.yaml`: what was recorded, where, on what, and when each segment happened.
 
 use serde::{Deserialize, Serialize};
-
-mod csvread;
-mod error;
-mod read;
-mod scan;
-mod validate;
-
-pub use error::RecordingError;
-pub use read::{parse_manifest, read};
 use std::collections::BTreeMap;
 
-mod fixed;
-mod streams;
-mod write;
-
-pub use fixed::push_fixed;
-pub use streams::Columns;
-pub use write::{RecordingWriter, manifest_yaml, rfc3339, sha256_hex};
+/// The format tag this version writes and reads.
+pub const FORMAT: &str = "ratecal-recording/1";
 
 /// `manifest.yaml`. Unknown keys are ignored on reading.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -270,48 +255,3 @@ pub struct AbortRecord {
     /// The values that fired it.
     pub values: String,
 }
-
-/// The IMU stream, one vector per column: the analysis borrows a segment's channels as
-/// slices instead of copying them.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct ImuStream {
-    /// Time stamps, s.
-    pub t: Vec<f64>,
-    /// Accelerometer outputs per axis (x, y, z), m/s^2.
-    pub accel: [Vec<f64>; 3],
-    /// Gyro outputs per axis (x, y, z), deg/s.
-    pub gyro: [Vec<f64>; 3],
-    /// IMU internal temperature, degC (optional column).
-    pub temp: Option<Vec<f64>>,
-}
-
-/// The table feedback stream, columnar.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct TableStream {
-    /// Time stamps, s.
-    pub t: Vec<f64>,
-    /// Outer angle, deg (may run past 360).
-    pub outer: Vec<f64>,
-    /// Inner angle, deg.
-    pub inner: Vec<f64>,
-    /// Outer rate, deg/s.
-    pub outer_rate: Vec<f64>,
-    /// Inner rate, deg/s.
-    pub inner_rate: Vec<f64>,
-    /// Lab air temperature, degC (optional column).
-    pub ambient: Option<Vec<f64>>,
-}
-
-/// A whole recording in memory.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Recording {
-    /// Manifest.
-    pub manifest: Manifest,
-    /// IMU stream.
-    pub imu: ImuStream,
-    /// Table stream.
-    pub table: TableStream,
-}
-
-/// The format tag this version writes and reads.
-pub const FORMAT: &str = "ratecal-recording/1";

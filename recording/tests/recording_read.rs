@@ -1,7 +1,7 @@
 //! Reading recordings: the independent example folder, and located errors for bad ones.
 
 use miette::{GraphicalReportHandler, GraphicalTheme};
-use ratecal_engine::recording::{self, RecordingError, SegmentKind};
+use ratecal_recording::{self as recording, RecordingError, SegmentKind};
 use std::path::{Path, PathBuf};
 
 fn shared() -> Option<PathBuf> {

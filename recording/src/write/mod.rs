@@ -6,14 +6,19 @@
 //! every checkpoint (segment end, abort, end of run), and `journal.jsonl` gets one JSON
 //! line per event.
 
-use super::streams::{Columns, IMU_HEADER, Stream, Streams, TABLE_HEADER};
-use super::{FORMAT, Manifest};
-use ratecal_drivers::{ImuSample, TableSample};
+mod fixed;
+mod streams;
+
+pub use fixed::push_fixed;
+pub use streams::Columns;
+
+use crate::{FORMAT, ImuSample, Manifest, TableSample};
 use sha2::{Digest, Sha256};
 use std::fs::{File, OpenOptions};
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
+use streams::{IMU_HEADER, Stream, Streams, TABLE_HEADER};
 
 /// What the interpreter's thread asks the writer thread.
 enum Msg {
@@ -148,7 +153,7 @@ impl RecordingWriter {
     pub fn append(dir: &Path) -> io::Result<(Self, Option<f64>)> {
         let text = std::fs::read_to_string(dir.join("manifest.yaml"))?;
         // The reader's manifest parser, so a resumed run accepts exactly what analysis reads.
-        let manifest = super::parse_manifest("manifest.yaml", &text)
+        let manifest = crate::parse_manifest("manifest.yaml", &text)
             .map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e.to_string()))?;
         let (imu, imu_header) = Stream::append(&dir.join("imu.csv"))?;
         let (table, table_header) = Stream::append(&dir.join("table.csv"))?;

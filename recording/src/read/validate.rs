@@ -5,8 +5,8 @@
 // A refused manifest is built once per read: the error's size costs nothing.
 #![allow(clippy::result_large_err)]
 
-use super::error::{RecordingError, line_col};
-use super::{Manifest, Mount};
+use crate::error::{RecordingError, line_col};
+use crate::{Manifest, Mount};
 use miette::NamedSource;
 use ratecal_physics::{Mat3, check_rotation};
 
@@ -67,7 +67,7 @@ pub(crate) fn manifest(file: &str, text: &str, m: &Manifest) -> Result<(), Recor
     }
     let mut from = text.find("segments").unwrap_or(0);
     for seg in &m.segments {
-        from = super::read::find_segment(text, &seg.id, from);
+        from = super::manifest::find_segment(text, &seg.id, from);
         if let Some(problem) = seg.mount.as_ref().and_then(not_a_rotation) {
             return Err(at("rotation", from, problem, MOUNT_HELP));
         }

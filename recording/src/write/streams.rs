@@ -3,7 +3,7 @@
 //! sample batches over.
 
 use super::fixed::Line;
-use ratecal_drivers::{ImuSample, TableSample};
+use crate::{ImuSample, TableSample};
 use sha2::{Digest, Sha256};
 use std::fs::{File, OpenOptions};
 use std::io::{self, Read, Seek, SeekFrom, Write};

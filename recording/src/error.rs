@@ -302,3 +302,26 @@ pub(crate) fn line_col_bytes(bytes: &[u8], offset: usize) -> (u64, usize) {
     let column = String::from_utf8_lossy(&before[start..]).chars().count() + 1;
     (line, column)
 }
+
+/// Byte offset of 1-based `line` and character `column` in a YAML text, lines broken as
+/// YAML (and miette) break them: LF, CRLF or a bare CR. Turns the line and column that
+/// serde-saphyr reports into a span (recording manifests here, station files in the drivers).
+pub fn yaml_offset(text: &str, line: u64, column: u64) -> usize {
+    let b = text.as_bytes();
+    let mut start = 0;
+    for _ in 1..line {
+        match b[start..].iter().position(|&c| c == b'\n' || c == b'\r') {
+            Some(p) => {
+                start += p + 1;
+                if b[start - 1] == b'\r' && b.get(start) == Some(&b'\n') {
+                    start += 1;
+                }
+            }
+            None => return text.len(),
+        }
+    }
+    text[start..]
+        .char_indices()
+        .nth(column.saturating_sub(1) as usize)
+        .map_or(text.len(), |(i, _)| start + i)
+}

@@ -4,8 +4,9 @@
 // A refused recording is built once per read: the error's size costs nothing.
 #![allow(clippy::result_large_err)]
 
-use super::error::{RecordingError, empty_stream, line_col_bytes};
+use crate::error::{RecordingError, empty_stream, line_col_bytes};
 use miette::{NamedSource, SourceSpan};
+use std::ops::Range;
 
 /// Columns of one CSV file, in the order they were asked for; `None` for an absent
 /// optional column.
@@ -21,6 +22,20 @@ pub(crate) fn read_columns(
     bytes: &[u8],
     required: &[&str],
     optional: &[&str],
+) -> Result<Columns, RecordingError> {
+    read_rows(file, bytes, None, required, optional, |_| {})
+}
+
+/// `read_columns` of the records that start in `data` (a range of record starts, after the
+/// header; all of them for `None`), located in the whole of `bytes`; `on_row` gets each
+/// kept record's start.
+pub(crate) fn read_rows(
+    file: &str,
+    bytes: &[u8],
+    data: Option<Range<usize>>,
+    required: &[&str],
+    optional: &[&str],
+    mut on_row: impl FnMut(usize),
 ) -> Result<Columns, RecordingError> {
     let mut rdr = csv::ReaderBuilder::new()
         .has_headers(false)
@@ -56,15 +71,24 @@ pub(crate) fn read_columns(
     for &c in optional {
         idx.push(names.iter().position(|n| n == c));
     }
+    // Records from `data.start` on: a reader of their bytes, positions shifted back.
+    let base = data.as_ref().map_or(0, |d| d.start);
+    if let Some(d) = &data {
+        rdr = csv::ReaderBuilder::new()
+            .has_headers(false)
+            .flexible(true)
+            .from_reader(&bytes[d.start.min(bytes.len())..d.end.min(bytes.len())]);
+    }
     // Rough row count from the byte size, to allocate once.
-    let guess = bytes.len() / (header_len.max(8) + 1) + 16;
+    let size = data.as_ref().map_or(bytes.len(), |d| d.len());
+    let guess = size / (header_len.max(8) + 1) + 16;
     let mut cols: Vec<Option<Vec<f64>>> = idx
         .iter()
         .map(|i| i.map(|_| Vec::with_capacity(guess)))
         .collect();
     let width = names.len();
     while rdr.read_byte_record(&mut rec).map_err(|e| io(file, e))? {
-        let pos = rec.position().expect("csv records carry positions");
+        let pos = base + rec.position().expect("csv records carry positions").byte() as usize;
         if rec.len() != width {
             if rec.len() == 1
                 && rec
@@ -108,6 +132,7 @@ pub(crate) fn read_columns(
                 }
             }
         }
+        on_row(record_start(bytes, pos));
     }
     Ok(Columns { cols })
 }
@@ -119,11 +144,11 @@ fn io(file: &str, e: csv::Error) -> RecordingError {
     }
 }
 
-/// Where the record at `pos` starts. After a CR the csv crate may put a record's start on
-/// the line-end bytes that follow it (the LF of a CRLF, the second CR of a CR CR LF): a
-/// record never starts with a line end, so the row starts after them.
-fn record_start(bytes: &[u8], pos: &csv::Position) -> usize {
-    let start = (pos.byte() as usize).min(bytes.len());
+/// Where the record at byte `pos` starts. After a CR the csv crate may put a record's
+/// start on the line-end bytes that follow it (the LF of a CRLF, the second CR of a CR CR
+/// LF): a record never starts with a line end, so the row starts after them.
+fn record_start(bytes: &[u8], pos: usize) -> usize {
+    let start = pos.min(bytes.len());
     start
         + bytes[start..]
             .iter()
@@ -148,7 +173,7 @@ pub(crate) fn row_start(bytes: &[u8], row: usize) -> usize {
         }
         if seen == row {
             let pos = rec.position().expect("csv records carry positions");
-            return record_start(bytes, pos);
+            return record_start(bytes, pos.byte() as usize);
         }
         seen += 1;
     }

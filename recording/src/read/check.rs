@@ -1,0 +1,158 @@
+//! What the format promises beyond each cell: time strictly increasing, at least two
+//! samples, segments inside both streams and not empty. A problem is located by reading
+//! the file again (only then).
+
+// A refused recording is built once per read: the error's size costs nothing.
+#![allow(clippy::result_large_err)]
+
+use super::csvread::{cell_offset, lossy_span, row_start};
+use super::io_error;
+use super::manifest::find_segment;
+use crate::Manifest;
+use crate::error::{RecordingError, empty_stream, line_col, line_col_bytes};
+use miette::NamedSource;
+use std::path::Path;
+
+/// Time strictly increasing, at least two rows; a problem is located by reading the file
+/// again (only then).
+pub(super) fn check_time(path: &Path, t: &[f64]) -> Result<(), RecordingError> {
+    if t.len() < 2 {
+        return Err(too_few(path));
+    }
+    match t.windows(2).position(|w| w[1] <= w[0]) {
+        Some(k) => Err(time_error(path, k + 1, t[k], t[k + 1])),
+        None => Ok(()),
+    }
+}
+
+/// A stream with fewer than two samples, located where its text ends.
+pub(super) fn too_few(path: &Path) -> RecordingError {
+    match std::fs::read(path) {
+        Ok(bytes) => empty_stream(&path.display().to_string(), &bytes),
+        Err(e) => io_error(path, e),
+    }
+}
+
+/// Data row `row` (0-based) whose time `t` is not after the previous row's `prev`.
+pub(super) fn time_error(path: &Path, row: usize, prev: f64, t: f64) -> RecordingError {
+    let file = path.display().to_string();
+    let bytes = match std::fs::read(path) {
+        Ok(b) => b,
+        Err(e) => return io_error(path, e),
+    };
+    let start = row_start(&bytes, row);
+    let line = line_col_bytes(&bytes, start).0;
+    let header = &bytes[..bytes
+        .iter()
+        .position(|&b| b == b'\n' || b == b'\r')
+        .unwrap_or(bytes.len())];
+    let field = header
+        .split(|&b| b == b',')
+        .position(|f| f.trim_ascii() == b"t")
+        .unwrap_or(0);
+    let (offset, column) = cell_offset(&bytes, start, field);
+    let len = bytes[offset..]
+        .iter()
+        .position(|&b| b == b',' || b == b'\n' || b == b'\r')
+        .unwrap_or(1)
+        .max(1);
+    RecordingError::TimeNotIncreasing {
+        file: file.clone(),
+        line,
+        column,
+        t,
+        prev,
+        src: NamedSource::new(file, String::from_utf8_lossy(&bytes).into_owned()),
+        span: lossy_span(&bytes, offset, offset + len),
+    }
+}
+
+/// The first two and the last time stamps of a stream of at least two: what the segment
+/// checks need of it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Extent {
+    pub first: f64,
+    pub second: f64,
+    pub last: f64,
+}
+
+impl Extent {
+    pub fn of(t: &[f64]) -> Self {
+        Extent {
+            first: t[0],
+            second: t[1],
+            last: t[t.len() - 1],
+        }
+    }
+}
+
+/// Whether `t` (increasing) holds a stamp in `[t_start, t_end]`.
+pub(super) fn holds_sample(t: &[f64], t_start: f64, t_end: f64) -> bool {
+    let a = t.partition_point(|&x| x < t_start);
+    let b = t.partition_point(|&x| x <= t_end);
+    b > a
+}
+
+pub(super) fn check_segments(
+    file: &str,
+    text: &str,
+    m: &Manifest,
+    imu: Extent,
+    table: Extent,
+    imu_holds_sample: impl Fn(f64, f64) -> bool,
+) -> Result<(), RecordingError> {
+    let lo = imu.first.max(table.first);
+    let hi = imu.last.min(table.last);
+    // Half a table step of slack: a window may start or end between two feedback samples.
+    let slack = 0.5
+        * (table.second - table.first)
+            .abs()
+            .max((imu.second - imu.first).abs());
+    let mut search_from = 0;
+    for seg in &m.segments {
+        let offset = find_segment(text, &seg.id, search_from);
+        search_from = offset;
+        let (line, column) = line_col(text, offset);
+        let len = text[offset..]
+            .find('\n')
+            .unwrap_or(text.len() - offset)
+            .max(1);
+        let outside = |problem: String, help: String| RecordingError::SegmentOutside {
+            file: file.to_string(),
+            line,
+            column,
+            id: seg.id.clone(),
+            t_start: seg.t_start,
+            t_end: seg.t_end,
+            problem,
+            help,
+            src: NamedSource::new(file, text.to_string()),
+            span: (offset, len).into(),
+        };
+        if !(seg.t_start.is_finite() && seg.t_end.is_finite()) || seg.t_end <= seg.t_start {
+            return Err(outside(
+                "ends before it starts".into(),
+                "t_end must be later than t_start".into(),
+            ));
+        }
+        if seg.t_start < lo - slack || seg.t_end > hi + slack {
+            return Err(outside(
+                format!("is outside the streams ({lo} s .. {hi} s)"),
+                "a segment lies inside both imu.csv and table.csv; check its times".into(),
+            ));
+        }
+        if !imu_holds_sample(seg.t_start, seg.t_end) {
+            return Err(RecordingError::EmptySegment {
+                file: file.to_string(),
+                line,
+                column,
+                id: seg.id.clone(),
+                t_start: seg.t_start,
+                t_end: seg.t_end,
+                src: NamedSource::new(file, text.to_string()),
+                span: (offset, len).into(),
+            });
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,201 @@
+//! A recording read by time span: [`Recording::open`] reads the manifest and indexes both
+//! streams by time; [`OpenRecording::read_span`] parses only the blocks that hold a span,
+//! so a long 1 kHz recording is analysed segment by segment in bounded memory.
+
+// A refused recording is built once per read: the error's size costs nothing.
+#![allow(clippy::result_large_err)]
+
+use super::check;
+use super::csvread::read_rows;
+use super::index::{StreamIndex, Times};
+use super::scan::{self, MAX_SLOTS, RowSink};
+use super::stream::Stream;
+use super::{io_error, read_manifest};
+use crate::error::RecordingError;
+use crate::{ImuStream, Manifest, Recording, TableStream};
+use std::io::{Read, Seek, SeekFrom};
+use std::path::Path;
+
+/// A recording folder opened for reading by time span: its manifest, and both streams
+/// indexed by time (one entry per 256 KiB of CSV), never held whole.
+#[derive(Debug, Clone)]
+pub struct OpenRecording {
+    manifest: Manifest,
+    imu: StreamIndex,
+    table: StreamIndex,
+}
+
+/// The rows of both streams whose time lies in a span.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SpanRows {
+    /// IMU rows.
+    pub imu: ImuStream,
+    /// Table feedback rows.
+    pub table: TableStream,
+}
+
+impl Recording {
+    /// Opens `dir` for reading by time span. It checks what [`crate::read`] checks, with
+    /// the same located errors, except the cells outside the time column, which are
+    /// checked when a span holding them is read (a stream whose time column the range
+    /// parser gives up on, quoted cells for one, is read whole once here, and checked whole).
+    pub fn open(dir: &Path) -> Result<OpenRecording, RecordingError> {
+        let (manifest_name, manifest_text, manifest) = read_manifest(dir)?;
+        let mut starts: Vec<f64> = manifest.segments.iter().map(|s| s.t_start).collect();
+        starts.sort_by(f64::total_cmp);
+        let mut imu_times = Times::new(&starts);
+        let mut table_times = Times::new(&[]);
+        let (imu, table) = std::thread::scope(|s| {
+            let h = s.spawn(|| StreamIndex::build::<TableStream>(dir, &mut table_times));
+            let imu = StreamIndex::build::<ImuStream>(dir, &mut imu_times);
+            (imu, h.join().expect("index thread"))
+        });
+        let (imu, table) = (imu?, table?);
+        for (times, index) in [(&imu_times, &imu), (&table_times, &table)] {
+            if times.rows < 2 {
+                return Err(check::too_few(&index.path));
+            }
+            if let Some((row, prev, t)) = times.backwards {
+                return Err(check::time_error(&index.path, row, prev, t));
+            }
+        }
+        check::check_segments(
+            &manifest_name,
+            &manifest_text,
+            &manifest,
+            imu_times.extent(),
+            table_times.extent(),
+            |a, b| imu_times.holds_sample(a, b),
+        )?;
+        Ok(OpenRecording {
+            manifest,
+            imu,
+            table,
+        })
+    }
+}
+
+impl OpenRecording {
+    /// The manifest.
+    pub fn manifest(&self) -> &Manifest {
+        &self.manifest
+    }
+
+    /// The rows of both streams with `t0 <= t <= t1`: the same rows, and the same numbers,
+    /// as that slice of a whole [`crate::read`]. A bad cell among the blocks read is
+    /// refused with the location a whole read gives it.
+    pub fn read_span(&self, t0: f64, t1: f64) -> Result<SpanRows, RecordingError> {
+        Ok(SpanRows {
+            imu: span::<ImuStream>(&self.imu, t0, t1)?,
+            table: span::<TableStream>(&self.table, t0, t1)?,
+        })
+    }
+}
+
+/// Keeps the rows of the span from what the range parser hands over.
+struct Within<S> {
+    t0: f64,
+    t1: f64,
+    rows: S,
+}
+
+impl<S: RowSink> RowSink for Within<S> {
+    #[inline]
+    fn push(&mut self, r: &[f64; MAX_SLOTS]) {
+        if r[0] >= self.t0 && r[0] <= self.t1 {
+            self.rows.push(r);
+        }
+    }
+}
+
+/// The rows of one stream in `[t0, t1]`.
+fn span<S: Stream>(ix: &StreamIndex, t0: f64, t1: f64) -> Result<S, RecordingError> {
+    let e = &ix.entries;
+    // No rows, or bounds no time lies between (upside down, NaN).
+    if e.is_empty() || t0.partial_cmp(&t1).is_none_or(|o| o.is_gt()) {
+        return Ok(S::with_capacity(ix.optional, 0));
+    }
+    // The block where the span starts, to the first block that starts after it.
+    let a = e.partition_point(|x| x.1 <= t0).saturating_sub(1);
+    let b = e.partition_point(|x| x.1 <= t1);
+    let (start, end) = (e[a].0, e.get(b).map_or(ix.len, |x| x.0));
+    let Some(layout) = &ix.fast else {
+        return exact_span(ix, start as usize, end as usize, t0, t1);
+    };
+    let rows = scan::rows_for(ix.density, end - start);
+    let mut within = Within {
+        t0,
+        t1,
+        rows: S::with_capacity(ix.optional, rows),
+    };
+    if scan::scan_range(&ix.path, layout, start, end, &mut within).is_ok() {
+        return Ok(within.rows);
+    }
+    // The exact reader takes the lines that start in the range, as the range parser
+    // splits them (its index found no quote: every line start is a record start).
+    let (la, lb) = (line_start(ix, start)?, line_start(ix, end)?);
+    exact_span(ix, la, lb, t0, t1)
+}
+
+/// Where the first line that starts at or after byte `at` starts (the range parser's
+/// rule: after a LF).
+fn line_start(ix: &StreamIndex, at: u64) -> Result<usize, RecordingError> {
+    if at <= ix.head_end || at >= ix.len {
+        return Ok(at.min(ix.len) as usize);
+    }
+    let io = |e| io_error(&ix.path, e);
+    let mut f = std::fs::File::open(&ix.path).map_err(io)?;
+    f.seek(SeekFrom::Start(at - 1)).map_err(io)?;
+    let mut buf = [0u8; 4096];
+    let mut pos = at - 1;
+    loop {
+        let n = f.read(&mut buf).map_err(io)?;
+        if n == 0 {
+            return Ok(ix.len as usize);
+        }
+        if let Some(p) = buf[..n].iter().position(|&b| b == b'\n') {
+            return Ok((pos + p as u64 + 1).min(ix.len) as usize);
+        }
+        pos += n as u64;
+    }
+}
+
+/// The exact reader over the header and the records that start in `[from, to)`; a
+/// problem there is located in the whole file (read again, only then).
+fn exact_span<S: Stream>(
+    ix: &StreamIndex,
+    from: usize,
+    to: usize,
+    t0: f64,
+    t1: f64,
+) -> Result<S, RecordingError> {
+    let io = |e| io_error(&ix.path, e);
+    let head = ix.head_end as usize;
+    let mut buf = vec![0u8; head + to.saturating_sub(from)];
+    let mut f = std::fs::File::open(&ix.path).map_err(io)?;
+    f.read_exact(&mut buf[..head]).map_err(io)?;
+    f.seek(SeekFrom::Start(from as u64)).map_err(io)?;
+    f.read_exact(&mut buf[head..]).map_err(io)?;
+    let file = ix.path.display().to_string();
+    let cols = |bytes: &[u8], data| {
+        read_rows(
+            &file,
+            bytes,
+            Some(data),
+            S::REQUIRED,
+            &[S::OPTIONAL],
+            |_| {},
+        )
+    };
+    let mut rows = match cols(&buf, head..buf.len()) {
+        Ok(c) => S::from_columns(c),
+        Err(e) => {
+            let whole = std::fs::read(&ix.path).map_err(io)?;
+            return Err(cols(&whole, from..to).err().unwrap_or(e));
+        }
+    };
+    let t = rows.t();
+    let keep = t.partition_point(|&x| x < t0)..t.partition_point(|&x| x <= t1);
+    rows.keep(keep);
+    Ok(rows)
+}
