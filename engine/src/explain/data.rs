@@ -4,7 +4,7 @@
 use crate::fit::joint::{Layout, SegAcc, accumulate};
 use crate::fit::prep::geometries;
 use crate::recording::{Recording, SegmentKind};
-use ratecal_physics::REGISTRY;
+use ratecal_physics::{Effect, REGISTRY};
 
 /// Accumulated segments and the split between fitted and held-out ones.
 pub(crate) struct Data {
@@ -19,11 +19,16 @@ pub(crate) struct Data {
 }
 
 impl Data {
-    /// Accumulates every segment (in parallel) and chooses the held-out ones: every third
-    /// segment of each kind, never the longest static one.
+    /// Accumulates every segment (in parallel) over the registry's effects and chooses the
+    /// held-out ones: every third segment of each kind, never the longest static one.
     pub(crate) fn new(rec: &Recording) -> Data {
+        Data::with_effects(rec, REGISTRY.to_vec())
+    }
+
+    /// The same over these effects (the registry's and user effects).
+    pub(crate) fn with_effects(rec: &Recording, effects: Vec<&'static dyn Effect>) -> Data {
         use rayon::prelude::*;
-        let layout = Layout::new(REGISTRY.to_vec());
+        let layout = Layout::new(effects);
         let geos = geometries(rec);
         let t_ref = rec.imu.temp.as_ref().map_or(0.0, |t| {
             let v: Vec<f64> = t.iter().copied().filter(|x| x.is_finite()).collect();

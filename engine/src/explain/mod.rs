@@ -9,20 +9,27 @@
 // Numeric loops index the six channels of several arrays at once.
 #![allow(clippy::needless_range_loop)]
 
+mod adopt;
 pub(crate) mod data;
 mod locate;
 pub(crate) mod model;
 mod output;
 mod select;
 mod text;
+pub mod user;
 
+pub use adopt::{AdoptTarget, Adoption, adoption, next_version};
 pub use model::NominalModel;
-pub use output::{Evidence, Explanation, FORMAT, Final, Finding, Located, Nominal, ParamOut, Rms};
+pub use output::{
+    Evidence, Explanation, FORMAT, Final, Finding, Located, Nominal, ParamOut, Rms, UserEffectOut,
+};
 pub use text::render_text;
+pub use user::UserEffect;
 
 use crate::recording::Recording;
 use data::Data;
 use model::{Terms, fit, rms, seed_segments};
+use ratecal_physics::{Effect, REGISTRY};
 use std::collections::BTreeMap;
 
 /// What explain may be told besides the recording.
@@ -32,6 +39,10 @@ pub struct Options {
     pub path: String,
     /// Family-wise false-discovery threshold of one selection step.
     pub alpha: f64,
+    /// Candidate effects read from files ([`user::load`]), tried with the registry's.
+    pub user: Vec<&'static UserEffect>,
+    /// Registry ids left out of the candidates.
+    pub without: Vec<String>,
 }
 
 impl Default for Options {
@@ -39,15 +50,35 @@ impl Default for Options {
         Options {
             path: String::new(),
             alpha: 1e-3,
+            user: Vec::new(),
+            without: Vec::new(),
         }
     }
 }
 
 /// Explains a recording against a nominal model.
 pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Explanation {
-    let data = Data::new(rec);
+    let mut effects: Vec<&'static dyn Effect> = REGISTRY.to_vec();
+    effects.extend(opts.user.iter().map(|u| *u as &'static dyn Effect));
+    let nonfinite: Vec<usize> = opts.user.iter().map(|u| u.nonfinite()).collect();
+    let data = Data::with_effects(rec, effects);
     let lay = &data.layout;
     let mut warnings = Vec::new();
+    for (u, before) in opts.user.iter().zip(nonfinite) {
+        let n = u.nonfinite() - before;
+        if n > 0 {
+            warnings.push(format!(
+                "user effect `{}` ({}): {n} regressor values were not finite and were taken as zero",
+                u.id(),
+                u.file()
+            ));
+        }
+    }
+    for id in &opts.without {
+        if lay.index(id).is_none_or(|e| lay.effects[e].nominal()) {
+            warnings.push(format!("--without {id}: not a candidate effect"));
+        }
+    }
     let index = |id: &str| lay.index(id).expect("a registry id");
     let start = Terms {
         effects: nominal.effects.iter().map(|id| index(id)).collect(),
@@ -77,12 +108,18 @@ pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Expla
         rms: rms(&data, &nom, &all),
         holdout_rms: rms(&data, &nom, &data.held),
     };
-    let (steps, rejected) = select::forward(&data, &start, opts.alpha);
+    let (steps, rejected) = select::forward(&data, &start, opts.alpha, &opts.without);
     let mut findings = Vec::new();
     let mut terms = start.clone();
     for step in &steps {
         terms.effects.push(step.effect);
-        findings.push(finding(rec, &data, step, &terms));
+        let mut f = finding(rec, &data, step, &terms);
+        f.defined_in = opts
+            .user
+            .iter()
+            .find(|u| u.id() == f.effect)
+            .map(|u| u.file().to_string());
+        findings.push(f);
     }
     let work = data.working();
     let last = match steps.last() {
@@ -102,10 +139,13 @@ pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Expla
             gyro_dps: floor(3..6),
         },
     };
-    let adopt = (!findings.is_empty()).then(|| {
-        let ids: Vec<&str> = findings.iter().map(|f| f.effect.as_str()).collect();
-        format!("with {}", ids.join(", "))
-    });
+    // Only the registry's effects can be declared in a procedure.
+    let ids: Vec<&str> = findings
+        .iter()
+        .filter(|f| f.defined_in.is_none())
+        .map(|f| f.effect.as_str())
+        .collect();
+    let adopt = (!ids.is_empty()).then(|| format!("with {}", ids.join(", ")));
     Explanation {
         format: FORMAT.into(),
         recording: opts.path.clone(),
@@ -119,6 +159,15 @@ pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Expla
             .collect(),
         rejected,
         adopt,
+        adopt_diff: None,
+        user_effects: opts
+            .user
+            .iter()
+            .map(|u| UserEffectOut {
+                effect: u.id().to_string(),
+                file: u.file().to_string(),
+            })
+            .collect(),
         warnings,
     }
 }
@@ -171,5 +220,6 @@ fn finding(rec: &Recording, data: &Data, step: &select::Step, terms: &Terms) -> 
         parameters,
         evidence,
         rms_after: rms(data, &step.after, &all),
+        defined_in: None,
     }
 }

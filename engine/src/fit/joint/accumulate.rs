@@ -150,7 +150,7 @@ pub(crate) fn accumulate(
         }
         let snap = state.snapshot(geo, &site);
         let dtemp = imu.temp.as_ref().map_or(0.0, |tc| tc[i] - t_ref_c);
-        let sig = Signals::new(&snap, &site, if dtemp.is_finite() { dtemp } else { 0.0 });
+        let sig = Signals::new(&snap, &site, if dtemp.is_finite() { dtemp } else { 0.0 }).at(t);
         for (e, fx) in layout.effects.iter().enumerate() {
             fx.regressors(&sig, &mut parts[layout.columns_of(e)]);
         }
