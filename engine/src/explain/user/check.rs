@@ -138,7 +138,7 @@ fn effect_def(e: &EffectDef, signals: &[SignalDef], diags: &mut Vec<Diagnostic>)
                             "effect::missing",
                             format!("parameter `{name}` does not say what motion excites it"),
                         )
-                        .label(p.span, "needs `needs \"...\"`")
+                        .label(p.name.span, "no `needs \"...\"`")
                         .help("add e.g. `needs \"rotate about Z\"`: explain shows it when the recording cannot determine the parameter"),
                     );
                 }
