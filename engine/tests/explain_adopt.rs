@@ -60,9 +60,19 @@ fn added_effects(old: &str, new: &str) -> Vec<(String, String)> {
 #[test]
 fn a_released_version_goes_to_the_next_minor_version() {
     let lock = bundled("versions.lock");
-    let siblings = ["1.0.0.rcal".to_string(), "1.1.0.rcal".into(), "versions.lock".into()];
-    assert_eq!(next_version("1.0.0.rcal", &lock, &siblings).as_deref(), Some("1.2.0"));
-    assert_eq!(next_version("1.1.0.rcal", &lock, &siblings).as_deref(), Some("1.2.0"));
+    let siblings = [
+        "1.0.0.rcal".to_string(),
+        "1.1.0.rcal".into(),
+        "versions.lock".into(),
+    ];
+    assert_eq!(
+        next_version("1.0.0.rcal", &lock, &siblings).as_deref(),
+        Some("1.2.0")
+    );
+    assert_eq!(
+        next_version("1.1.0.rcal", &lock, &siblings).as_deref(),
+        Some("1.2.0")
+    );
     // A draft above the released ones is edited in place; so is a file outside a folder.
     assert_eq!(next_version("1.2.0.rcal", &lock, &siblings), None);
     assert_eq!(next_version("p.rcal", &lock, &siblings), None);
@@ -79,28 +89,43 @@ fn the_diff_applies_and_the_new_version_declares_the_effects() {
         let target = AdoptTarget {
             path: "procedures/imu-2d-standard/1.1.0.rcal".into(),
             text: old.clone(),
-            next: Some(("1.2.0".into(), "procedures/imu-2d-standard/1.2.0.rcal".into())),
+            next: Some((
+                "1.2.0".into(),
+                "procedures/imu-2d-standard/1.2.0.rcal".into(),
+            )),
         };
         let a = adoption(&target, &["lever_arm", "earth_rate", "time_offset"]).unwrap();
         assert!(a.not_placed.is_empty());
         let diff = a.diff.unwrap();
         assert!(diff.starts_with("diff --git procedures/imu-2d-standard/1.1.0.rcal procedures/imu-2d-standard/1.2.0.rcal\ncopy from "));
         assert!(diff.contains("-procedure imu-2d-standard version 1.1.0 {\n+procedure imu-2d-standard version 1.2.0 {\n"), "{diff}");
-        assert!(diff.contains("+    fit accel bias_scale with lever_arm from accel_static/* {\n"), "{diff}");
+        assert!(
+            diff.contains("+    fit accel bias_scale with lever_arm from accel_static/* {\n"),
+            "{diff}"
+        );
         assert!(diff.contains("+    fit gyro scale (x, y) with earth_rate, time_offset from gyro_scale/* using gyro_bias {\n"), "{diff}");
         if apply(tmp.path(), tool, &diff).is_none() {
             continue;
         }
         // The released file is untouched; the new version is the canonical old text plus
         // the declarations.
-        assert_eq!(std::fs::read_to_string(folder.join("1.1.0.rcal")).unwrap(), old);
+        assert_eq!(
+            std::fs::read_to_string(folder.join("1.1.0.rcal")).unwrap(),
+            old
+        );
         let new = std::fs::read_to_string(folder.join("1.2.0.rcal")).unwrap();
         assert_eq!(ratecal_grammar::canonical(&new).unwrap().text, new);
         assert_eq!(
             added_effects(&old, &new),
             [
-                ("step accel_static / fit accel_bias_scale / effects".to_string(), "lever_arm".to_string()),
-                ("step gyro_scale / fit gyro_scale / effects".into(), "earth_rate, time_offset".into()),
+                (
+                    "step accel_static / fit accel_bias_scale / effects".to_string(),
+                    "lever_arm".to_string()
+                ),
+                (
+                    "step gyro_scale / fit gyro_scale / effects".into(),
+                    "earth_rate, time_offset".into()
+                ),
             ]
         );
     }
@@ -133,6 +158,13 @@ fn a_loose_file_is_edited_in_place_and_declared_effects_are_extended() {
     assert_eq!(changes.len(), 1);
     assert!(changes[0].1.contains("g_sensitivity"), "{changes:?}");
     // Nothing new: no diff.
-    let again = adoption(&AdoptTarget { text: new, ..target }, &["g_sensitivity"]).unwrap();
+    let again = adoption(
+        &AdoptTarget {
+            text: new,
+            ..target
+        },
+        &["g_sensitivity"],
+    )
+    .unwrap();
     assert_eq!(again.diff, None);
 }

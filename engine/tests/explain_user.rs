@@ -47,7 +47,10 @@ fn record(effects: &str, seed: u64) -> Recording {
 }
 
 fn example(name: &str) -> (String, String) {
-    let path = format!("{}/../docs/examples/effects/{name}", env!("CARGO_MANIFEST_DIR"));
+    let path = format!(
+        "{}/../docs/examples/effects/{name}",
+        env!("CARGO_MANIFEST_DIR")
+    );
     (name.to_string(), std::fs::read_to_string(path).unwrap())
 }
 
@@ -82,24 +85,50 @@ fn a_restated_lever_arm_gives_the_built_in_finding_and_values() {
     assert_eq!(found(&builtin), ["earth_rate", "lever_arm"]);
     let restated = run(&rec, &["centripetal.effect"], &["lever_arm"]);
     assert_eq!(found(&restated), ["centripetal", "earth_rate"]);
-    let f = restated.findings.iter().find(|f| f.effect == "centripetal").unwrap();
+    let f = restated
+        .findings
+        .iter()
+        .find(|f| f.effect == "centripetal")
+        .unwrap();
     assert_eq!(f.defined_in.as_deref(), Some("centripetal.effect"));
-    assert!(f.located.iter().any(|l| l.segment.starts_with("gyro_scale/")));
+    assert!(
+        f.located
+            .iter()
+            .any(|l| l.segment.starts_with("gyro_scale/"))
+    );
     for (p, truth) in [("rxx_mm", -4.0), ("ryy_mm", 14.0), ("rzz_mm", 25.0)] {
         let (a, ua) = estimate(&builtin, "lever_arm", p);
         let (b, ub) = estimate(&restated, "centripetal", p);
         // The same columns: the same estimate to a small fraction of its uncertainty.
-        assert!((a - b).abs() < 0.05 * ua.min(ub), "{p}: {a} ± {ua} vs {b} ± {ub}");
-        assert!((b - truth).abs() < 3.0 * ub + 1e-3 * truth.abs(), "{p}: {b} ± {ub}");
+        assert!(
+            (a - b).abs() < 0.05 * ua.min(ub),
+            "{p}: {a} ± {ua} vs {b} ± {ub}"
+        );
+        assert!(
+            (b - truth).abs() < 3.0 * ub + 1e-3 * truth.abs(),
+            "{p}: {b} ± {ub}"
+        );
     }
     let (rb, rr) = (builtin.final_.rms, restated.final_.rms);
     assert!((rb.accel_mps2 - rr.accel_mps2).abs() < 1e-3 * rb.accel_mps2);
     // Both as candidates: one is taken, and the report says the other is the same physics.
     let both = run(&rec, &["centripetal.effect"], &[]);
     assert_eq!(both.findings.len(), 2);
-    let f = both.findings.iter().find(|f| f.effect != "earth_rate").unwrap();
-    let other = if f.effect == "lever_arm" { "centripetal" } else { "lever_arm" };
-    assert!(f.evidence.not_separable_from.iter().any(|o| o == other), "{:?}", f.evidence);
+    let f = both
+        .findings
+        .iter()
+        .find(|f| f.effect != "earth_rate")
+        .unwrap();
+    let other = if f.effect == "lever_arm" {
+        "centripetal"
+    } else {
+        "lever_arm"
+    };
+    assert!(
+        f.evidence.not_separable_from.iter().any(|o| o == other),
+        "{:?}",
+        f.evidence
+    );
     // Only registry effects can be adopted in a procedure.
     assert_eq!(restated.adopt.as_deref(), Some("with earth_rate"));
     assert_eq!(restated.user_effects[0].effect, "centripetal");
@@ -123,10 +152,18 @@ fn physics_the_registry_lacks_is_found_from_its_file() {
         let truth = [20.0, 0.0, -15.0];
         add_k2(&mut rec, truth);
         let x = run(&rec, &["accel_k2.effect", "centripetal.effect"], &[]);
-        assert_eq!(found(&x), ["accel_k2", "earth_rate"], "seed {seed}: {:?}", x.rejected);
+        assert_eq!(
+            found(&x),
+            ["accel_k2", "earth_rate"],
+            "seed {seed}: {:?}",
+            x.rejected
+        );
         for (p, t) in ["x", "y", "z"].iter().zip(truth) {
             let (v, u) = estimate(&x, "accel_k2", p);
-            assert!((v - t).abs() < 3.0 * u, "seed {seed}: k2.{p} = {v} ± {u}, truth {t}");
+            assert!(
+                (v - t).abs() < 3.0 * u,
+                "seed {seed}: k2.{p} = {v} ± {u}, truth {t}"
+            );
             assert!(u < 2.0, "seed {seed}: k2.{p} ± {u}");
         }
         assert!(x.final_.rms.accel_mps2 < 1.2 * x.final_.noise_floor.accel_mps2);
@@ -135,11 +172,17 @@ fn physics_the_registry_lacks_is_found_from_its_file() {
         let top = &f.located[0];
         assert!(["ax", "az"].contains(&top.channel.as_str()), "{top:?}");
         assert!(top.rms_before > 1.25 * top.rms_after, "{top:?}");
-        assert!(top.rms_after < 1.1 * x.final_.noise_floor.accel_mps2, "{top:?}");
+        assert!(
+            top.rms_after < 1.1 * x.final_.noise_floor.accel_mps2,
+            "{top:?}"
+        );
         // Without the file the nonlinearity stays unexplained, on the held-out segments too.
         let bare = run(&rec, &[], &[]);
         assert!(!found(&bare).contains(&"accel_k2"), "seed {seed}");
         let (b, w) = (bare.final_.holdout_rms, x.final_.holdout_rms);
-        assert!(b.accel_mps2 > 1.02 * w.accel_mps2, "seed {seed}: {b:?} {w:?}");
+        assert!(
+            b.accel_mps2 > 1.02 * w.accel_mps2,
+            "seed {seed}: {b:?} {w:?}"
+        );
     }
 }

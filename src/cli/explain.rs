@@ -47,7 +47,11 @@ pub struct Args {
 /// by their `*.effect` files in name order.
 fn effect_files(args: &[PathBuf]) -> Result<Vec<(String, String)>, String> {
     let env: Vec<PathBuf> = std::env::var_os("RATECAL_EFFECTS")
-        .map(|v| std::env::split_paths(&v).filter(|p| !p.as_os_str().is_empty()).collect())
+        .map(|v| {
+            std::env::split_paths(&v)
+                .filter(|p| !p.as_os_str().is_empty())
+                .collect()
+        })
         .unwrap_or_default();
     let mut paths = Vec::new();
     for p in env.iter().chain(args) {
@@ -67,8 +71,12 @@ fn effect_files(args: &[PathBuf]) -> Result<Vec<(String, String)>, String> {
     paths
         .iter()
         .map(|p| {
-            let bytes = std::fs::read(p).map_err(|e| format!("cannot read {}: {e}", p.display()))?;
-            Ok((p.display().to_string(), String::from_utf8_lossy(&bytes).into_owned()))
+            let bytes =
+                std::fs::read(p).map_err(|e| format!("cannot read {}: {e}", p.display()))?;
+            Ok((
+                p.display().to_string(),
+                String::from_utf8_lossy(&bytes).into_owned(),
+            ))
         })
         .collect()
 }

@@ -2,7 +2,8 @@
 //! lowers the pairs to the effect AST, or turns pest's error into a located diagnostic.
 
 use super::{
-    BinOp, Contribution, EffectDef, EffectFile, EffectItem, Expr, ExprKind, MAX_EXPR_DEPTH, ParamDecl,
+    BinOp, Contribution, EffectDef, EffectFile, EffectItem, Expr, ExprKind, MAX_EXPR_DEPTH,
+    ParamDecl,
 };
 use crate::ast::{Span, Spanned};
 use crate::diag::Diagnostic;
@@ -87,9 +88,7 @@ fn rule_name(r: Rule) -> Option<&'static str> {
         Rule::contribution => "a contribution (`ax += ...`)",
         Rule::add_op | Rule::mul_op => "an operator",
         Rule::neg => "`-`",
-        Rule::expr | Rule::term | Rule::factor | Rule::power | Rule::exponent => {
-            "an expression"
-        }
+        Rule::expr | Rule::term | Rule::factor | Rule::power | Rule::exponent => "an expression",
         Rule::paren => "`(`",
         Rule::call => "a function call",
         _ => return None,
@@ -156,10 +155,7 @@ fn item(p: P, deep: &mut Option<Span>) -> Option<EffectItem> {
         Rule::param => EffectItem::Param(ParamDecl {
             name: text(inner.next()?),
             unit: string(inner.next()?),
-            needs: inner
-                .next()
-                .and_then(|n| n.into_inner().next())
-                .map(string),
+            needs: inner.next().and_then(|n| n.into_inner().next()).map(string),
             span: sp,
         }),
         Rule::contribution => {

@@ -40,7 +40,10 @@ fn precedence_and_associativity() {
     assert_eq!(one("-x^2"), "(-(x ^ 2))");
     assert_eq!(one("2 * -w_b.x"), "(2 * (-w_b.x))");
     assert_eq!(one("x^-1"), "(x ^ (-1))");
-    assert_eq!(one("(a + b) * sin(t_s / 60, 2)"), "((a + b) * sin((t_s / 60), 2))");
+    assert_eq!(
+        one("(a + b) * sin(t_s / 60, 2)"),
+        "((a + b) * sin((t_s / 60), 2))"
+    );
     assert_eq!(one("1.5e-3 * .5 * 2."), "((1.5e-3 * .5) * 2.)");
 }
 
@@ -58,8 +61,14 @@ fn items_keep_their_spans() {
     let EffectItem::Param(p) = &e.items[1] else {
         panic!()
     };
-    assert_eq!((p.name.node.as_str(), p.unit.node.as_str()), ("kx", "ug/g^2"));
-    assert_eq!(p.needs.as_ref().map(|n| n.node.as_str()), Some("gravity along X"));
+    assert_eq!(
+        (p.name.node.as_str(), p.unit.node.as_str()),
+        ("kx", "ug/g^2")
+    );
+    assert_eq!(
+        p.needs.as_ref().map(|n| n.node.as_str()),
+        Some("gravity along X")
+    );
     let EffectItem::Contribution(c) = &e.items[2] else {
         panic!()
     };
@@ -78,7 +87,11 @@ fn syntax_errors_point_at_the_place() {
 
 #[test]
 fn deep_nesting_is_refused_before_parsing() {
-    let deep = format!("effect e {{ ax += {}p{} }}", "(".repeat(5000), ")".repeat(5000));
+    let deep = format!(
+        "effect e {{ ax += {}p{} }}",
+        "(".repeat(5000),
+        ")".repeat(5000)
+    );
     let d = parse(&deep).unwrap_err();
     assert_eq!(d.code, "effect::too_deep");
     // Parentheses in strings and comments do not count.

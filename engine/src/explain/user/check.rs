@@ -59,8 +59,14 @@ pub(crate) fn check(
     for e in &file.effects {
         if let Some((_, origin)) = taken.iter().find(|t| t.0 == e.name.node) {
             let (message, label) = match origin {
-                None => (format!("`{}` is a built-in effect", e.name.node), "already in the registry".to_string()),
-                Some(f) => (format!("effect `{}` is also defined in {f}", e.name.node), format!("defined in {f} too")),
+                None => (
+                    format!("`{}` is a built-in effect", e.name.node),
+                    "already in the registry".to_string(),
+                ),
+                Some(f) => (
+                    format!("effect `{}` is also defined in {f}", e.name.node),
+                    format!("defined in {f} too"),
+                ),
             };
             diags.push(
                 Diagnostic::error("effect::duplicate", message)
@@ -83,10 +89,18 @@ pub(crate) fn check(
             out.push(c);
         }
     }
-    if diags.is_empty() { Ok(out) } else { Err(diags) }
+    if diags.is_empty() {
+        Ok(out)
+    } else {
+        Err(diags)
+    }
 }
 
-fn effect_def(e: &EffectDef, signals: &[SignalDef], diags: &mut Vec<Diagnostic>) -> Option<Checked> {
+fn effect_def(
+    e: &EffectDef,
+    signals: &[SignalDef],
+    diags: &mut Vec<Diagnostic>,
+) -> Option<Checked> {
     let before = diags.len();
     let mut explanation: Option<&Spanned<String>> = None;
     let mut follows: Option<&Spanned<String>> = None;
@@ -203,9 +217,17 @@ fn effect_def(e: &EffectDef, signals: &[SignalDef], diags: &mut Vec<Diagnostic>)
     diags.extend(cx.diags);
     if explanation.is_none() {
         diags.push(
-            Diagnostic::error("effect::missing", format!("effect `{}` has no explanation", e.name.node))
-                .label(e.name.span, "explain shows an explanation for every finding")
-                .help("add `explanation \"...\"`: the physics, in one line an engineer reads in a report"),
+            Diagnostic::error(
+                "effect::missing",
+                format!("effect `{}` has no explanation", e.name.node),
+            )
+            .label(
+                e.name.span,
+                "explain shows an explanation for every finding",
+            )
+            .help(
+                "add `explanation \"...\"`: the physics, in one line an engineer reads in a report",
+            ),
         );
     }
     if !any_contribution || params.is_empty() {
@@ -221,9 +243,12 @@ fn effect_def(e: &EffectDef, signals: &[SignalDef], diags: &mut Vec<Diagnostic>)
     for (k, (name, span)) in params.iter().enumerate() {
         if !used.contains(&k) && any_contribution {
             diags.push(
-                Diagnostic::error("effect::unused_parameter", format!("parameter `{name}` is not used"))
-                    .label(*span, "no contribution reads it")
-                    .help("use it in a contribution or remove it: the fit could not determine it"),
+                Diagnostic::error(
+                    "effect::unused_parameter",
+                    format!("parameter `{name}` is not used"),
+                )
+                .label(*span, "no contribution reads it")
+                .help("use it in a contribution or remove it: the fit could not determine it"),
             );
         }
     }
@@ -278,9 +303,12 @@ fn lin(e: &Expr, cx: &mut Cx) -> (Ex, Class) {
             Ok(v) if v.is_finite() => (Ex::Num(v), Class::Free),
             _ => {
                 cx.diags.push(
-                    Diagnostic::error("effect::bad_number", format!("`{n}` is not a finite number"))
-                        .label(e.span, "out of range")
-                        .help("write a number between about -1e308 and 1e308"),
+                    Diagnostic::error(
+                        "effect::bad_number",
+                        format!("`{n}` is not a finite number"),
+                    )
+                    .label(e.span, "out of range")
+                    .help("write a number between about -1e308 and 1e308"),
                 );
                 (Ex::Num(0.0), Class::Bad)
             }
@@ -294,13 +322,16 @@ fn lin(e: &Expr, cx: &mut Cx) -> (Ex, Class) {
             let Some((_, which)) = FUNCTIONS.iter().find(|(k, _)| *k == f.node) else {
                 let names: Vec<&str> = FUNCTIONS.iter().map(|f| f.0).collect();
                 cx.diags.push(
-                    Diagnostic::error("effect::unknown_function", format!("unknown function `{}`", f.node))
-                        .label(f.span, "not a function of the expression language")
-                        .help(format!(
-                            "{}the functions are {}",
-                            suggestion(&f.node, names.iter().copied()),
-                            names.join(", ")
-                        )),
+                    Diagnostic::error(
+                        "effect::unknown_function",
+                        format!("unknown function `{}`", f.node),
+                    )
+                    .label(f.span, "not a function of the expression language")
+                    .help(format!(
+                        "{}the functions are {}",
+                        suggestion(&f.node, names.iter().copied()),
+                        names.join(", ")
+                    )),
                 );
                 return (Ex::Num(0.0), Class::Bad);
             };
@@ -347,20 +378,32 @@ fn lin(e: &Expr, cx: &mut Cx) -> (Ex, Class) {
                 }
                 (BinOp::Mul, Linear, Linear) => {
                     cx.diags.push(
-                        not_linear(e.span, "a product of two parameter terms", "parameters multiply each other")
-                            .label(a.span, "holds a parameter")
-                            .label(b.span, "holds a parameter"),
+                        not_linear(
+                            e.span,
+                            "a product of two parameter terms",
+                            "parameters multiply each other",
+                        )
+                        .label(a.span, "holds a parameter")
+                        .label(b.span, "holds a parameter"),
                     );
                     return (Ex::Num(0.0), Class::Bad);
                 }
                 (BinOp::Mul, _, _) => Linear,
                 (BinOp::Div, Linear, Free) => Linear,
                 (BinOp::Div, _, _) => {
-                    cx.diags.push(not_linear(b.span, "holds a parameter", "a parameter in a divisor"));
+                    cx.diags.push(not_linear(
+                        b.span,
+                        "holds a parameter",
+                        "a parameter in a divisor",
+                    ));
                     return (Ex::Num(0.0), Class::Bad);
                 }
                 (BinOp::Pow, _, _) => {
-                    cx.diags.push(not_linear(e.span, "a power of a parameter term", "a parameter in a power"));
+                    cx.diags.push(not_linear(
+                        e.span,
+                        "a power of a parameter term",
+                        "a parameter in a power",
+                    ));
                     return (Ex::Num(0.0), Class::Bad);
                 }
             };
@@ -396,9 +439,19 @@ fn name(n: &str, span: Span, cx: &mut Cx) -> (Ex, Class) {
         .chain(CONSTANTS.iter().map(|c| c.0));
     let hint = suggestion(n, known);
     let (what, help) = if n.contains('.') {
-        ("signal", format!("{hint}signals are written `f_b.x`, `w_b.y`, `up_b.z`... (docs/user-effects.md)"))
+        (
+            "signal",
+            format!(
+                "{hint}signals are written `f_b.x`, `w_b.y`, `up_b.z`... (docs/user-effects.md)"
+            ),
+        )
     } else {
-        ("parameter or signal", format!("{hint}declare it with `param {n} unit \"...\" needs \"...\"`, or use a signal of docs/user-effects.md"))
+        (
+            "parameter or signal",
+            format!(
+                "{hint}declare it with `param {n} unit \"...\" needs \"...\"`, or use a signal of docs/user-effects.md"
+            ),
+        )
     };
     cx.diags.push(
         Diagnostic::error("effect::unknown_name", format!("unknown {what} `{n}`"))

@@ -71,7 +71,8 @@ pub fn signals() -> Vec<SignalDef> {
 }
 
 /// Named constants: `pi`, and `deg` (one degree in radians: `w_b.x / deg` is deg/s).
-pub const CONSTANTS: [(&str, f64); 2] = [("pi", std::f64::consts::PI), ("deg", ratecal_physics::DEG)];
+pub const CONSTANTS: [(&str, f64); 2] =
+    [("pi", std::f64::consts::PI), ("deg", ratecal_physics::DEG)];
 
 /// A function of one argument.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

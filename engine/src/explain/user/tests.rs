@@ -32,8 +32,7 @@ fn codes(text: &str) -> Vec<&'static str> {
 
 #[test]
 fn restated_centripetal_terms_match_the_lever_arm() {
-    let fx = one(
-        "effect centripetal {
+    let fx = one("effect centripetal {
            explanation \"centripetal acceleration at the sensing points\"
            param rxx_mm unit \"mm\" needs \"rotate about Y or Z\"
            param ryy_mm unit \"mm\" needs \"rotate about X or Z\"
@@ -41,8 +40,7 @@ fn restated_centripetal_terms_match_the_lever_arm() {
            ax += rxx_mm * 1e-3 * -(w_b.y^2 + w_b.z^2)
            ay += ryy_mm * 1e-3 * -(w_b.x^2 + w_b.z^2)
            az += -rzz_mm / 1000 * (w_b.x^2 + w_b.y^2)
-         }",
-    );
+         }");
     let lever = ratecal_physics::effect("lever_arm").unwrap();
     for k in [0.0, 0.4, -1.3] {
         let s = sig(k);
@@ -57,22 +55,23 @@ fn restated_centripetal_terms_match_the_lever_arm() {
         }
     }
     assert_eq!(fx.sensors(), [ratecal_physics::Sensor::Accel]);
-    assert_eq!(fx.params()[1].channel, Some((ratecal_physics::Sensor::Accel, 1)));
+    assert_eq!(
+        fx.params()[1].channel,
+        Some((ratecal_physics::Sensor::Accel, 1))
+    );
     assert_eq!(fx.follows(), "w_b.x, w_b.y, w_b.z");
 }
 
 #[test]
 fn regressors_are_the_derivatives_of_a_sum_of_terms() {
-    let fx = one(
-        "effect mix {
+    let fx = one("effect mix {
            explanation \"x\" follows \"attitude and temperature\"
            param a unit \"1\" needs \"m\"
            param b unit \"1\" needs \"m\"
            gx += (a + 2 * b) * w_b.x / deg - b * f_b.y / g
            gz += a * up_b.z * sin(pi / 6) + b * dtemp_c * t_s
            ax += a * sqrt(abs(north_b.x)) - (-b) * earth_b.z
-         }",
-    );
+         }");
     let s = sig(0.8);
     let mut p = [Partials::default(); 2];
     fx.regressors(&s, &mut p);
