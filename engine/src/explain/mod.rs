@@ -4,7 +4,9 @@
 //! The recording is accumulated once ([`data`]); the nominal model is fitted as the
 //! standard would; then forward selection ([`select`]) adds catalogue effects one at a
 //! time, each judged by a Wald test with the honest covariance (white noise plus the
-//! wandering bias) and confirmed on segments held out of every fit.
+//! wandering bias) and confirmed on segments held out of every fit. Candidates are the
+//! registry's effects and the user effects of `*.effect` files ([`user`]); with a
+//! procedure, [`adoption`] writes the diff that declares the findings in its fits.
 
 // Numeric loops index the six channels of several arrays at once.
 #![allow(clippy::needless_range_loop)]

@@ -7,6 +7,7 @@
 mod check;
 mod effect;
 mod expr;
+mod linear;
 mod signals;
 
 pub use effect::UserEffect;
