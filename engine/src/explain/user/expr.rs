@@ -66,8 +66,8 @@ pub(crate) fn neg(a: Ex) -> Ex {
 pub(crate) fn bin(op: Op, a: Ex, b: Ex) -> Ex {
     match (op, a, b) {
         (op, Ex::Num(x), Ex::Num(y)) => Ex::Num(op.apply(x, y)),
-        (Op::Mul, Ex::Num(x), b) if x == 1.0 => b,
-        (Op::Mul | Op::Div, a, Ex::Num(y)) if y == 1.0 => a,
+        (Op::Mul, Ex::Num(1.0), b) => b,
+        (Op::Mul | Op::Div, a, Ex::Num(1.0)) => a,
         (op, a, b) => Ex::Bin(op, Box::new(a), Box::new(b)),
     }
 }
