@@ -87,9 +87,20 @@ fn effects_map_to_the_physics_parameters() {
     assert!((of("gyro_scale")[1] + 310.0).abs() < 1e-9);
     assert!((of("accel_bias")[0] - 1.2e-3 * 9.80665).abs() < 1e-15);
     // The Earth's rate at the site is a term like the others; effects absent are absent.
-    assert_eq!(of("earth_rate"), ratecal_physics::effects::EarthRate::values(55.70));
-    assert!(m.terms.iter().all(|t| t.effect.id() != "lever_arm" || t.values.len() == 9));
-    assert!(m.terms.iter().all(|t| t.effect.id() != "gyro_thermal_drift"));
+    assert_eq!(
+        of("earth_rate"),
+        ratecal_physics::effects::EarthRate::values(55.70)
+    );
+    assert!(
+        m.terms
+            .iter()
+            .all(|t| t.effect.id() != "lever_arm" || t.values.len() == 9)
+    );
+    assert!(
+        m.terms
+            .iter()
+            .all(|t| t.effect.id() != "gyro_thermal_drift")
+    );
     assert_eq!(s.time_offset_s(), 0.0025);
 }
 

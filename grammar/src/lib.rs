@@ -12,6 +12,7 @@
 pub mod ast;
 mod comments;
 mod diag;
+pub mod effect;
 mod fmt;
 mod lower;
 

@@ -1,10 +1,12 @@
-//! `ratecal explain RUN_DIR [--procedure PROCEDURE] [--format text|json]`: where the
-//! recording and the nominal model disagree, what physics was left out, the refit with
-//! it. Exit codes, like diff(1): 0 nothing found, 1 findings reported, 2 error.
+//! `ratecal explain RUN_DIR [--procedure PROCEDURE] [--effects FILE_OR_DIR]... [--without ID]...
+//! [--format text|json]`: where the recording and the nominal model disagree, what physics
+//! was left out, the refit with it. Exit codes, like diff(1): 0 nothing found, 1 findings
+//! reported, 2 error.
 
-use ratecal_engine::explain::{self, NominalModel, Options};
+use super::procedure;
+use ratecal_engine::explain::{self, AdoptTarget, NominalModel, Options, UserEffect};
 use ratecal_engine::recording;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// Output format.
@@ -22,15 +24,90 @@ pub struct Args {
     /// Recording folder (manifest.yaml, imu.csv, table.csv), from any acquisition system.
     #[arg(value_name = "RUN_DIR")]
     run: PathBuf,
-    /// Procedure whose fits are the nominal model (default: the standard's seed model).
+    /// Procedure whose fits are the nominal model (default: the standard's seed model);
+    /// "how to adopt" becomes a diff against its file.
     #[arg(long, value_name = "PROCEDURE")]
     procedure: Option<PathBuf>,
+    /// Candidate effects defined in a file, or every `*.effect` file of a folder
+    /// (docs/user-effects.md); repeatable. `RATECAL_EFFECTS` adds paths too (`:`-separated).
+    #[arg(long, value_name = "FILE_OR_DIR")]
+    effects: Vec<PathBuf>,
+    /// Leave a registry effect out of the candidates (repeatable).
+    #[arg(long, value_name = "EFFECT")]
+    without: Vec<String>,
     /// Output format.
     #[arg(long, value_enum, default_value = "text")]
     format: Format,
     /// Accept a released procedure version whose text changed after release.
     #[arg(long)]
     allow_changed: bool,
+}
+
+/// The effect files named by `--effects` and `RATECAL_EFFECTS`: files as given, folders
+/// by their `*.effect` files in name order.
+fn effect_files(args: &[PathBuf]) -> Result<Vec<(String, String)>, String> {
+    let env: Vec<PathBuf> = std::env::var_os("RATECAL_EFFECTS")
+        .map(|v| {
+            std::env::split_paths(&v)
+                .filter(|p| !p.as_os_str().is_empty())
+                .collect()
+        })
+        .unwrap_or_default();
+    let mut paths = Vec::new();
+    for p in env.iter().chain(args) {
+        if p.is_dir() {
+            let mut inside: Vec<PathBuf> = std::fs::read_dir(p)
+                .map_err(|e| format!("cannot read the folder {}: {e}", p.display()))?
+                .flatten()
+                .map(|e| e.path())
+                .filter(|f| f.is_file() && f.extension().is_some_and(|x| x == "effect"))
+                .collect();
+            inside.sort();
+            paths.extend(inside);
+        } else {
+            paths.push(p.clone());
+        }
+    }
+    paths
+        .iter()
+        .map(|p| {
+            let bytes =
+                std::fs::read(p).map_err(|e| format!("cannot read {}: {e}", p.display()))?;
+            Ok((
+                p.display().to_string(),
+                String::from_utf8_lossy(&bytes).into_owned(),
+            ))
+        })
+        .collect()
+}
+
+fn load_effects(args: &[PathBuf]) -> Result<Vec<&'static UserEffect>, ()> {
+    let files = effect_files(args).map_err(|e| errln!("error: {e}"))?;
+    explain::user::load(&files).map_err(|diags| diags.iter().for_each(procedure::report))
+}
+
+/// The file a diff is made against: the procedure as resolved, and for a released version
+/// the next version's file in the same folder.
+fn adopt_target(arg: &Path) -> Option<AdoptTarget> {
+    let file = procedure::read(&arg.display().to_string()).ok()?;
+    let dir = file.path.parent()?;
+    let name = file.path.file_name()?.to_string_lossy().into_owned();
+    let lock = std::fs::read_to_string(dir.join(ratecal_engine::audit::versions::LOCK_FILE));
+    let next = lock.ok().and_then(|lock| {
+        let siblings: Vec<String> = std::fs::read_dir(dir)
+            .ok()?
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .collect();
+        let v = explain::next_version(&name, &lock, &siblings)?;
+        let path = file.path.with_file_name(format!("{v}.rcal"));
+        Some((v, path.display().to_string()))
+    });
+    Some(AdoptTarget {
+        path: file.display,
+        text: file.text,
+        next,
+    })
 }
 
 /// Runs the subcommand.
@@ -42,6 +119,9 @@ pub fn main(args: Args) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    let Ok(user) = load_effects(&args.effects) else {
+        return ExitCode::from(2);
+    };
     let nominal = match &args.procedure {
         None => NominalModel::seed(),
         Some(p) => match super::analyze::load_plan(p, args.allow_changed) {
@@ -51,9 +131,38 @@ pub fn main(args: Args) -> ExitCode {
     };
     let opts = Options {
         path: args.run.display().to_string(),
+        user,
+        without: args.without.clone(),
         ..Options::default()
     };
-    let x = explain::explain(&rec, &nominal, &opts);
+    let mut x = explain::explain(&rec, &nominal, &opts);
+    // Only the registry's effects can be declared in a procedure.
+    let ids: Vec<String> = x
+        .findings
+        .iter()
+        .filter(|f| f.defined_in.is_none())
+        .map(|f| f.effect.clone())
+        .collect();
+    if let Some(p) = &args.procedure
+        && !ids.is_empty()
+    {
+        let ids: Vec<&str> = ids.iter().map(String::as_str).collect();
+        match adopt_target(p).map(|t| explain::adoption(&t, &ids)) {
+            Some(Ok(a)) => {
+                x.adopt_diff = a.diff;
+                for id in a.not_placed {
+                    x.warnings.push(format!(
+                        "{id}: the procedure has no fit statement of the sensors it acts on to declare it"
+                    ));
+                }
+            }
+            Some(Err(e)) => x.warnings.push(format!("no adoption diff: {e}")),
+            None => x.warnings.push(format!(
+                "no adoption diff: {} is not a procedure file",
+                p.display()
+            )),
+        }
+    }
     let json = serde_json::to_string_pretty(&x).expect("plain data serializes");
     // Kept in a ratecal run folder (not in another system's recording): its report shows it.
     if rec.manifest.run.is_some() {

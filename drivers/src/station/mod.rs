@@ -9,8 +9,8 @@ mod quantity;
 
 pub use describe::{Environment, ImuIdentity, StationInfo};
 
-pub use faults::{AxisName, DropoutMode, FaultSpec, LinkName, TableFaultMode};
 pub use effects::EffectsSpec;
+pub use faults::{AxisName, DropoutMode, FaultSpec, LinkName, TableFaultMode};
 pub use file::{
     AmbientSpec, EnvironmentSpec, ImuDriverSpec, ImuSpec, ImuTemperatureSpec, MountSpec,
     SettlingSpec, SiteSpec, Station, TableDriverSpec, TableSpec, TemperatureSpec,

@@ -1,10 +1,10 @@
 //! The recording accumulated once for every model explain will try: every segment, every
 //! registry effect's columns, and which segments are held out.
 
-use crate::fit::joint::{Layout, SegAcc, accumulate, excitation};
+use crate::fit::joint::{Layout, SegAcc, accumulate, excitation, mean_temperature};
 use crate::fit::prep::geometries;
 use crate::recording::{Recording, SegmentKind};
-use ratecal_physics::REGISTRY;
+use ratecal_physics::Effect;
 
 /// Accumulated segments and the split between fitted and held-out ones.
 pub(crate) struct Data {
@@ -19,20 +19,14 @@ pub(crate) struct Data {
 }
 
 impl Data {
-    /// Accumulates every segment (in parallel) and chooses the held-out ones: every third
-    /// segment of each kind, never the longest static one.
-    pub(crate) fn new(rec: &Recording) -> Data {
+    /// Accumulates every segment (in parallel) over these effects (the registry's and user
+    /// effects) and chooses the held-out ones: every third segment of each kind, never the
+    /// longest static one.
+    pub(crate) fn with_effects(rec: &Recording, effects: Vec<&'static dyn Effect>) -> Data {
         use rayon::prelude::*;
-        let layout = Layout::new(REGISTRY.to_vec());
+        let layout = Layout::new(effects);
         let geos = geometries(rec);
-        let t_ref = rec.imu.temp.as_ref().map_or(0.0, |t| {
-            let v: Vec<f64> = t.iter().copied().filter(|x| x.is_finite()).collect();
-            if v.is_empty() {
-                0.0
-            } else {
-                v.iter().sum::<f64>() / v.len() as f64
-            }
-        });
+        let t_ref = mean_temperature(rec);
         let segs = &rec.manifest.segments;
         let accs: Vec<SegAcc> = (0..segs.len())
             .into_par_iter()

@@ -4,26 +4,35 @@
 //! The recording is accumulated once ([`data`]); the nominal model is fitted as the
 //! standard would; then forward selection ([`select`]) adds catalogue effects one at a
 //! time, each judged by a Wald test with the honest covariance (white noise plus the
-//! wandering bias) and confirmed on segments held out of every fit.
+//! wandering bias) and confirmed on segments held out of every fit. Candidates are the
+//! registry's effects and the user effects of `*.effect` files ([`user`]); with a
+//! procedure, [`adoption`] writes the diff that declares the findings in its fits.
 
 // Numeric loops index the six channels of several arrays at once.
 #![allow(clippy::needless_range_loop)]
 
+mod adopt;
 pub(crate) mod data;
 mod locate;
 pub(crate) mod model;
 mod output;
 mod select;
 mod text;
+pub mod user;
 
+pub use adopt::{AdoptTarget, Adoption, adoption, next_version};
 pub use model::NominalModel;
-pub use output::{Evidence, Explanation, FORMAT, Final, Finding, Located, Nominal, ParamOut, Rms};
+pub use output::{
+    Evidence, Explanation, FORMAT, Final, Finding, Located, Nominal, ParamOut, Rms, UserEffectOut,
+};
 pub use text::render_text;
+pub use user::UserEffect;
 
 use crate::fit::joint::Fit;
 use crate::recording::Recording;
 use data::Data;
 use model::{Terms, fit, rms, seed_segments};
+use ratecal_physics::{Effect, REGISTRY};
 use std::collections::BTreeMap;
 
 /// What explain may be told besides the recording.
@@ -33,6 +42,10 @@ pub struct Options {
     pub path: String,
     /// Family-wise false-discovery threshold of one selection step.
     pub alpha: f64,
+    /// Candidate effects read from files ([`user::load`]), tried with the registry's.
+    pub user: Vec<&'static UserEffect>,
+    /// Registry ids left out of the candidates.
+    pub without: Vec<String>,
 }
 
 impl Default for Options {
@@ -40,15 +53,35 @@ impl Default for Options {
         Options {
             path: String::new(),
             alpha: 1e-3,
+            user: Vec::new(),
+            without: Vec::new(),
         }
     }
 }
 
 /// Explains a recording against a nominal model.
 pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Explanation {
-    let data = Data::new(rec);
+    let mut effects: Vec<&'static dyn Effect> = REGISTRY.to_vec();
+    effects.extend(opts.user.iter().map(|u| *u as &'static dyn Effect));
+    let nonfinite: Vec<usize> = opts.user.iter().map(|u| u.nonfinite()).collect();
+    let data = Data::with_effects(rec, effects);
     let lay = &data.layout;
     let mut warnings = Vec::new();
+    for (u, before) in opts.user.iter().zip(nonfinite) {
+        let n = u.nonfinite() - before;
+        if n > 0 {
+            warnings.push(format!(
+                "user effect `{}` ({}): {n} regressor values were not finite and were taken as zero",
+                u.id(),
+                u.file()
+            ));
+        }
+    }
+    for id in &opts.without {
+        if lay.index(id).is_none_or(|e| lay.effects[e].nominal()) {
+            warnings.push(format!("--without {id}: not a candidate effect"));
+        }
+    }
     let index = |id: &str| lay.index(id).expect("a registry id");
     let start = Terms {
         effects: nominal.effects.iter().map(|id| index(id)).collect(),
@@ -79,7 +112,7 @@ pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Expla
         rms: rms(&data, &nom, &all),
         holdout_rms: rms(&data, &nom, &data.held),
     };
-    let (steps, rejected) = select::forward(&data, &start, opts.alpha);
+    let (steps, rejected) = select::forward(&data, &start, opts.alpha, &opts.without);
     let work = data.working();
     let last = match steps.last() {
         Some(s) => s.after.clone(),
@@ -96,7 +129,15 @@ pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Expla
     let whole = fit(&data, &terms, &all, &all);
     let findings: Vec<Finding> = steps
         .iter()
-        .map(|step| finding(rec, &data, step, &terms, &whole))
+        .map(|step| {
+            let mut f = finding(rec, &data, step, &terms, &whole);
+            f.defined_in = opts
+                .user
+                .iter()
+                .find(|u| u.id() == f.effect)
+                .map(|u| u.file().to_string());
+            f
+        })
         .collect();
     let floor = |cs: std::ops::Range<usize>| {
         let v: Vec<f64> = cs.map(|c| last.noise[c].sigma.powi(2)).collect();
@@ -111,10 +152,13 @@ pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Expla
             gyro_dps: floor(3..6),
         },
     };
-    let adopt = (!findings.is_empty()).then(|| {
-        let ids: Vec<&str> = findings.iter().map(|f| f.effect.as_str()).collect();
-        format!("with {}", ids.join(", "))
-    });
+    // Only the registry's effects can be declared in a procedure.
+    let ids: Vec<&str> = findings
+        .iter()
+        .filter(|f| f.defined_in.is_none())
+        .map(|f| f.effect.as_str())
+        .collect();
+    let adopt = (!ids.is_empty()).then(|| format!("with {}", ids.join(", ")));
     Explanation {
         format: FORMAT.into(),
         recording: opts.path.clone(),
@@ -128,6 +172,15 @@ pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Expla
             .collect(),
         rejected,
         adopt,
+        adopt_diff: None,
+        user_effects: opts
+            .user
+            .iter()
+            .map(|u| UserEffectOut {
+                effect: u.id().to_string(),
+                file: u.file().to_string(),
+            })
+            .collect(),
         warnings,
     }
 }
@@ -188,5 +241,6 @@ fn finding(
         parameters,
         evidence,
         rms_after: rms(data, &step.after, &all),
+        defined_in: None,
     }
 }

@@ -105,6 +105,18 @@ pub struct Finding {
     pub evidence: Evidence,
     /// RMS over every segment once this effect (and those before it) is modelled.
     pub rms_after: Rms,
+    /// The file of a user effect (docs/user-effects.md); absent for the registry's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub defined_in: Option<String>,
+}
+
+/// A user effect explain tried, and its file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct UserEffectOut {
+    /// Its id.
+    pub effect: String,
+    /// The file that defines it.
+    pub file: String,
 }
 
 /// The model with every finding.
@@ -138,8 +150,14 @@ pub struct Explanation {
     pub held_out: Vec<String>,
     /// Candidates tried and not reported, with their last p-value.
     pub rejected: BTreeMap<String, f64>,
-    /// How to adopt the findings: the effects to add to the procedure's fits.
+    /// How to adopt the findings: the registry effects to add to the procedure's fits.
     pub adopt: Option<String>,
+    /// With a procedure: the unified diff that adds them to its fit statements.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub adopt_diff: Option<String>,
+    /// User effects tried besides the registry's.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub user_effects: Vec<UserEffectOut>,
     /// What could not be done as asked.
     pub warnings: Vec<String>,
 }

@@ -82,12 +82,14 @@ pub(crate) fn holdout_score(data: &Data, fit: &Fit, base: &Fit) -> f64 {
 }
 
 /// Runs the selection from `start` over the working segments. `alpha` is the family-wise
-/// threshold of one step (Bonferroni over the candidates left). Returns the steps and the
+/// threshold of one step (Bonferroni over the candidates left); `without` are ids left out
+/// of the candidates. Returns the steps and the
 /// last p-value of every candidate not taken.
 pub(crate) fn forward(
     data: &Data,
     start: &Terms,
     alpha: f64,
+    without: &[String],
 ) -> (Vec<Step>, std::collections::BTreeMap<String, f64>) {
     let work = data.working();
     let lay = &data.layout;
@@ -95,6 +97,7 @@ pub(crate) fn forward(
     let mut candidates: Vec<usize> = (0..lay.effects.len())
         .filter(|e| {
             !lay.effects[*e].nominal()
+                && !without.iter().any(|w| w == lay.effects[*e].id())
                 && !terms.effects.contains(e)
                 && !terms.fixed.iter().any(|f| f.0 == *e)
         })

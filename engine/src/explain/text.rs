@@ -29,7 +29,12 @@ pub fn render_text(x: &Explanation) -> String {
         );
     }
     for (k, f) in x.findings.iter().enumerate() {
-        let _ = writeln!(s, "\n{}. {}: {}", k + 1, f.effect, f.explanation);
+        let origin = f
+            .defined_in
+            .as_ref()
+            .map(|file| format!(" (user effect, {file})"))
+            .unwrap_or_default();
+        let _ = writeln!(s, "\n{}. {}{origin}: {}", k + 1, f.effect, f.explanation);
         let _ = writeln!(
             s,
             "   evidence: chi2 {:.1} on {} dof, p = {:.1e} (threshold {:.1e}); held-out RMS {} -> {}",
@@ -81,8 +86,30 @@ pub fn render_text(x: &Explanation) -> String {
         rms(&x.final_.holdout_rms),
         rms(&x.final_.noise_floor)
     );
-    if let Some(a) = &x.adopt {
-        let _ = writeln!(s, "to adopt: add `{a}` to the procedure's fit statements");
+    match (&x.adopt_diff, &x.adopt) {
+        (Some(d), _) => {
+            let _ = write!(
+                s,
+                "to adopt, apply this diff (`patch -p0` or `git apply -p0`):\n{d}"
+            );
+        }
+        (None, Some(a)) => {
+            let _ = writeln!(s, "to adopt: add `{a}` to the procedure's fit statements");
+        }
+        (None, None) => {}
+    }
+    let user: Vec<&str> = x
+        .findings
+        .iter()
+        .filter(|f| f.defined_in.is_some())
+        .map(|f| f.effect.as_str())
+        .collect();
+    if !user.is_empty() {
+        let _ = writeln!(
+            s,
+            "user effects ({}) cannot be declared in a procedure: add them to the effect registry (docs/effects.md) to calibrate them",
+            user.join(", ")
+        );
     }
     for w in &x.warnings {
         let _ = writeln!(s, "warning: {w}");

@@ -8,6 +8,7 @@
 
 use super::joint::{
     Layout, SegAcc, Terms, accumulate, excitation, excites, fit_terms, latitude_of,
+    mean_temperature,
 };
 use super::prep::{SegData, geometries};
 use super::select::Selection;
@@ -87,17 +88,6 @@ fn key(id: &str, param: &str, unit: &'static str, nominal: &[&str]) -> (String, 
         }
         _ => (format!("{id}.{param}"), unit),
     }
-}
-
-/// The IMU temperature the thermal terms refer to: the recording's mean.
-pub(crate) fn mean_temperature(rec: &Recording) -> f64 {
-    rec.imu.temp.as_ref().map_or(0.0, |t| {
-        let (s, n) = t
-            .iter()
-            .filter(|x| x.is_finite())
-            .fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
-        if n == 0 { 0.0 } else { s / n as f64 }
-    })
 }
 
 /// Fits the models and writes their parameters into `out`.

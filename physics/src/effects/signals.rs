@@ -24,6 +24,9 @@ pub struct Signals {
     pub dtemp_c: f64,
     /// Local gravity, m/s^2.
     pub g: f64,
+    /// Time stamp of the instant, s (the recording's time axis; 0 unless set with
+    /// [`Signals::at`]). No registry effect reads it; user effects may.
+    pub t_s: f64,
 }
 
 impl Signals {
@@ -43,7 +46,14 @@ impl Signals {
             dw_ib: snap.c_bp * snap.dw_p - w_b.cross(&earth_b),
             dtemp_c,
             g: site.gravity_mps2,
+            t_s: 0.0,
         }
+    }
+
+    /// The same signals stamped at time `t_s`, s.
+    pub fn at(mut self, t_s: f64) -> Self {
+        self.t_s = t_s;
+        self
     }
 
     /// `w_ib` in deg/s: what ideal gyros read (table motion and the Earth's rate).

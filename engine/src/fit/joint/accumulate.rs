@@ -68,6 +68,17 @@ pub(crate) fn state_at(rec: &Recording, j: &mut usize, t: f64) -> TableState {
     }
 }
 
+/// The IMU temperature the thermal terms refer to: the recording's mean.
+pub(crate) fn mean_temperature(rec: &Recording) -> f64 {
+    rec.imu.temp.as_ref().map_or(0.0, |t| {
+        let (s, n) = t
+            .iter()
+            .filter(|x| x.is_finite())
+            .fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
+        if n == 0 { 0.0 } else { s / n as f64 }
+    })
+}
+
 /// Accumulates one segment. `t_ref_c` is the temperature the thermal terms refer to.
 /// With the segment's preprocessed data (`prepped`, over the same samples), the outputs
 /// are its (filtered) ones and the samples it flagged as outliers are left out.
@@ -146,7 +157,7 @@ pub(crate) fn accumulate(
         }
         let snap = state.snapshot(geo, &site);
         let dtemp = imu.temp.as_ref().map_or(0.0, |tc| tc[i] - t_ref_c);
-        let sig = Signals::new(&snap, &site, if dtemp.is_finite() { dtemp } else { 0.0 });
+        let sig = Signals::new(&snap, &site, if dtemp.is_finite() { dtemp } else { 0.0 }).at(t);
         for (e, fx) in layout.effects.iter().enumerate() {
             fx.regressors(&sig, &mut parts[layout.columns_of(e)]);
         }

@@ -13,7 +13,7 @@ mod solve;
 mod terms;
 mod tri;
 
-pub(crate) use accumulate::{SegAcc, accumulate, seg_rss};
+pub(crate) use accumulate::{SegAcc, accumulate, mean_temperature, seg_rss};
 pub(crate) use solve::{Fit, FitRequest, rss_on, solve};
 pub(crate) use terms::{Terms, excitation, excites, fit_terms, latitude_of};
 
