@@ -7,6 +7,7 @@ pub mod audit;
 pub mod check;
 pub mod explain;
 pub mod fit;
+pub mod measured;
 pub mod plan;
 pub mod recording;
 pub mod render;

@@ -15,7 +15,6 @@ mod effects;
 mod gyro;
 pub(crate) mod joint;
 mod lsq;
-mod measured;
 pub(crate) mod prep;
 mod repeat;
 mod select;
@@ -24,7 +23,6 @@ mod stats;
 mod temp;
 
 pub use allan::overlapping_adev;
-pub use measured::format_measured;
 pub use repeat::analyze_runs;
 
 use crate::plan::{Outliers, Plan};
