@@ -17,7 +17,9 @@ mod select;
 mod text;
 
 pub use model::NominalModel;
-pub use output::{Evidence, Explanation, FORMAT, Final, Finding, Located, Nominal, ParamOut, Rms};
+pub use output::{
+    Evidence, Explanation, FORMAT, Final, Finding, Located, Nominal, ParamOut, Rms, SegmentRms,
+};
 pub use text::render_text;
 
 use crate::recording::Recording;
@@ -168,6 +170,7 @@ fn finding(rec: &Recording, data: &Data, step: &select::Step, terms: &Terms) -> 
         effect: fx.id().into(),
         explanation: fx.explanation().into(),
         located: locate::locate(rec, data, step),
+        residuals: locate::per_segment(rec, data, step),
         parameters,
         evidence,
         rms_after: rms(data, &step.after, &all),
