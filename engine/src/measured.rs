@@ -3,7 +3,8 @@
 //! value rounded to the same decimal place, `0.01234 ± 0.00056 m/s^2`, `-1120 ± 190 ppm`.
 //!
 //! The one implementation: the terminal (`analyze`, `run`, `explain`, `archive trend`) and
-//! the report filter `measured` all print through [`format_measured`]. The rule:
+//! the report filter `measured` all print through [`format_measured`] (and [`format_value`]
+//! for a value without an uncertainty). The rule:
 //! - `u` to two significant digits, rounded half up on its decimal form (`0.0995` -> `0.10`,
 //!   `0.0125` -> `0.013`); the value rounded half up (away from zero) at the place of `u`'s
 //!   second digit, in the integer digits too (`-1118.87 ± 190.1` -> `-1120 ± 190`: the `0`s
@@ -26,6 +27,17 @@ const PLAIN_HI: i32 = 4;
 /// `value ± u unit` (no unit when `unit` is empty), as the module doc says.
 pub fn format_measured(value: f64, u: f64, unit: &str) -> String {
     let text = measured_number(value, u);
+    if unit.is_empty() {
+        text
+    } else {
+        format!("{text} {unit}")
+    }
+}
+
+/// A value without an uncertainty (a limit, a condition recorded once): six significant
+/// digits, trailing zeros dropped (`20 degC`, `0.0200037 degC/h`, `-2.1e-7`).
+pub fn format_value(value: f64, unit: &str) -> String {
+    let text = special(value);
     if unit.is_empty() {
         text
     } else {
@@ -270,6 +282,16 @@ mod tests {
         assert_eq!(f(1.5, f64::NAN, "s"), "1.5 ± NaN s");
         assert_eq!(f(1.5, f64::INFINITY, "s"), "1.5 ± ∞ s");
         assert_eq!(f(1.5, -0.25, "s"), "1.5 ± -0.25 s");
+    }
+
+    #[test]
+    fn a_value_alone_has_six_significant_digits() {
+        use super::format_value as v;
+        assert_eq!(v(20.0, "degC"), "20 degC");
+        assert_eq!(v(0.02000372589853021, "degC/h"), "0.0200037 degC/h");
+        assert_eq!(v(101.3, "kPa"), "101.3 kPa");
+        assert_eq!(v(-8.660729817769845e-6, ""), "-8.66073e-6");
+        assert_eq!(v(f64::NAN, "g"), "NaN g");
     }
 
     #[test]
