@@ -2,9 +2,9 @@
 //! a value with its standard uncertainty `u`, `u` rounded to two significant digits and the
 //! value rounded to the same decimal place, `0.01234 ± 0.00056 m/s^2`, `-1120 ± 190 ppm`.
 //!
-//! The one implementation: the terminal (`analyze`, `run`, `explain`, `archive trend`) and
-//! the report filter `measured` all print through [`format_measured`] (and [`format_value`]
-//! for a value without an uncertainty). The rule:
+//! The one implementation: the terminal (`analyze`, `run`, `explain`, `archive show` and
+//! `trend`) and the report filter `measured` all print through [`format_measured`] (and
+//! [`format_value`] for a value without an uncertainty). The rule:
 //! - `u` to two significant digits, rounded half up on its decimal form (`0.0995` -> `0.10`,
 //!   `0.0125` -> `0.013`); the value rounded half up (away from zero) at the place of `u`'s
 //!   second digit, in the integer digits too (`-1118.87 ± 190.1` -> `-1120 ± 190`: the `0`s
