@@ -31,7 +31,15 @@ fn explain_finds_the_lever_arm_and_draws_it_before_and_after() {
     );
     let std = procedures("imu-2d-standard");
     let o = ratecal(
-        &["run", &std, "--dry-run", "--station", &station, "--out", "lever"],
+        &[
+            "run",
+            &std,
+            "--dry-run",
+            "--station",
+            &station,
+            "--out",
+            "lever",
+        ],
         dir,
     );
     assert_eq!(code(&o), 0, "{}", text(&o));
@@ -39,7 +47,10 @@ fn explain_finds_the_lever_arm_and_draws_it_before_and_after() {
     let run_out = String::from_utf8_lossy(&o.stdout);
     assert!(run_out.contains("acceptance (value ± expanded uncertainty U, k = 2):"));
     let (v, u) = param(&run_out, "gyro.residual.std");
-    assert!(v.starts_with("0.00") && u.starts_with("0.0000"), "{run_out}");
+    assert!(
+        v.starts_with("0.00") && u.starts_with("0.0000"),
+        "{run_out}"
+    );
     assert_eq!(decimals(v), decimals(u), "{run_out}");
 
     let o = ratecal(&["explain", "lever", "--plots", "figs"], dir);
@@ -64,14 +75,21 @@ fn explain_finds_the_lever_arm_and_draws_it_before_and_after() {
         let beside = std::fs::read_to_string(dir.join("lever").join(&name)).unwrap();
         let asked = std::fs::read_to_string(dir.join("figs").join(&name)).unwrap();
         assert_eq!(beside, asked, "{name}");
-        assert!(text(&o).contains(&format!("figure: figs/{name}")), "{}", text(&o));
+        assert!(
+            text(&o).contains(&format!("figure: figs/{name}")),
+            "{}",
+            text(&o)
+        );
     }
     let svg = std::fs::read_to_string(dir.join("figs/explain-lever_arm.svg")).unwrap();
     assert!(svg.starts_with("<svg xmlns=\"http://www.w3.org/2000/svg\""));
     for ch in ["ax", "ay", "az"] {
         assert!(svg.contains(&format!("lever_arm: {ch} residual RMS per segment")));
     }
-    assert!(!svg.contains("lever_arm: gx"), "the gyros are not where it shows");
+    assert!(
+        !svg.contains("lever_arm: gx"),
+        "the gyros are not where it shows"
+    );
     assert!(svg.contains("data-name=\"after, held out\""));
 
     // explain.json and the figures joined the seal in one addition.

@@ -265,7 +265,10 @@ mod tests {
         assert_eq!(f(3.0e6, 2.5e5, "Pa"), "(3.00 ± 0.25)e6 Pa");
         // A tiny value under a large u takes the power of ten of u.
         assert_eq!(f(0.001, 2.0e7, ""), "(0.0 ± 2.0)e7");
-        assert_eq!(f(4.0e-8, 4.549e-7, "m/s^2/degC"), "(0.4 ± 4.5)e-7 m/s^2/degC");
+        assert_eq!(
+            f(4.0e-8, 4.549e-7, "m/s^2/degC"),
+            "(0.4 ± 4.5)e-7 m/s^2/degC"
+        );
         // Edges of the plain range: 1e-3 and just under 1e5 stay plain.
         assert_eq!(f(0.00123, 0.00012, ""), "0.00123 ± 0.00012");
         assert_eq!(f(0.000987, 0.00012, ""), "(9.9 ± 1.2)e-4");

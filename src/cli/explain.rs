@@ -70,7 +70,11 @@ pub fn main(args: Args) -> ExitCode {
     let in_run = rec.manifest.run.is_some();
     if in_run {
         let mut files = vec![("explain.json".to_string(), format!("{json}\n"))];
-        files.extend(figures.iter().map(|(n, svg)| (n.clone(), format!("{svg}\n"))));
+        files.extend(
+            figures
+                .iter()
+                .map(|(n, svg)| (n.clone(), format!("{svg}\n"))),
+        );
         if let Err(e) = write(&args.run, &files, true) {
             eprintln!("warning: cannot keep explain.json and its figures in the run folder: {e}");
         }
@@ -82,7 +86,10 @@ pub fn main(args: Args) -> ExitCode {
             .map(|(n, svg)| (n.clone(), format!("{svg}\n")))
             .collect();
         if !same && let Err(e) = write(dir, &files, false) {
-            eprintln!("error: cannot write the figures into {}: {e}", dir.display());
+            eprintln!(
+                "error: cannot write the figures into {}: {e}",
+                dir.display()
+            );
             return ExitCode::from(2);
         }
         for (name, _) in &files {

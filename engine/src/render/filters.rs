@@ -240,7 +240,10 @@ mod tests {
             out("{{ 0.01234 | fmt_value(0.00056, 'm/s^2') }}"),
             "0.01234 ± 0.00056 m/s²"
         );
-        assert_eq!(out("{{ 0.0041 | measured(none, 'deg/s') }}"), "0.004100 °/s");
+        assert_eq!(
+            out("{{ 0.0041 | measured(none, 'deg/s') }}"),
+            "0.004100 °/s"
+        );
     }
 
     #[test]

@@ -214,7 +214,12 @@ mod tests {
                 .to_string()
         };
         assert_eq!(series("before").matches("<circle").count(), 2 + 1);
-        assert_eq!(series("after, held out").matches(r##"fill="#fff""##).count(), 1 + 1);
+        assert_eq!(
+            series("after, held out")
+                .matches(r##"fill="#fff""##)
+                .count(),
+            1 + 1
+        );
         assert!(svg.contains(r#"data-name="noise floor""#));
         // A finding without residuals has no figure.
         assert!(figs[1].1.is_none());
