@@ -7,6 +7,7 @@ pub mod audit;
 pub mod check;
 pub mod explain;
 pub mod fit;
+pub mod measured;
 pub mod plan;
 /// The recording format lives in its own crate; `crate::recording` names it here.
 pub use ratecal_recording as recording;

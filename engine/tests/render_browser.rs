@@ -71,11 +71,11 @@ fn console_errors(stderr: &str) -> Vec<&str> {
     stderr.lines().filter(|l| l.contains(":CONSOLE")).collect()
 }
 
-/// A probe appended to a copy of the report: after layout, write each SVG's rendered
-/// size into the DOM so `--dump-dom` shows it.
+/// A probe appended to a copy of the report: after layout, write each plot's (each
+/// outermost SVG's) rendered size into the DOM so `--dump-dom` shows it.
 const PROBE: &str = r#"<script>
 window.addEventListener('load', () => {
-  const sizes = [...document.querySelectorAll('svg')].map(s => {
+  const sizes = [...document.querySelectorAll('svg:not(svg svg)')].map(s => {
     const r = s.getBoundingClientRect();
     const marks = s.querySelectorAll('circle, polyline').length;
     return Math.round(r.width) + 'x' + Math.round(r.height) + ':' + marks;
@@ -117,8 +117,9 @@ fn html_report_renders_its_plots_without_console_errors() {
         console_errors(&stderr).is_empty(),
         "console errors:\n{stderr}"
     );
+    // A figure of several panels nests one `<svg>` per panel in its own.
     assert_eq!(
-        dom.matches("<svg").count(),
+        dom.matches("<svg xmlns").count(),
         6,
         "six inline plots in the DOM"
     );

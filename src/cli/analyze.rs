@@ -6,6 +6,7 @@
 use super::procedure::{self, FsSources};
 use ratecal_engine::check::{CheckOptions, check_text};
 use ratecal_engine::fit::{self, Options};
+use ratecal_engine::measured::format_measured;
 use ratecal_engine::plan::Plan;
 use ratecal_engine::recording;
 use ratecal_engine::results::{Parameter, Results, RunVerdict};
@@ -138,9 +139,9 @@ fn summary(r: &Results) {
     for (name, p) in &r.parameters {
         match p {
             Parameter::Estimate { value, u, unit } => {
-                errln!("  {name:<32} {value:>14.6} ± {u:<10.3e} {unit}")
+                errln!("  {name:<32} {}", format_measured(*value, *u, unit))
             }
-            Parameter::Unobservable { .. } => errln!("  {name:<32} {:>14}", "not observable"),
+            Parameter::Unobservable { .. } => errln!("  {name:<32} not observable"),
         }
     }
     for a in &r.acceptance {

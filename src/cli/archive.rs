@@ -372,8 +372,9 @@ fn show_text(d: &ratecal_archive::RunDetail) -> String {
     s.push_str(&format!("parameters ({}):\n", d.parameters.len()));
     for p in &d.parameters {
         s.push_str(&format!(
-            "  {:<28} {:>14.6e} ± {:.2e} {}\n",
-            p.name, p.value, p.u, p.unit
+            "  {:<28} {}\n",
+            p.name,
+            ratecal_engine::measured::format_measured(p.value, p.u, &p.unit)
         ));
     }
     s.push_str(&format!("files ({}):\n", d.files.len()));

@@ -54,7 +54,13 @@ fn save(dir: &Path, seal: &Seal) -> std::io::Result<()> {
 /// After writing `file`: if it lies in a sealed run folder, adds it to that seal with the
 /// time and `command` (the seal is left alone when it no longer parses: `verify` says so).
 pub fn record_addition(file: &Path, command: &str) -> std::io::Result<bool> {
-    let Some(dir) = file.parent().map(|p| {
+    record_additions(&[file], command)
+}
+
+/// After writing `files`, all in one folder: if it is a sealed run folder, adds them to its
+/// seal as one addition with the time and `command`.
+pub fn record_additions(files: &[&Path], command: &str) -> std::io::Result<bool> {
+    let Some(dir) = files.first().and_then(|f| f.parent()).map(|p| {
         if p.as_os_str().is_empty() {
             Path::new(".")
         } else {
@@ -69,13 +75,20 @@ pub fn record_addition(file: &Path, command: &str) -> std::io::Result<bool> {
     let Ok(mut seal) = serde_json::from_str::<Seal>(&text) else {
         return Ok(false);
     };
-    let name = file
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let bytes = std::fs::read(file)?;
+    let mut named = Vec::with_capacity(files.len());
+    for file in files {
+        let name = file
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        named.push((name, std::fs::read(file)?));
+    }
+    let borrowed: Vec<(&str, &[u8])> = named
+        .iter()
+        .map(|(n, b)| (n.as_str(), b.as_slice()))
+        .collect();
     let now = rfc3339(std::time::SystemTime::now());
-    seal.add(&now, command, &[(name.as_str(), bytes.as_slice())]);
+    seal.add(&now, command, &borrowed);
     save(dir, &seal)?;
     Ok(true)
 }

@@ -3,6 +3,7 @@
 
 use super::{ParamTrend, Trend};
 use crate::dates;
+use ratecal_engine::measured::format_measured;
 use std::fmt::Write;
 
 impl Trend {
@@ -48,10 +49,9 @@ fn param_text(p: &ParamTrend) -> String {
     for pt in &p.points {
         let _ = writeln!(
             s,
-            "  {}  {:>14.6e} ± {:.2e}  run {}",
+            "  {}  {}  run {}",
             pt.started.get(..10).unwrap_or(&pt.started),
-            pt.value,
-            pt.u,
+            format_measured(pt.value, pt.u, &p.unit),
             pt.run
         );
     }
@@ -59,8 +59,9 @@ fn param_text(p: &ParamTrend) -> String {
         Some(d) => {
             let _ = writeln!(
                 s,
-                "  drift {:+.4e} ± {:.2e} {}/year (Birge ratio {:.2})",
-                d.rate_per_year, d.u_rate_per_year, p.unit, d.birge_ratio
+                "  drift {}/year (Birge ratio {:.2})",
+                format_measured(d.rate_per_year, d.u_rate_per_year, &p.unit),
+                d.birge_ratio
             );
         }
         None => s.push_str("  drift undetermined\n"),

@@ -3,7 +3,7 @@
 
 use super::data::Data;
 use super::model::{Terms, fit};
-use super::output::Located;
+use super::output::{Located, SegmentRms};
 use super::select::Step;
 use crate::fit::joint::{CHANNELS, seg_rss};
 use crate::recording::Recording;
@@ -15,8 +15,38 @@ const MOST: usize = 8;
 /// channel's noise (a reduction under 9, three standard deviations, is not listed unless
 /// nothing reaches it).
 pub(crate) fn locate(rec: &Recording, data: &Data, step: &Step) -> Vec<Located> {
+    let mut rows: Vec<(f64, Located)> = rows(rec, data, step)
+        .into_iter()
+        .filter(|r| r.0 > 0.0)
+        .collect();
+    rows.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let strong = rows.iter().filter(|r| r.0 >= 9.0).count().max(1);
+    rows.into_iter()
+        .take(strong.min(MOST))
+        .map(|r| r.1)
+        .collect()
+}
+
+/// Residual RMS before and after the step on every segment and channel with data, in
+/// recording order (the finding's figure).
+pub(crate) fn per_segment(rec: &Recording, data: &Data, step: &Step) -> Vec<SegmentRms> {
+    rows(rec, data, step)
+        .into_iter()
+        .map(|(_, l)| SegmentRms {
+            segment: l.segment,
+            channel: l.channel,
+            rms_before: l.rms_before,
+            rms_after: l.rms_after,
+            held_out: l.held_out,
+        })
+        .collect()
+}
+
+/// Every segment and channel with data: the residual sum of squares the step removed, in
+/// units of the channel's noise variance, and the entry.
+fn rows(rec: &Recording, data: &Data, step: &Step) -> Vec<(f64, Located)> {
     let fx = data.layout.effects[step.effect];
-    let mut rows: Vec<(f64, Located)> = Vec::new();
+    let mut rows = Vec::new();
     for (i, acc) in data.accs.iter().enumerate() {
         for c in 0..6 {
             let sig = step.after.noise[c].sigma;
@@ -25,13 +55,9 @@ pub(crate) fn locate(rec: &Recording, data: &Data, step: &Step) -> Vec<Located> 
             }
             let before = seg_rss(acc, &data.layout, c, &step.before.theta);
             let after = seg_rss(acc, &data.layout, c, &step.after.theta);
-            let gain = (before - after) / (sig * sig);
-            if gain <= 0.0 {
-                continue;
-            }
             let seg = &rec.manifest.segments[acc.seg];
             rows.push((
-                gain,
+                (before - after) / (sig * sig),
                 Located {
                     segment: seg.id.clone(),
                     channel: CHANNELS[c].into(),
@@ -45,12 +71,7 @@ pub(crate) fn locate(rec: &Recording, data: &Data, step: &Step) -> Vec<Located> 
             ));
         }
     }
-    rows.sort_by(|a, b| b.0.total_cmp(&a.0));
-    let strong = rows.iter().filter(|r| r.0 >= 9.0).count().max(1);
-    rows.into_iter()
-        .take(strong.min(MOST))
-        .map(|r| r.1)
-        .collect()
+    rows
 }
 
 /// Candidates that, fitted beside `effect`, lose parameters to it (or it to them): their

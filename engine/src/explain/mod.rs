@@ -23,7 +23,8 @@ pub mod user;
 pub use adopt::{AdoptTarget, Adoption, adoption, next_version};
 pub use model::NominalModel;
 pub use output::{
-    Evidence, Explanation, FORMAT, Final, Finding, Located, Nominal, ParamOut, Rms, UserEffectOut,
+    Evidence, Explanation, FORMAT, Final, Finding, Located, Nominal, ParamOut, Rms, SegmentRms,
+    UserEffectOut,
 };
 pub use text::render_text;
 pub use user::UserEffect;
@@ -238,6 +239,7 @@ fn finding(
         effect: fx.id().into(),
         explanation: fx.explanation().into(),
         located: locate::locate(rec, data, step),
+        residuals: locate::per_segment(rec, data, step),
         parameters,
         evidence,
         rms_after: rms(data, &step.after, &all),

@@ -49,6 +49,22 @@ pub struct Located {
     pub held_out: bool,
 }
 
+/// Residual RMS of one segment and channel before and after a finding: the data of its
+/// before/after figure, for every segment, not only where the finding shows.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SegmentRms {
+    /// Segment id.
+    pub segment: String,
+    /// Channel, `ax` ... `gz`.
+    pub channel: String,
+    /// Residual RMS before the effect was modelled (m/s^2 or deg/s).
+    pub rms_before: f64,
+    /// After.
+    pub rms_after: f64,
+    /// Whether the segment was held out of the fit.
+    pub held_out: bool,
+}
+
 /// One parameter: an estimate, or what the motion lacked.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(untagged)]
@@ -108,6 +124,9 @@ pub struct Finding {
     /// The file of a user effect (docs/user-effects.md); absent for the registry's.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub defined_in: Option<String>,
+    /// Residual RMS before and after, every segment and channel, in recording order.
+    #[serde(default)]
+    pub residuals: Vec<SegmentRms>,
 }
 
 /// A user effect explain tried, and its file.

@@ -1,7 +1,7 @@
 //! The text form of an explanation, for the terminal.
 
 use super::output::{Explanation, ParamOut, Rms};
-use crate::fit::format_measured;
+use crate::measured::format_measured;
 use std::fmt::Write;
 
 fn rms(r: &Rms) -> String {

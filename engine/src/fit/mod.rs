@@ -12,7 +12,6 @@ mod accept;
 mod allan;
 mod gyro;
 pub(crate) mod joint;
-mod measured;
 mod models;
 pub(crate) mod prep;
 mod repeat;
@@ -22,7 +21,6 @@ pub mod size_effect;
 mod stats;
 
 pub use allan::overlapping_adev;
-pub use measured::format_measured;
 pub use repeat::analyze_runs;
 
 use crate::plan::{Outliers, Plan};

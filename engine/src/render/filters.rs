@@ -2,14 +2,20 @@
 //! internal units; how a lab wants to read them (significant digits, `±`, SI prefixes,
 //! unit symbols) is decided here and in the templates, never in `fit`.
 
+use minijinja::value::ValueKind;
 use minijinja::{Environment, Value};
 
 /// What a filter prints for a missing number.
 pub const MISSING: &str = "—";
 
+/// What `measured` prints for a parameter the data could not determine.
+pub const NOT_DETERMINED: &str = "not determined";
+
 /// Registers every report filter on `env`.
 pub fn register(env: &mut Environment<'_>) {
-    env.add_filter("fmt_value", fmt_value);
+    env.add_filter("measured", measured);
+    // The filter's first name, kept for the labs' templates that use it.
+    env.add_filter("fmt_value", measured);
     env.add_filter("fmt_num", fmt_num);
     env.add_filter("si", si);
     env.add_filter("ppm", ppm);
@@ -31,17 +37,29 @@ pub fn cmp(op: Option<String>) -> String {
     }
 }
 
-/// `{{ x | fmt_value(u, unit) }}`: value and standard uncertainty, the uncertainty rounded to
-/// two significant digits and the value to the same decimal place (GUM 7.2.6).
-/// Without `u`, four significant digits.
-pub fn fmt_value(value: Value, u: Option<Value>, unit: Option<String>) -> String {
+/// `{{ x | measured(u, unit) }}`: value and standard uncertainty the way a lab writes them,
+/// `u` to two significant digits and the value to the same place (GUM 7.2.6; the rule is
+/// [`crate::measured`]'s). Without `u`, four significant digits. Given a parameter entry or
+/// an explain parameter (`{{ p | measured }}`), reads its `value`, `u` and `unit`, and prints
+/// `not determined` when it is not observable.
+pub fn measured(value: Value, u: Option<Value>, unit: Option<String>) -> String {
+    let (value, u, unit) = if value.kind() == ValueKind::Map {
+        let attr = |k: &str| value.get_attr(k).ok().filter(|v| !v.is_undefined());
+        if attr("observable").is_some_and(|o| !o.is_true()) {
+            return NOT_DETERMINED.to_string();
+        }
+        let unit = unit.or_else(|| attr("unit").and_then(|v| v.as_str().map(String::from)));
+        (attr("value").unwrap_or_default(), u.or(attr("u")), unit)
+    } else {
+        (value, u, unit)
+    };
     let Some(x) = number(&value) else {
         return MISSING.to_string();
     };
     let unit = unit.map(|s| pretty_unit(&s)).unwrap_or_default();
     let text = match u.as_ref().and_then(number) {
-        Some(u) if u > 0.0 => with_uncertainty(x, u),
-        _ => sig(x, 4),
+        Some(u) => crate::measured::measured_number(x, u),
+        None => sig(x, 4),
     };
     join_unit(text, &unit)
 }
@@ -193,34 +211,6 @@ fn plain_sig(x: f64, digits: u32) -> String {
     s
 }
 
-/// `x ± u` with `u` at two significant digits and `x` at the same decimal place.
-fn with_uncertainty(x: f64, u: f64) -> String {
-    if !x.is_finite() || !u.is_finite() {
-        return format!("{} ± {}", sig(x, 4), sig(u, 2));
-    }
-    let mut mag = u.log10().floor() as i32;
-    // 0.0996 rounds to 0.10: the second significant digit moves up one place.
-    if (u / 10f64.powi(mag - 1)).round() >= 100.0 {
-        mag += 1;
-    }
-    let decimals = 1 - mag;
-    let big = x.abs().max(u);
-    if decimals > 8 || big >= 1e7 {
-        // Factor out a common power of ten: (2.1000 ± 0.0020)e-5.
-        let e = big.log10().floor() as i32;
-        let d = (decimals + e).max(0) as usize;
-        let scale = 10f64.powi(e);
-        return format!("({:.d$} ± {:.d$})e{e}", x / scale, u / scale);
-    }
-    if decimals >= 0 {
-        let d = decimals as usize;
-        format!("{x:.d$} ± {u:.d$}")
-    } else {
-        let q = 10f64.powi(-decimals);
-        format!("{:.0} ± {:.0}", (x / q).round() * q, (u / q).round() * q)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -230,31 +220,57 @@ mod tests {
     }
 
     #[test]
-    fn uncertainty_sets_the_decimal_place() {
+    fn measured_rounds_as_the_terminal_does() {
+        let m = |x: f64, u: f64, unit: &str| measured(v(x), Some(v(u)), Some(unit.into()));
+        assert_eq!(m(0.0210, 0.00002, "m/s^2"), "0.021000 ± 0.000020 m/s²");
+        assert_eq!(m(802.1, 3.1, "ppm"), "802.1 ± 3.1 ppm");
+        assert_eq!(m(-1118.874315, 190.1, "ppm"), "-1119 ± 190 ppm");
+        assert_eq!(m(9.96, 0.0995, "mm"), "9.96 ± 0.10 mm");
+        assert_eq!(m(-0.0812, 0.0001, "deg/s"), "-0.08120 ± 0.00010 °/s");
+        assert_eq!(m(3.2e-6, 4.1e-7, "deg/s"), "(3.20 ± 0.41)e-6 °/s");
+        assert_eq!(m(12.5, 0.25, "%"), "12.50 ± 0.25%");
+        // The old name is the same filter.
+        let env = {
+            let mut e = Environment::new();
+            register(&mut e);
+            e
+        };
+        let out = |t: &str| env.render_str(t, ()).unwrap();
         assert_eq!(
-            fmt_value(v(0.0210), Some(v(0.00002)), None),
-            "0.021000 ± 0.000020"
+            out("{{ 0.01234 | fmt_value(0.00056, 'm/s^2') }}"),
+            "0.01234 ± 0.00056 m/s²"
         );
         assert_eq!(
-            fmt_value(v(802.1), Some(v(3.1)), Some("ppm".into())),
-            "802.1 ± 3.1 ppm"
-        );
-        assert_eq!(fmt_value(v(802.14), Some(v(31.4)), None), "802 ± 31");
-        assert_eq!(fmt_value(v(8021.4), Some(v(314.0)), None), "8020 ± 310");
-        assert_eq!(fmt_value(v(1.23456), Some(v(0.0996)), None), "1.23 ± 0.10");
-        assert_eq!(
-            fmt_value(v(-0.0812), Some(v(0.0001)), Some("deg/s".into())),
-            "-0.08120 ± 0.00010 °/s"
-        );
-        assert_eq!(
-            fmt_value(v(2.1e-11), Some(v(2e-14)), None),
-            "(2.1000 ± 0.0020)e-11"
+            out("{{ 0.0041 | measured(none, 'deg/s') }}"),
+            "0.004100 °/s"
         );
     }
 
     #[test]
+    fn measured_reads_parameter_entries() {
+        let env = {
+            let mut e = Environment::new();
+            register(&mut e);
+            e
+        };
+        let p = serde_json::json!({
+            "est": { "observable": true, "value": 350.576388, "u": 0.4771, "unit": "ppm" },
+            "explain": { "value": 50.0612, "u": 6.43, "unit": "deg" },
+            "unobs": { "observable": false, "reason": "rotate about Z" },
+            "needs": { "observable": false, "needs": "accelerate about Z" },
+        });
+        let ctx = minijinja::context! { p => Value::from(minijinja::value::Serde(&p)) };
+        let out = |t: &str| env.render_str(t, ctx.clone()).unwrap();
+        assert_eq!(out("{{ p.est | measured }}"), "350.58 ± 0.48 ppm");
+        assert_eq!(out("{{ p.explain | measured }}"), "50.1 ± 6.4°");
+        assert_eq!(out("{{ p.unobs | measured }}"), "not determined");
+        assert_eq!(out("{{ p.needs | measured }}"), "not determined");
+        assert_eq!(out("{{ p.missing | measured }}"), MISSING);
+    }
+
+    #[test]
     fn missing_numbers_print_a_dash() {
-        assert_eq!(fmt_value(Value::UNDEFINED, None, None), MISSING);
+        assert_eq!(measured(Value::UNDEFINED, None, None), MISSING);
         assert_eq!(fmt_num(Value::from(()), None), MISSING);
         assert_eq!(si(Value::from("x"), None, None), MISSING);
     }

@@ -14,9 +14,11 @@
 //! assert!(md.contains("Calibration report"));
 //! ```
 
+mod axis;
 mod context;
 mod error;
 pub mod filters;
+mod finding;
 mod plots;
 mod process;
 pub mod svg;
@@ -24,6 +26,7 @@ mod views;
 
 pub use context::CONTEXT_FORMAT;
 pub use error::{RenderError, TemplateError};
+pub use finding::explain_figures;
 
 use crate::plan::Plan;
 use minijinja::{Environment, UndefinedBehavior, Value};
@@ -295,6 +298,10 @@ fn context(input: &ReportInput, template: &str) -> Value {
     p.insert(
         "findings".into(),
         Value::from(plots.findings.into_iter().map(safe).collect::<Vec<_>>()),
+    );
+    p.insert(
+        "explain".into(),
+        Value::from(plots.explain.into_iter().map(safe).collect::<Vec<_>>()),
     );
     map.insert("plots".into(), Value::from(p));
     map.insert("template".into(), Value::from(template));

@@ -7,12 +7,14 @@ use serde_json::Value;
 use std::collections::BTreeMap;
 
 /// Every plot by name (`residuals_accel`, `residuals_gyro`, `rate_fit`, `allan`,
-/// `temperature`), and one per explain finding, in the findings' order.
+/// `temperature`), and one per finding, in the findings' order.
 pub struct Plots {
     /// Named plots (`None`: no data).
     pub named: BTreeMap<&'static str, Option<String>>,
-    /// Residuals before/after, one per finding (`None` where the finding has no residuals).
+    /// Residuals before/after, one per results.json finding (`None`: no residuals).
     pub findings: Vec<Option<String>>,
+    /// Residuals before/after, one per explain.json finding.
+    pub explain: Vec<Option<String>>,
 }
 
 /// Draws every plot the input has data for.
@@ -35,10 +37,22 @@ pub fn draw(input: &ReportInput) -> Plots {
     named.insert("size_effect_velocity", size_effect_velocity(r));
     named.insert("temperature", temperature(&input.temperature));
     let findings = match r.get("findings").and_then(Value::as_array) {
-        Some(fs) => fs.iter().map(finding).collect(),
+        Some(fs) => fs.iter().map(|f| super::finding::figure(f, None)).collect(),
         None => vec![],
     };
-    Plots { named, findings }
+    let explain = input
+        .explain
+        .as_ref()
+        .map(super::finding::explain_figures)
+        .unwrap_or_default()
+        .into_iter()
+        .map(|(_, svg)| svg)
+        .collect();
+    Plots {
+        named,
+        findings,
+        explain,
+    }
 }
 
 fn num(v: &Value, keys: &[&str]) -> Option<f64> {
@@ -385,53 +399,6 @@ fn temperature(t: &TemperatureSeries) -> Option<String> {
         x_label: "time since start (min)".into(),
         y_label: "temperature (°C)".into(),
         series,
-        ..Chart::default()
-    }
-    .to_svg()
-}
-
-/// Residual means before and after an explain finding's correction, per segment.
-fn finding(f: &Value) -> Option<String> {
-    let rows = f.get("residuals").and_then(Value::as_array)?;
-    let mut labels: Vec<String> = vec![];
-    let mut before = vec![];
-    let mut after = vec![];
-    for (i, row) in rows.iter().enumerate() {
-        let seg = text(row, &["segment"]).unwrap_or("?");
-        let label = match text(row, &["channel"]) {
-            Some(ch) => format!("{seg} {ch}"),
-            None => seg.to_string(),
-        };
-        labels.push(label);
-        if let Some(b) = num(row, &["before"]) {
-            before.push((i as f64, b));
-        }
-        if let Some(a) = num(row, &["after"]) {
-            after.push((i as f64, a));
-        }
-    }
-    let title = text(f, &["title", "effect", "name"]).unwrap_or("finding");
-    Chart {
-        title: format!("Residuals before and after: {title}"),
-        y_label: "residual mean".into(),
-        series: vec![
-            Series {
-                name: "before".into(),
-                points: before,
-                err: None,
-                style: Style::Markers,
-                color: PALETTE[1].into(),
-            },
-            Series {
-                name: "after".into(),
-                points: after,
-                err: None,
-                style: Style::Markers,
-                color: PALETTE[2].into(),
-            },
-        ],
-        x_categories: labels,
-        zero_line: true,
         ..Chart::default()
     }
     .to_svg()

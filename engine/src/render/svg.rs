@@ -3,6 +3,7 @@
 //! no fonts are rasterised (the browser draws the text), and the output is stable for
 //! snapshots.
 
+use super::axis::{axis, tick_label};
 use std::fmt::Write;
 
 const W: f64 = 720.0;
@@ -31,6 +32,8 @@ pub enum Style {
     Markers,
     /// Markers joined by a thin line.
     LineMarkers,
+    /// An open circle per point (a subset set apart from the filled markers).
+    OpenMarkers,
 }
 
 /// One named series of points, optionally with symmetric error bars (`err[i]` about `y`).
@@ -69,108 +72,11 @@ pub struct Chart {
     pub zero_line: bool,
 }
 
-struct Axis {
-    lo: f64,
-    hi: f64,
-    log: bool,
-}
-
-impl Axis {
-    fn t(&self, v: f64) -> f64 {
-        if self.log {
-            (v.log10() - self.lo) / (self.hi - self.lo)
-        } else {
-            (v - self.lo) / (self.hi - self.lo)
-        }
-    }
-
-    fn ticks(&self) -> Vec<f64> {
-        if self.log {
-            (self.lo.ceil() as i32..=self.hi.floor() as i32)
-                .map(|e| 10f64.powi(e))
-                .collect()
-        } else {
-            let step = nice_step((self.hi - self.lo) / 5.0);
-            let first = (self.lo / step).ceil() as i64;
-            let last = (self.hi / step).floor() as i64;
-            (first..=last).map(|k| k as f64 * step).collect()
-        }
-    }
-}
-
-/// The round step (1, 2 or 5 times a power of ten) nearest to `raw` on a log scale.
-fn nice_step(raw: f64) -> f64 {
-    let mag = 10f64.powf(raw.log10().floor());
-    let f = raw / mag;
-    let nice = [1.0, 2.0, 5.0, 10.0]
-        .into_iter()
-        .min_by(|a: &f64, b: &f64| (a / f).ln().abs().total_cmp(&(b / f).ln().abs()))
-        .unwrap_or(1.0);
-    nice * mag
-}
-
-fn axis(values: impl Iterator<Item = f64>, log: bool) -> Option<Axis> {
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for v in values.filter(|v| v.is_finite() && (!log || *v > 0.0)) {
-        let v = if log { v.log10() } else { v };
-        lo = lo.min(v);
-        hi = hi.max(v);
-    }
-    if !lo.is_finite() {
-        return None;
-    }
-    if log {
-        // A decade computed as -1.9999999 must not add an empty decade below.
-        let (lo, hi) = ((lo + 1e-9).floor(), (hi - 1e-9).ceil());
-        return Some(Axis {
-            lo,
-            hi: hi.max(lo + 1.0),
-            log,
-        });
-    }
-    if hi - lo < 1e-12 * lo.abs().max(1e-300) || hi == lo {
-        let pad = if lo == 0.0 { 1.0 } else { lo.abs() * 0.1 };
-        return Some(Axis {
-            lo: lo - pad,
-            hi: hi + pad,
-            log,
-        });
-    }
-    let pad = (hi - lo) * 0.06;
-    Some(Axis {
-        lo: lo - pad,
-        hi: hi + pad,
-        log,
-    })
-}
-
 fn esc(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")
         .replace('"', "&quot;")
-}
-
-fn tick_label(v: f64, log: bool) -> String {
-    if log {
-        let e = v.log10().round() as i32;
-        return match e {
-            0 => "1".into(),
-            1 => "10".into(),
-            _ => format!("1e{e}"),
-        };
-    }
-    if v == 0.0 {
-        return "0".into();
-    }
-    let a = v.abs();
-    if !(1e-3..1e5).contains(&a) {
-        return format!("{v:.1e}");
-    }
-    // Enough decimals to tell ticks apart, no trailing noise.
-    let s = format!("{v:.6}");
-    let s = s.trim_end_matches('0').trim_end_matches('.');
-    s.to_string()
 }
 
 impl Chart {
@@ -181,6 +87,15 @@ impl Chart {
 
     /// The chart as an `<svg>` element (no XML prolog), or `None` without data.
     pub fn to_svg(&self) -> Option<String> {
+        let (body, height) = self.body()?;
+        Some(format!(
+            r#"<svg xmlns="http://www.w3.org/2000/svg" class="plot" viewBox="0 0 {W} {height}" width="{W}" height="{height}" role="img" aria-label="{t}" font-family="sans-serif" font-size="11">{body}</svg>"#,
+            t = esc(&self.title)
+        ))
+    }
+
+    /// What goes inside the chart's `<svg>` element, and the element's height.
+    fn body(&self) -> Option<(String, f64)> {
         let pts = || self.series.iter().flat_map(|s| s.points.iter());
         let errs = || {
             self.series.iter().flat_map(|s| {
@@ -224,11 +139,6 @@ impl Chart {
         };
 
         let mut s = String::new();
-        let _ = write!(
-            s,
-            r#"<svg xmlns="http://www.w3.org/2000/svg" class="plot" viewBox="0 0 {W} {height}" width="{W}" height="{height}" role="img" aria-label="{t}" font-family="sans-serif" font-size="11">"#,
-            t = esc(&self.title)
-        );
         let _ = write!(s, r#"<title>{}</title>"#, esc(&self.title));
         let _ = write!(
             s,
@@ -341,12 +251,26 @@ impl Chart {
                     );
                 }
             }
+            if ser.style == Style::OpenMarkers {
+                for p in ser.points.iter().filter(|p| ok(p)) {
+                    let _ = write!(
+                        s,
+                        r##"<circle cx="{:.1}" cy="{:.1}" r="3.2" fill="#fff" stroke="{c}" stroke-width="1.6"/>"##,
+                        px(p.0),
+                        py(p.1)
+                    );
+                }
+            }
             // Legend entry: a line for line styles, a dot for markers.
             let ly = TOP + 12.0 + 16.0 * k as f64;
             let lx = LEFT + pw + 12.0;
             let symbol = match ser.style {
                 Style::Markers => format!(
                     r#"<circle cx="{}" cy="{ly}" r="3.5" fill="{c}"/>"#,
+                    lx + 9.0
+                ),
+                Style::OpenMarkers => format!(
+                    r##"<circle cx="{}" cy="{ly}" r="3.5" fill="#fff" stroke="{c}" stroke-width="1.6"/>"##,
                     lx + 9.0
                 ),
                 _ => format!(
@@ -362,9 +286,29 @@ impl Chart {
                 esc(&ser.name)
             );
         }
-        s.push_str("</svg>");
-        Some(s)
+        Some((s, height))
     }
+}
+
+/// Charts one above the other in one `<svg>` on a white ground (a figure of several
+/// panels that stands alone as a file), or `None` when no chart has data.
+pub fn stack(title: &str, charts: &[Chart]) -> Option<String> {
+    let mut inner = String::new();
+    let mut y = 0.0;
+    for (body, h) in charts.iter().filter_map(Chart::body) {
+        let _ = write!(
+            inner,
+            r#"<svg y="{y}" width="{W}" height="{h}" viewBox="0 0 {W} {h}">{body}</svg>"#
+        );
+        y += h;
+    }
+    if y == 0.0 {
+        return None;
+    }
+    Some(format!(
+        r##"<svg xmlns="http://www.w3.org/2000/svg" class="plot" viewBox="0 0 {W} {y}" width="{W}" height="{y}" role="img" aria-label="{t}" font-family="sans-serif" font-size="11"><title>{t}</title><rect width="100%" height="100%" fill="#fff"/>{inner}</svg>"##,
+        t = esc(title)
+    ))
 }
 
 #[cfg(test)]
@@ -388,24 +332,6 @@ mod tests {
             ..Chart::default()
         };
         assert!(c.to_svg().is_none());
-    }
-
-    #[test]
-    fn log_axis_ticks_are_decades() {
-        let a = axis([0.02, 300.0].into_iter(), true).unwrap();
-        assert_eq!(a.ticks(), vec![0.01, 0.1, 1.0, 10.0, 100.0, 1000.0]);
-    }
-
-    #[test]
-    fn linear_ticks_are_round_numbers() {
-        let a = Axis {
-            lo: -0.013,
-            hi: 0.052,
-            log: false,
-        };
-        let t = a.ticks();
-        assert_eq!(t.len(), 7);
-        assert!((t[0] + 0.01).abs() < 1e-12 && (t[6] - 0.05).abs() < 1e-12);
     }
 
     #[test]

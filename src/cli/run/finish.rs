@@ -4,6 +4,7 @@
 
 use ed25519_dalek::SigningKey;
 use miette::Report;
+use ratecal_engine::measured::{format_measured, format_value};
 use ratecal_engine::plan::Plan;
 use ratecal_engine::recording::{manifest_yaml, parse_manifest, rfc3339};
 use ratecal_engine::results::RunVerdict;
@@ -141,18 +142,21 @@ fn analyze(dir: &Path, plan: &Plan) -> Option<RunVerdict> {
         errln!("cannot write results.json: {e}");
         return None;
     }
+    if !results.acceptance.is_empty() {
+        outln!("acceptance (value ± expanded uncertainty U, k = 2):");
+    }
     for a in &results.acceptance {
-        let value = a
-            .value
-            .map_or_else(|| "-".to_string(), |x| format!("{x:.6}"));
+        let value = match (a.value, a.expanded_u) {
+            (Some(x), Some(u)) if u > 0.0 => format_measured(x, u, &a.unit),
+            (Some(x), _) => format_value(x, &a.unit),
+            (None, _) => format!("- {}", a.unit),
+        };
         outln!(
-            "  {:>13}  {} = {value} {} (limit {} {} {})",
+            "  {:>13}  {} = {value} (limit {} {})",
             a.verdict.label(),
             a.quantity,
-            a.unit,
             a.op,
-            a.limit,
-            a.unit
+            format_value(a.limit, &a.unit)
         );
     }
     outln!("verdict: {}", results.verdict.as_str().to_uppercase());
