@@ -95,6 +95,9 @@ pub(crate) fn prepare<'a>(
     let n = t.len();
     let accel = std::array::from_fn(|k| Cow::Borrowed(&imu.accel[k][a..b]));
     let gyro = std::array::from_fn(|k| Cow::Borrowed(&imu.gyro[k][a..b]));
+    let rest = (seg.kind == SegmentKind::Static)
+        .then(|| rest_angles(rec, seg.t_start, seg.t_end))
+        .flatten();
     // The references of a long segment are computed in two halves side by side.
     let mut f_ref: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; n]);
     let mut w_ref: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; n]);
@@ -111,11 +114,22 @@ pub(crate) fn prepare<'a>(
             let (w1, w1b) = w1.split_at_mut(h);
             let (w2, w2b) = w2.split_at_mut(h);
             let (mut a, b) = rayon::join(
-                || references(rec, seg.kind, geo, &t[..h], [f0, f1, f2], [w0, w1, w2]),
                 || {
                     references(
                         rec,
                         seg.kind,
+                        rest,
+                        geo,
+                        &t[..h],
+                        [f0, f1, f2],
+                        [w0, w1, w2],
+                    )
+                },
+                || {
+                    references(
+                        rec,
+                        seg.kind,
+                        rest,
                         geo,
                         &t[h..],
                         [f0b, f1b, f2b],
@@ -126,7 +140,7 @@ pub(crate) fn prepare<'a>(
             a.merge(&b);
             a
         } else {
-            references(rec, seg.kind, geo, t, [f0, f1, f2], [w0, w1, w2])
+            references(rec, seg.kind, rest, geo, t, [f0, f1, f2], [w0, w1, w2])
         }
     };
     sync.max_gap_s = sync.max_gap_s.max(refs.sync.max_gap_s);
@@ -221,6 +235,7 @@ impl Refs {
 fn references(
     rec: &Recording,
     kind: SegmentKind,
+    rest: Option<(f64, f64)>,
     geo: &Geometry,
     t: &[f64],
     f_ref: [&mut [f64]; 3],
@@ -278,11 +293,19 @@ fn references(
         let snap = state.snapshot(geo, &site);
         (snap.f_b(&Vec3::zeros()), snap.w_ib() / DEG)
     };
-    let mut cache = (
-        usize::MAX,
-        (Vec3::zeros(), Vec3::zeros()),
-        (Vec3::zeros(), Vec3::zeros()),
-    );
+    let rest_refs = rest.map(|(o, i)| {
+        let still = |angle: f64| AxisMotion {
+            angle: angle * DEG,
+            rate: 0.0,
+            accel: 0.0,
+        };
+        let snap = TableState {
+            outer: still(o),
+            inner: still(i),
+        }
+        .snapshot(geo, &site);
+        (snap.f_b(&Vec3::zeros()), snap.w_ib() / DEG)
+    });
     for (i, &ti) in t.iter().enumerate() {
         while j + 2 < tab.t.len() && tab.t[j + 1] <= ti {
             j += 1;
@@ -300,23 +323,10 @@ fn references(
         sync.max_angle_error_deg = sync.max_angle_error_deg.max(gap * gap / 8.0 * max_acc);
         so += tab.outer[j] + w * unwrap(tab.outer[j + 1] - tab.outer[j]);
         si += tab.inner[j] + w * unwrap(tab.inner[j + 1] - tab.inner[j]);
-        let (f, wi) = if kind == SegmentKind::Static {
-            // At rest the references hardly change between two feedback samples: evaluate
-            // the kinematics on the feedback samples and interpolate (half the work of
-            // evaluating it at every IMU stamp, same answer to well below the noise).
-            if cache.0 != j {
-                // Moving one feedback step on, the old end is the new start.
-                let start = if cache.0.wrapping_add(1) == j {
-                    cache.2
-                } else {
-                    refs_at(j, 0.0)
-                };
-                cache = (j, start, refs_at(j, 1.0));
-            }
-            let ((f0, w0), (f1, w1)) = (cache.1, cache.2);
-            (f0 + (f1 - f0) * w, w0 + (w1 - w0) * w)
-        } else {
-            refs_at(j, w)
+        let (f, wi) = match rest_refs {
+            // At rest: one attitude for the whole segment (its mean feedback angles).
+            Some(r) => r,
+            None => refs_at(j, w),
         };
         for k in 0..3 {
             f_ref[k][i] = f[k];
@@ -368,6 +378,28 @@ pub(crate) fn steady_rates(rec: &Recording, t0: f64, t1: f64) -> (f64, f64) {
         slope(&tab.outer, &tab.outer_rate),
         slope(&tab.inner, &tab.inner_rate),
     )
+}
+
+/// The attitude (outer, inner), deg, of a static segment between `t0` and `t1`: the mean of
+/// the unwrapped feedback angles. The table is at rest; the encoder's sample-to-sample
+/// noise is measurement noise, which the mean averages out. `None` without feedback there.
+pub(crate) fn rest_angles(rec: &Recording, t0: f64, t1: f64) -> Option<(f64, f64)> {
+    let tab = &rec.table;
+    let lo = tab.t.partition_point(|&x| x < t0);
+    let hi = tab.t.partition_point(|&x| x <= t1);
+    if hi <= lo {
+        return None;
+    }
+    let mean = |angle: &[f64]| {
+        let a0 = angle[lo];
+        let (mut a, mut sum) = (a0, a0);
+        for k in lo + 1..hi {
+            a += unwrap(angle[k] - angle[k - 1]);
+            sum += a;
+        }
+        sum / (hi - lo) as f64
+    };
+    Some((mean(&tab.outer), mean(&tab.inner)))
 }
 
 /// Shortest signed angle step, deg (feedback may wrap at 360).

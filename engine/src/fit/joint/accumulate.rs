@@ -4,7 +4,7 @@
 
 use super::tri::Tri;
 use super::{Layout, channel};
-use crate::fit::prep::{SegData, steady_rates, unwrap};
+use crate::fit::prep::{SegData, rest_angles, steady_rates, unwrap};
 use crate::recording::Recording;
 use nalgebra::{DMatrix, DVector};
 use ratecal_physics::effects::{Partials, Signals};
@@ -98,6 +98,13 @@ pub(crate) fn accumulate(
     let prepped = prepped.filter(|d| d.t.len() == b - a);
     let ncol = layout.cols.len();
     let at_rest = s.kind == crate::recording::SegmentKind::Static;
+    let rest = if at_rest {
+        rest_angles(rec, s.t_start, s.t_end)
+    } else {
+        None
+    };
+    // At rest the kinematic state is the same at every sample: evaluated once.
+    let mut rest_snap = None;
     let steady = s.kind == crate::recording::SegmentKind::Rate;
     let mean_rates = {
         let (o, i) = steady_rates(rec, s.t_start, s.t_end);
@@ -139,6 +146,11 @@ pub(crate) fn accumulate(
             block_end += BLOCK_S * ((t - block_end) / BLOCK_S).ceil().max(1.0);
         }
         let mut state = state_at(rec, &mut j, t);
+        if let Some((o, i)) = rest {
+            // At rest: one attitude for the segment, the mean of its feedback angles.
+            state.outer.angle = o * DEG;
+            state.inner.angle = i * DEG;
+        }
         if at_rest {
             // A static segment is at rest: the feedback's rate ripple is the table's
             // measurement noise, not motion the IMU felt.
@@ -155,7 +167,13 @@ pub(crate) fn accumulate(
             state.outer.accel = 0.0;
             state.inner.accel = 0.0;
         }
-        let snap = state.snapshot(geo, &site);
+        let snap = match (&rest_snap, rest) {
+            (Some(snap), Some(_)) => *snap,
+            _ => state.snapshot(geo, &site),
+        };
+        if rest.is_some() && rest_snap.is_none() {
+            rest_snap = Some(snap);
+        }
         let dtemp = imu.temp.as_ref().map_or(0.0, |tc| tc[i] - t_ref_c);
         let sig = Signals::new(&snap, &site, if dtemp.is_finite() { dtemp } else { 0.0 }).at(t);
         for (e, fx) in layout.effects.iter().enumerate() {
