@@ -8,6 +8,7 @@
 
 mod common;
 
+use common::explain::{found, within};
 use common::plans::standard;
 use common::sim::{record, station};
 use ratecal_drivers::Station;
@@ -19,31 +20,6 @@ fn explain_run(st: &Station, block_s: f64, seed: u64) -> Explanation {
     record(st, &standard(block_s), seed, dir.path());
     let rec = recording::read(dir.path()).unwrap();
     explain::explain(&rec, &NominalModel::seed(), &Options::default())
-}
-
-fn found(x: &Explanation) -> Vec<&str> {
-    let mut v: Vec<&str> = x.findings.iter().map(|f| f.effect.as_str()).collect();
-    v.sort_unstable();
-    v
-}
-
-/// Every estimated parameter of `effect` within `k` u of the truth (zero unless listed),
-/// plus a thousandth of the truth (the second-order scale x effect product).
-fn within(x: &Explanation, effect: &str, truth: &[(&str, f64)], k: f64) {
-    let f = x
-        .findings
-        .iter()
-        .find(|f| f.effect == effect)
-        .unwrap_or_else(|| panic!("{effect} not found: {:?}", found(x)));
-    for (name, p) in &f.parameters {
-        if let ParamOut::Estimate { value, u, .. } = p {
-            let want = truth.iter().find(|t| t.0 == name).map_or(0.0, |t| t.1);
-            assert!(
-                (value - want).abs() <= k * u + 1e-3 * want.abs(),
-                "{effect}.{name} = {value} ± {u}, truth {want}"
-            );
-        }
-    }
 }
 
 /// The final residual RMS at most `f` times the noise floor explain states.

@@ -6,6 +6,7 @@
 
 mod common;
 
+use common::explain::{found, within};
 use common::plans::standard;
 use common::sim::{record, station};
 use ratecal_drivers::Station;
@@ -20,29 +21,6 @@ fn simulate(st: &Station, seed: u64) -> Explanation {
     record(st, &standard(600.0), seed, dir.path());
     let rec = recording::read(dir.path()).unwrap();
     explain::explain(&rec, &NominalModel::seed(), &Options::default())
-}
-
-fn found(x: &Explanation) -> Vec<&str> {
-    let mut v: Vec<&str> = x.findings.iter().map(|f| f.effect.as_str()).collect();
-    v.sort_unstable();
-    v
-}
-
-/// Every estimated parameter of `effect` lies within `k` standard uncertainties of the
-/// truth (`truth` lists the non-zero ones; the rest are zero), plus one part in a thousand
-/// of the truth: the fit is linear, and the product of a scale error (up to 1000 ppm) with
-/// an effect (`a = K_a s`, the lever arm inside `s`) is a second-order term it leaves out.
-fn within(x: &Explanation, effect: &str, truth: &[(&str, f64)], k: f64) {
-    let f = x.findings.iter().find(|f| f.effect == effect).unwrap();
-    for (name, p) in &f.parameters {
-        if let ParamOut::Estimate { value, u, .. } = p {
-            let want = truth.iter().find(|t| t.0 == name).map_or(0.0, |t| t.1);
-            assert!(
-                (value - want).abs() <= k * u + 1e-3 * want.abs(),
-                "{effect}.{name} = {value} ± {u}, truth {want}"
-            );
-        }
-    }
 }
 
 fn at_noise_floor(x: &Explanation) {

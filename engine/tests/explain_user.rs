@@ -5,44 +5,20 @@
 
 mod common;
 
-use common::manifest;
+use common::explain::found;
 use common::plans::standard;
-use ratecal_drivers::{DEFAULT_STATION_YAML, Station, registry};
+use common::sim;
 use ratecal_engine::explain::{self, Explanation, NominalModel, Options, ParamOut, user};
-use ratecal_engine::recording::{self, Columns, Recording, RecordingWriter};
-use ratecal_engine::run::{NoProgress, RunOptions, RunStatus, execute};
+use ratecal_engine::recording::{self, Recording};
 
 fn record(effects: &str, seed: u64) -> Recording {
-    let yaml = DEFAULT_STATION_YAML.replace("effects: {}", &format!("effects: {effects}"));
-    let st = Station::from_yaml(&yaml, "test.yaml").unwrap();
-    let rt = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .start_paused(true)
-        .build()
-        .unwrap();
     let dir = tempfile::tempdir().unwrap();
-    rt.block_on(async {
-        let (mut table, mut imu) = registry::build(&st, seed).unwrap();
-        let plan = standard(600.0);
-        let mut m = manifest(&plan.name);
-        m.station.site = st.site();
-        let cols = Columns {
-            imu_temp: true,
-            ambient: true,
-        };
-        let mut w = RecordingWriter::create(dir.path(), m, cols).unwrap();
-        let out = execute(
-            &plan,
-            table.as_mut(),
-            imu.as_mut(),
-            &mut w,
-            &mut NoProgress,
-            &RunOptions::default(),
-        )
-        .await
-        .unwrap();
-        assert_eq!(out.status, RunStatus::Completed, "{:?}", out.warnings);
-    });
+    sim::record(
+        &sim::station(effects, &[]),
+        &standard(600.0),
+        seed,
+        dir.path(),
+    );
     recording::read(dir.path()).unwrap()
 }
 
@@ -62,12 +38,6 @@ fn run(rec: &Recording, files: &[&str], without: &[&str]) -> Explanation {
         ..Options::default()
     };
     explain::explain(rec, &NominalModel::seed(), &opts)
-}
-
-fn found(x: &Explanation) -> Vec<&str> {
-    let mut v: Vec<&str> = x.findings.iter().map(|f| f.effect.as_str()).collect();
-    v.sort_unstable();
-    v
 }
 
 fn estimate(x: &Explanation, effect: &str, param: &str) -> (f64, f64) {

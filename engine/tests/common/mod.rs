@@ -4,6 +4,7 @@
 
 #![allow(dead_code)]
 
+pub mod explain;
 pub mod plans;
 pub mod sim;
 
