@@ -145,7 +145,10 @@ impl Session {
 fn percentiles(v: &[f32]) -> String {
     let mut v = v.to_vec();
     v.sort_by(f32::total_cmp);
-    let at = |q: f64| v.get(((v.len() as f64 - 1.0) * q).round() as usize).copied();
+    let at = |q: f64| {
+        v.get(((v.len() as f64 - 1.0) * q).round() as usize)
+            .copied()
+    };
     match (at(0.5), at(0.95), at(0.99), v.last()) {
         (Some(a), Some(b), Some(c), Some(d)) => {
             format!("p50 {a:.0} / p95 {b:.0} / p99 {c:.0} / max {d:.0} ms")

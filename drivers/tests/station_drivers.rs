@@ -40,7 +40,11 @@ fn every_registered_kind_parses_from_its_name() {
         other => panic!("a kind this test does not know: {other}"),
     };
     for k in DRIVERS {
-        let imu = if k.name == "sim" { "sim".into() } else { settings(k.name) };
+        let imu = if k.name == "sim" {
+            "sim".into()
+        } else {
+            settings(k.name)
+        };
         let text = with_drivers(&settings(k.name), &imu);
         let st = Station::from_yaml(&text, "lab.yaml").unwrap_or_else(|e| panic!("{}", render(&e)));
         assert_eq!(st.table.driver.kind.name, k.name);
@@ -76,10 +80,19 @@ fn an_unknown_kind_is_refused_on_its_line_with_the_closest_name() {
 #[test]
 fn settings_a_kind_does_not_take_or_needs_are_refused() {
     for (table, needle) in [
-        ("{ tcp: { port: /dev/x } }", "unknown field `port` of the `tcp` driver"),
-        ("{ tcp: { timeout: 1 s } }", "the `tcp` driver needs `address`"),
+        (
+            "{ tcp: { port: /dev/x } }",
+            "unknown field `port` of the `tcp` driver",
+        ),
+        (
+            "{ tcp: { timeout: 1 s } }",
+            "the `tcp` driver needs `address`",
+        ),
         ("tcp", "the `tcp` driver needs `address`"),
-        ("{ serial: { port: /dev/x, adress: a } }", "did you mean `address`?"),
+        (
+            "{ serial: { port: /dev/x, adress: a } }",
+            "did you mean `address`?",
+        ),
     ] {
         let err = Station::from_yaml(&with_drivers(table, "sim"), "lab.yaml").unwrap_err();
         let shown = render(&err);

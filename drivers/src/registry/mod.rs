@@ -129,7 +129,10 @@ fn sim_imu(c: &mut Context<'_>, _: &Settings) -> Result<Box<dyn ImuDriver>, Driv
 fn endpoint(s: &Settings) -> Result<Endpoint, DriverError> {
     match (&s.address, &s.port) {
         (Some(a), _) => Ok(Endpoint::Tcp(a.clone())),
-        (None, p) => Ok(Endpoint::Serial(required(p.as_ref(), "port")?.clone(), s.baud())),
+        (None, p) => Ok(Endpoint::Serial(
+            required(p.as_ref(), "port")?.clone(),
+            s.baud(),
+        )),
     }
 }
 
@@ -143,7 +146,12 @@ fn link_table(c: &mut Context<'_>, s: &Settings) -> Result<Box<dyn TableDriver>,
         feedback_hz: spec.feedback_rate.0,
         simulated: false,
     };
-    Ok(Box::new(LinkTable::new(endpoint, info, s.timeout_s(), c.start)))
+    Ok(Box::new(LinkTable::new(
+        endpoint,
+        info,
+        s.timeout_s(),
+        c.start,
+    )))
 }
 
 fn framed_imu(c: &mut Context<'_>, s: &Settings) -> Result<Box<dyn ImuDriver>, DriverError> {
@@ -191,7 +199,8 @@ pub fn build(station: &Station, seed: u64) -> Result<Drivers, DriverError> {
             format!("the `{}` driver cannot run {what}", k.name),
         )
     };
-    let table = table.kind.table.ok_or_else(|| no("a table", table.kind))?(&mut ctx, &table.settings)?;
+    let table =
+        table.kind.table.ok_or_else(|| no("a table", table.kind))?(&mut ctx, &table.settings)?;
     let imu = imu.kind.imu.ok_or_else(|| no("an IMU", imu.kind))?(&mut ctx, &imu.settings)?;
     Ok((table, imu))
 }

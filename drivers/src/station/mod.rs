@@ -12,8 +12,8 @@ pub use describe::{Environment, ImuIdentity, StationInfo};
 pub use effects::EffectsSpec;
 pub use faults::{AxisName, DropoutMode, FaultSpec, LinkName, TableFaultMode};
 pub use file::{
-    AmbientSpec, EnvironmentSpec, ImuSpec, ImuTemperatureSpec, MountSpec, SettlingSpec,
-    SiteSpec, Station, TableSpec, TemperatureSpec,
+    AmbientSpec, EnvironmentSpec, ImuSpec, ImuTemperatureSpec, MountSpec, SettlingSpec, SiteSpec,
+    Station, TableSpec, TemperatureSpec,
 };
 pub use quantity::{
     Accel, AccelDensity, Angle, Freq, Pressure, Rate, RateDensity, RateWalk, Ratio, Rotation, Temp,
