@@ -5,10 +5,14 @@
 //! of this process (every thread: the link reader, the loop, the writer thread) per
 //! session; each session also reports the samples received and lost, corrupted frames and
 //! the delay from a sample's stamp (its arrival, to the link delay) to the flush that put
-//! it on the disk. Sessions last `RATECAL_INGEST_S` seconds (default 3; the full
-//! figure is `RATECAL_INGEST_S=600 cargo bench --bench ingest`).
+//! it on the disk. Sessions last `RATECAL_INGEST_S` seconds (default 3, under Criterion).
+//! From 60 s on, one session runs alone, without Criterion's repetitions, and prints its
+//! figures: the full figure is `RATECAL_INGEST_S=600 cargo bench --bench ingest`.
+//! The delay to the disk is bracketed per sample: from its stamp (device time mapped onto
+//! the host clock: at or before its arrival) and from the tick that drained it from the link
+//! (at or after its arrival).
 
-use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use criterion::{Criterion, Throughput, criterion_group};
 use ratecal_drivers::Station;
 use ratecal_engine::recording::{Columns, Manifest, ManifestStation, RecordingWriter, TableAxes};
 use std::path::{Path, PathBuf};
@@ -113,8 +117,44 @@ struct Session {
     lost: u64,
     corrupted: u64,
     cpu: Duration,
-    to_disk_mean_ms: f64,
-    to_disk_max_ms: f64,
+    /// Per sample, flush time minus stamp, ms.
+    from_stamp_ms: Vec<f32>,
+    /// Per sample, flush time minus the tick that drained it, ms.
+    from_drain_ms: Vec<f32>,
+}
+
+impl Session {
+    fn report(&self, k: usize, secs: f64) -> String {
+        let n = self.imu + self.table;
+        format!(
+            "session {k}: {secs} s, imu {} (expected {:.0}), table {} (expected {:.0}), lost {}, corrupted {}, cpu {:.2} us/sample, to disk from stamp {}, from drain {}",
+            self.imu,
+            IMU_HZ * secs,
+            self.table,
+            TABLE_HZ * secs,
+            self.lost,
+            self.corrupted,
+            self.cpu.as_secs_f64() * 1e6 / n.max(1) as f64,
+            percentiles(&self.from_stamp_ms),
+            percentiles(&self.from_drain_ms),
+        )
+    }
+}
+
+/// `p50 / p95 / p99 / max` of delays in ms.
+fn percentiles(v: &[f32]) -> String {
+    let mut v = v.to_vec();
+    v.sort_by(f32::total_cmp);
+    let at = |q: f64| {
+        v.get(((v.len() as f64 - 1.0) * q).round() as usize)
+            .copied()
+    };
+    match (at(0.5), at(0.95), at(0.99), v.last()) {
+        (Some(a), Some(b), Some(c), Some(d)) => {
+            format!("p50 {a:.0} / p95 {b:.0} / p99 {c:.0} / max {d:.0} ms")
+        }
+        _ => "no samples".into(),
+    }
 }
 
 fn session(st: &Station, secs: f64, dir: &Path) -> Session {
@@ -133,8 +173,8 @@ fn session(st: &Station, secs: f64, dir: &Path) -> Session {
         let mut w = RecordingWriter::create(dir, manifest(st), columns).unwrap();
         let (mut ib, mut tb) = (Vec::new(), Vec::new());
         let mut s = Session::default();
-        let (mut pending_n, mut pending_sum_t, mut oldest) = (0u64, 0.0, f64::INFINITY);
-        let (mut sum_latency, mut flushed) = (0.0, 0u64);
+        // (stamp, drained at) of every sample written since the last flush.
+        let mut pending: Vec<(f64, f64)> = Vec::new();
         let mut tick = tokio::time::interval(Duration::from_millis(20));
         let mut last_sync = Instant::now();
         while t0.elapsed().as_secs_f64() < secs {
@@ -147,26 +187,24 @@ fn session(st: &Station, secs: f64, dir: &Path) -> Session {
             w.write_table(&tb).unwrap();
             s.imu += ib.len() as u64;
             s.table += tb.len() as u64;
-            for t in ib.iter().map(|x| x.t).chain(tb.iter().map(|x| x.t)) {
-                pending_n += 1;
-                pending_sum_t += t;
-                oldest = oldest.min(t);
-            }
+            let drained = t0.elapsed().as_secs_f64();
+            let stamps = ib.iter().map(|x| x.t).chain(tb.iter().map(|x| x.t));
+            pending.extend(stamps.map(|t| (t, drained)));
             if last_sync.elapsed() >= Duration::from_millis(500) {
                 last_sync = Instant::now();
                 w.sync().unwrap();
                 let h = t0.elapsed().as_secs_f64();
-                sum_latency += pending_n as f64 * h - pending_sum_t;
-                flushed += pending_n;
-                s.to_disk_max_ms = s.to_disk_max_ms.max((h - oldest) * 1e3);
-                (pending_n, pending_sum_t, oldest) = (0, 0.0, f64::INFINITY);
+                for (t, d) in pending.drain(..) {
+                    s.from_stamp_ms.push(((h - t) * 1e3) as f32);
+                    s.from_drain_ms.push(((h - d) * 1e3) as f32);
+                }
             }
         }
         w.finish().unwrap();
-        let stats = imu.link_stats().unwrap_or_default();
-        s.lost = stats.lost;
-        s.corrupted = stats.corrupted;
-        s.to_disk_mean_ms = sum_latency / flushed.max(1) as f64 * 1e3;
+        let (si, stt) = (imu.link_stats(), table.link_stats());
+        let (si, stt) = (si.unwrap_or_default(), stt.unwrap_or_default());
+        s.lost = si.lost + stt.lost;
+        s.corrupted = si.corrupted + stt.corrupted;
         s
     });
     out.cpu = cpu_time() - cpu0;
@@ -189,19 +227,7 @@ fn bench(c: &mut Criterion) {
             for _ in 0..iters {
                 k += 1;
                 let s = session(&station, secs, &tmp.path().join(format!("run{k}")));
-                let n = s.imu + s.table;
-                eprintln!(
-                    "session {k}: {secs} s, imu {} (expected {:.0}), table {} (expected {:.0}), lost {}, corrupted {}, cpu {:.2} us/sample, stamp to disk mean {:.0} ms max {:.0} ms",
-                    s.imu,
-                    IMU_HZ * secs,
-                    s.table,
-                    TABLE_HZ * secs,
-                    s.lost,
-                    s.corrupted,
-                    s.cpu.as_secs_f64() * 1e6 / n.max(1) as f64,
-                    s.to_disk_mean_ms,
-                    s.to_disk_max_ms
-                );
+                eprintln!("{}", s.report(k, secs));
                 cpu += s.cpu;
             }
             cpu
@@ -211,4 +237,17 @@ fn bench(c: &mut Criterion) {
 }
 
 criterion_group!(benches, bench);
-criterion_main!(benches);
+
+fn main() {
+    let secs = secs();
+    if secs < 60.0 {
+        benches();
+        Criterion::default().configure_from_args().final_summary();
+        return;
+    }
+    // A long session is the figure itself: once, not ten times under Criterion.
+    let tmp = tempfile::tempdir().unwrap();
+    let (_emu, station) = emulator(tmp.path());
+    let s = session(&station, secs, &tmp.path().join("run"));
+    println!("{}", s.report(1, secs));
+}

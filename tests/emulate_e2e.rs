@@ -141,6 +141,18 @@ fn check(s: &Seen, code: i32, status: &str, needles: &[&str]) -> Vec<String> {
             if counted.is_none_or(|c| c == 0) {
                 wrong.push(format!("no corrupted frame counted: {}", ctx()));
             }
+        } else if *n == "no lost frames" {
+            // `NAME link: N samples, C corrupted (skipped), L lost, ...`, for both links.
+            let lost: Vec<Option<u64>> = ["imu link: ", "table link: "]
+                .iter()
+                .map(|p| {
+                    let l = s.output.lines().find_map(|l| l.strip_prefix(p))?;
+                    l.split(", ").nth(2)?.split(' ').next()?.parse().ok()
+                })
+                .collect();
+            if lost.iter().any(|l| *l != Some(0)) {
+                wrong.push(format!("lost frames {lost:?} (expected none): {}", ctx()));
+            }
         } else if !s.manifest.contains(n) && !s.output.contains(n) {
             wrong.push(format!("`{n}` missing: {}", ctx()));
         }
@@ -171,7 +183,12 @@ fn station_check_against_the_emulator() {
             None,
             0,
             "completed",
-            &["table_minus_imu_s", "imu link: ", "Table-to-IMU sync"],
+            &[
+                "table_minus_imu_s",
+                "imu link: ",
+                "Table-to-IMU sync",
+                "no lost frames",
+            ],
         ),
         #[cfg(unix)]
         (
@@ -181,7 +198,7 @@ fn station_check_against_the_emulator() {
             None,
             0,
             "completed",
-            &["table_minus_imu_s"],
+            &["table_minus_imu_s", "no lost frames"],
         ),
         (
             "link back within its timeout, corrupted frames",

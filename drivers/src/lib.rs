@@ -26,7 +26,7 @@ pub mod sim;
 pub mod station;
 mod traits;
 
-pub use registry::{DRIVERS, DriverKind, Drivers, build};
+pub use registry::{DRIVERS, DriverKind, DriverSpec, Drivers, build};
 pub use station::{
     DEFAULT_STATION_YAML, SWAYING_STATION_YAML, Station, StationError, StationInfo, yaml_offset,
 };

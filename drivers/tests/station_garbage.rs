@@ -6,7 +6,7 @@
 
 use proptest::prelude::*;
 use proptest::sample::Index;
-use ratecal_drivers::station::{DropoutMode, FaultSpec, ImuDriverSpec, TableDriverSpec};
+use ratecal_drivers::station::{DropoutMode, FaultSpec};
 use ratecal_drivers::{ImuSample, Station, StationError, TableAxisId, TableCommand, TableSample};
 use std::time::Duration;
 
@@ -62,10 +62,7 @@ fn assert_graceful(text: &str) {
 /// paused clock, on a thread of its own so that a hang fails the test instead of blocking.
 fn run_briefly(station: &Station, text: &str) {
     let input = changed(text);
-    let simulated = matches!(
-        (&station.table.driver, &station.imu.driver),
-        (TableDriverSpec::Sim, ImuDriverSpec::Sim)
-    );
+    let simulated = ratecal_drivers::registry::simulated(station);
     if !simulated {
         // Replay and TCP drivers touch files and sockets named in the text: not here.
         return;

@@ -10,13 +10,7 @@ fuzz_target!(|data: &[u8]| {
     match Station::from_yaml(&text, "fuzz.yaml") {
         Ok(station) => {
             // Building the drivers touches no clock and no file for the simulated station.
-            if matches!(
-                (&station.table.driver, &station.imu.driver),
-                (
-                    ratecal_drivers::station::TableDriverSpec::Sim,
-                    ratecal_drivers::station::ImuDriverSpec::Sim
-                )
-            ) {
+            if ratecal_drivers::registry::simulated(&station) {
                 let _ = ratecal_drivers::build(&station, 0);
             }
         }

@@ -184,15 +184,8 @@ fn execute_prepared(prep: Prepared, key: Option<&SigningKey>) -> Result<ExitCode
 
 /// The longest timeout of a station's hardware links, s.
 fn link_timeout_s(station: &ratecal_drivers::Station) -> Option<f64> {
-    use ratecal_drivers::station::{ImuDriverSpec as I, TableDriverSpec as T};
-    let table = match &station.table.driver {
-        T::Tcp { timeout, .. } | T::Serial { timeout, .. } => Some(timeout.0),
-        T::Sim | T::Replay { .. } => None,
-    };
-    let imu = match &station.imu.driver {
-        I::Tcp { timeout, .. } | I::Serial { timeout, .. } => Some(timeout.0),
-        I::Sim | I::Replay { .. } => None,
-    };
+    let table = station.table.driver.link_timeout_s();
+    let imu = station.imu.driver.link_timeout_s();
     table.into_iter().chain(imu).reduce(f64::max)
 }
 

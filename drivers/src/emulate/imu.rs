@@ -6,29 +6,49 @@ use crate::frame::{FLAG_ACCEL_SATURATED, FLAG_GYRO_SATURATED, FrameFields, encod
 use crate::station::LinkName;
 use std::sync::atomic::Ordering;
 use std::time::Duration;
-use tokio::io::{AsyncWrite, AsyncWriteExt};
+use tokio::io::{AsyncRead, AsyncReadExt, AsyncWrite, AsyncWriteExt};
 
 const PERIOD: Duration = Duration::from_millis(2);
 /// Byte of the payload flipped in a corrupted frame (inside the accelerometer x value).
 const CORRUPT_AT: usize = 3 + 12 + 2;
 
-/// Streams frames until the client closes the link or a fault drops it. On a
-/// pseudo-terminal nobody may be reading: frames that cannot be written within 200 ms are
-/// dropped, as a device does, rather than queued (and never end the link).
-pub(super) async fn serve<S: AsyncWrite + Unpin>(mut stream: S, s: &Session, pty: bool) -> End {
+/// Streams frames until the client closes the link (seen as soon as its end reads as
+/// closed, not at the next failed write), a newer IMU link of the session takes over, or
+/// a fault drops it. On a pseudo-terminal nobody may be reading: frames that cannot be
+/// written within 200 ms are dropped, as a device does, rather than queued (and never end
+/// the link).
+pub(super) async fn serve<S: AsyncRead + AsyncWrite>(stream: S, s: &Session, pty: bool) -> End {
+    let link = s.imu_link.fetch_add(1, Ordering::SeqCst) + 1;
+    let (mut rx, mut stream) = tokio::io::split(stream);
     let mut tick = tokio::time::interval(PERIOD);
     tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
     let mut samples = Vec::new();
     let mut buf = Vec::new();
+    let mut incoming = [0u8; 64];
     let (accel_range, gyro_range) = s.ranges;
     loop {
-        tick.tick().await;
+        tokio::select! {
+            _ = tick.tick() => {}
+            // The client sends nothing on this link: a read ends only when it closed.
+            r = rx.read(&mut incoming), if !pty => match r {
+                Ok(n) if n > 0 => continue,
+                _ => return End::Client,
+            },
+        }
         if s.take_drop(LinkName::Imu, s.now()) {
             return End::Dropped;
         }
         samples.clear();
-        if s.imu.lock().await.read(&mut samples).await.is_err() {
-            continue;
+        {
+            // Checked under the IMU's lock: once a newer link counted itself, this one
+            // takes no sample, so the newer link's counter runs without gaps.
+            let mut imu = s.imu.lock().await;
+            if s.imu_link.load(Ordering::SeqCst) != link {
+                return End::Client;
+            }
+            if imu.read(&mut samples).await.is_err() {
+                continue;
+            }
         }
         buf.clear();
         for smp in &samples {

@@ -17,7 +17,7 @@ pub use station::{Served, connecting_station};
 use crate::sim::{SimImu, SimTable};
 use crate::station::{LinkName, Station};
 use faults::LinkFaults;
-use std::sync::atomic::{AtomicU32, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicU32, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 use tokio::io::{AsyncRead, AsyncWrite};
 use tokio::net::TcpListener;
@@ -40,6 +40,10 @@ struct Session {
     imu: tokio::sync::Mutex<SimImu>,
     /// Frame counter, kept across reconnects.
     counter: AtomicU32,
+    /// The newest IMU link's number: an older link still being served (its client gone,
+    /// not yet noticed) stops before taking another sample, so that it never takes samples
+    /// from between the ones the newest link sends (they were lost frames on that link).
+    imu_link: AtomicU64,
     faults: Arc<LinkFaults>,
     /// Drops already played.
     fired: Mutex<Vec<bool>>,
@@ -119,6 +123,7 @@ impl Emulator {
                 table: tokio::sync::Mutex::new(table),
                 imu: tokio::sync::Mutex::new(imu),
                 counter: AtomicU32::new(0),
+                imu_link: AtomicU64::new(0),
                 faults: self.faults.clone(),
                 fired: Mutex::new(vec![false; self.faults.drops.len()]),
                 open: AtomicUsize::new(0),

@@ -7,6 +7,7 @@ use super::quantity::{
     Accel, AccelDensity, Angle, Freq, Pressure, Rate, RateDensity, RateWalk, Ratio, Rotation, Temp,
     TempDelta, TempRate, Time, UnitVec, damping, finite, fraction, frequency, positive,
 };
+use crate::registry::DriverSpec;
 use serde::{Deserialize, Serialize};
 
 use super::faults::FaultSpec;
@@ -50,78 +51,6 @@ pub struct SiteSpec {
     pub gravity_mps2: f64,
 }
 
-/// Which driver runs the table (the registry, `registry.rs`, lists every kind).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case", deny_unknown_fields)]
-pub enum TableDriverSpec {
-    /// The simulated table.
-    Sim,
-    /// A table speaking the line protocol of `docs/protocols.md` over TCP.
-    Tcp {
-        /// `host:port`.
-        address: String,
-        /// Reply timeout; a link lost for longer aborts the run.
-        #[serde(default = "default_timeout")]
-        timeout: Time,
-    },
-    /// A table speaking the line protocol over a serial port.
-    Serial {
-        /// Device path (`/dev/ttyUSB0`, a pseudo-terminal).
-        port: String,
-        /// Baud rate.
-        #[serde(default = "default_baud")]
-        baud: u32,
-        /// Reply timeout; a link lost for longer aborts the run.
-        #[serde(default = "default_timeout")]
-        timeout: Time,
-    },
-    /// Replays the table stream of a recording folder.
-    Replay {
-        /// The recording folder.
-        recording: String,
-    },
-}
-
-fn default_timeout() -> Time {
-    Time(2.0)
-}
-
-fn default_baud() -> u32 {
-    921_600
-}
-
-/// Which driver runs the IMU (the registry, `registry.rs`, lists every kind).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case", deny_unknown_fields)]
-pub enum ImuDriverSpec {
-    /// The simulated IMU (needs the simulated table: it senses the table's true motion).
-    Sim,
-    /// An IMU streaming the binary frames of `docs/protocols.md` over TCP.
-    Tcp {
-        /// `host:port`.
-        address: String,
-        /// Silence after which the link is rebuilt; a link lost for longer aborts the run.
-        #[serde(default = "default_timeout")]
-        timeout: Time,
-    },
-    /// An IMU streaming binary frames over a serial port.
-    Serial {
-        /// Device path.
-        port: String,
-        /// Baud rate.
-        #[serde(default = "default_baud")]
-        baud: u32,
-        /// Silence after which the link is rebuilt; a link lost for longer aborts the run.
-        #[serde(default = "default_timeout")]
-        timeout: Time,
-    },
-    /// Replays the IMU stream of a recording folder.
-    Replay {
-        /// The recording folder.
-        recording: String,
-    },
-}
-
 /// Settling behaviour of the table servo: a second-order loop.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -156,8 +85,8 @@ impl Default for SettlingSpec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TableSpec {
-    /// Which driver.
-    pub driver: TableDriverSpec,
+    /// Which driver (a kind the registry lists, `registry/mod.rs`).
+    pub driver: DriverSpec,
     /// Model name.
     #[serde(default = "default_table_model")]
     pub model: String,
@@ -209,8 +138,9 @@ impl Default for MountSpec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ImuSpec {
-    /// Which driver.
-    pub driver: ImuDriverSpec,
+    /// Which driver (a kind the registry lists; `sim` needs the simulated table: it senses
+    /// the table's true motion).
+    pub driver: DriverSpec,
     /// Model name.
     #[serde(default)]
     pub model: String,

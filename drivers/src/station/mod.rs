@@ -12,8 +12,8 @@ pub use describe::{Environment, ImuIdentity, StationInfo};
 pub use effects::EffectsSpec;
 pub use faults::{AxisName, DropoutMode, FaultSpec, LinkName, TableFaultMode};
 pub use file::{
-    AmbientSpec, EnvironmentSpec, ImuDriverSpec, ImuSpec, ImuTemperatureSpec, MountSpec,
-    SettlingSpec, SiteSpec, Station, TableDriverSpec, TableSpec, TemperatureSpec,
+    AmbientSpec, EnvironmentSpec, ImuSpec, ImuTemperatureSpec, MountSpec, SettlingSpec, SiteSpec,
+    Station, TableSpec, TemperatureSpec,
 };
 pub use quantity::{
     Accel, AccelDensity, Angle, Freq, Pressure, Rate, RateDensity, RateWalk, Ratio, Rotation, Temp,
@@ -160,6 +160,8 @@ fn located(err: &serde_saphyr::Error, text: &str, file_name: &str) -> StationErr
     let help = help_for(&message);
     let label = if message.contains("unknown field") {
         "unknown key"
+    } else if message.contains("unknown driver") {
+        "unknown driver"
     } else {
         "here"
     }
@@ -190,7 +192,7 @@ fn help_for(message: &str) -> String {
         return "the Earth's rotation is site physics, always on: set site.latitude_deg instead"
             .into();
     }
-    if message.contains("unknown field") {
+    if message.contains("unknown field") || message.contains("unknown driver") {
         let found = message.split('`').nth(1).unwrap_or("");
         let keys: Vec<&str> = message
             .split_once("expected ")
@@ -201,9 +203,15 @@ fn help_for(message: &str) -> String {
                     .collect()
             })
             .unwrap_or_default();
+        // One edit away counts as close too: Jaro-Winkler misses a swap in a short name
+        // (`tpc` for `tcp`).
+        let close = |k: &str| match strsim::osa_distance(found, k) {
+            0 | 1 => 1.0,
+            _ => strsim::jaro_winkler(found, k),
+        };
         let best = keys
             .iter()
-            .map(|k| (strsim::jaro_winkler(found, k), *k))
+            .map(|k| (close(k), *k))
             .filter(|(score, _)| *score > 0.8)
             .max_by(|a, b| a.0.total_cmp(&b.0));
         return match best {

@@ -2,7 +2,6 @@
 //! (text, canonical hash, checked plan), the run folder and its manifest.
 
 use miette::{IntoDiagnostic, Report, WrapErr, miette};
-use ratecal_drivers::station::{ImuDriverSpec, TableDriverSpec};
 use ratecal_drivers::{DEFAULT_STATION_YAML, SWAYING_STATION_YAML, Station};
 use ratecal_engine::plan::Plan;
 use ratecal_engine::recording::{
@@ -67,8 +66,8 @@ pub fn station_for(
     };
     let mut station = Station::from_yaml(&yaml, &name).map_err(|e| Report::new(*e))?;
     if dry_run {
-        station.table.driver = TableDriverSpec::Sim;
-        station.imu.driver = ImuDriverSpec::Sim;
+        station.table.driver = ratecal_drivers::DriverSpec::sim();
+        station.imu.driver = ratecal_drivers::DriverSpec::sim();
     }
     Ok(LoadedStation { station, yaml })
 }

@@ -1,10 +1,15 @@
 //! The one list of driver kinds, and `build`, which turns a station into a table and an
-//! IMU driver. Adding a driver means adding it here (and its keys to the station file's
-//! driver section); the station loader, `describe` and the CLI ask this list.
+//! IMU driver. Adding a driver means adding it here, with the settings it takes: the
+//! station file's `driver:` values are parsed against this list (`spec.rs`), and
+//! `describe` and the CLI ask it.
+
+mod spec;
+
+pub use spec::{DriverSpec, Settings};
 
 use crate::link::{Endpoint, FramedImu, LinkTable};
 use crate::sim::{SharedWorld, SimImu, SimTable};
-use crate::station::{ImuDriverSpec, Station, TableDriverSpec};
+use crate::station::Station;
 use crate::{DriverError, DriverErrorKind, ImuDriver, ImuInfo, TableDriver, TableInfo};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -31,8 +36,8 @@ impl Context<'_> {
     }
 }
 
-type TableBuilder = fn(&mut Context<'_>) -> Result<Box<dyn TableDriver>, DriverError>;
-type ImuBuilder = fn(&mut Context<'_>) -> Result<Box<dyn ImuDriver>, DriverError>;
+type TableBuilder = fn(&mut Context<'_>, &Settings) -> Result<Box<dyn TableDriver>, DriverError>;
+type ImuBuilder = fn(&mut Context<'_>, &Settings) -> Result<Box<dyn ImuDriver>, DriverError>;
 
 /// A kind of driver the registry knows.
 #[derive(Clone, Copy)]
@@ -41,6 +46,9 @@ pub struct DriverKind {
     pub name: &'static str,
     /// Whether it is a simulation (runs on the paused clock) rather than a device.
     pub simulated: bool,
+    /// The settings it takes, each with whether it is required (none: written `driver:
+    /// NAME`).
+    pub keys: &'static [(&'static str, bool)],
     /// Builds the table driver, if the kind can drive a table.
     pub table: Option<TableBuilder>,
     /// Builds the IMU driver, if the kind can read an IMU.
@@ -60,13 +68,15 @@ pub const DRIVERS: &[DriverKind] = &[
     DriverKind {
         name: "sim",
         simulated: true,
-        table: Some(|c| Ok(Box::new(SimTable::new(c.station, c.world(), c.seed)))),
+        keys: &[],
+        table: Some(|c, _| Ok(Box::new(SimTable::new(c.station, c.world(), c.seed)))),
         imu: Some(sim_imu),
         about: "simulated station (physics.md), seeded, virtual time",
     },
     DriverKind {
         name: "tcp",
         simulated: false,
+        keys: &[("address", true), ("timeout", false)],
         table: Some(link_table),
         imu: Some(framed_imu),
         about: "table over the line protocol, IMU over binary frames (docs/protocols.md), TCP",
@@ -74,6 +84,7 @@ pub const DRIVERS: &[DriverKind] = &[
     DriverKind {
         name: "serial",
         simulated: false,
+        keys: &[("port", true), ("baud", false), ("timeout", false)],
         table: Some(link_table),
         imu: Some(framed_imu),
         about: "the same protocols over a serial port (tokio-serial)",
@@ -81,31 +92,31 @@ pub const DRIVERS: &[DriverKind] = &[
     DriverKind {
         name: "replay",
         simulated: false,
-        table: Some(|c| match &c.station.table.driver {
-            TableDriverSpec::Replay { recording } => Ok(Box::new(
-                crate::replay::ReplayTable::open(recording, c.station)?,
-            )),
-            _ => Err(mismatch("replay")),
+        keys: &[("recording", true)],
+        table: Some(|c, s| {
+            let dir = required(s.recording.as_ref(), "recording")?;
+            Ok(Box::new(crate::replay::ReplayTable::open(dir, c.station)?))
         }),
-        imu: Some(|c| match &c.station.imu.driver {
-            ImuDriverSpec::Replay { recording } => Ok(Box::new(crate::replay::ReplayImu::open(
-                recording, c.station,
-            )?)),
-            _ => Err(mismatch("replay")),
+        imu: Some(|c, s| {
+            let dir = required(s.recording.as_ref(), "recording")?;
+            Ok(Box::new(crate::replay::ReplayImu::open(dir, c.station)?))
         }),
         about: "replays the streams of a recording folder in time",
     },
 ];
 
-fn mismatch(kind: &str) -> DriverError {
-    DriverError::new(
-        DriverErrorKind::InvalidCommand,
-        format!("internal: the `{kind}` builder was given another kind"),
-    )
+/// A required setting (the station loader checked it: missing is an internal error).
+fn required<'a>(v: Option<&'a String>, key: &str) -> Result<&'a String, DriverError> {
+    v.ok_or_else(|| {
+        DriverError::new(
+            DriverErrorKind::InvalidCommand,
+            format!("internal: the driver was built without its `{key}`"),
+        )
+    })
 }
 
-fn sim_imu(c: &mut Context<'_>) -> Result<Box<dyn ImuDriver>, DriverError> {
-    if !matches!(c.station.table.driver, TableDriverSpec::Sim) {
+fn sim_imu(c: &mut Context<'_>, _: &Settings) -> Result<Box<dyn ImuDriver>, DriverError> {
+    if !c.station.table.driver.kind.simulated {
         return Err(DriverError::new(
             DriverErrorKind::InvalidCommand,
             "the simulated IMU senses the simulated table's motion: it needs `table.driver: sim`",
@@ -114,16 +125,19 @@ fn sim_imu(c: &mut Context<'_>) -> Result<Box<dyn ImuDriver>, DriverError> {
     Ok(Box::new(SimImu::new(c.station, c.world(), c.seed)))
 }
 
-fn link_table(c: &mut Context<'_>) -> Result<Box<dyn TableDriver>, DriverError> {
-    let (endpoint, timeout) = match &c.station.table.driver {
-        TableDriverSpec::Tcp { address, timeout } => (Endpoint::Tcp(address.clone()), timeout.0),
-        TableDriverSpec::Serial {
-            port,
-            baud,
-            timeout,
-        } => (Endpoint::Serial(port.clone(), *baud), timeout.0),
-        _ => return Err(mismatch("tcp/serial")),
-    };
+/// A TCP address or a serial port, whichever the settings name.
+fn endpoint(s: &Settings) -> Result<Endpoint, DriverError> {
+    match (&s.address, &s.port) {
+        (Some(a), _) => Ok(Endpoint::Tcp(a.clone())),
+        (None, p) => Ok(Endpoint::Serial(
+            required(p.as_ref(), "port")?.clone(),
+            s.baud(),
+        )),
+    }
+}
+
+fn link_table(c: &mut Context<'_>, s: &Settings) -> Result<Box<dyn TableDriver>, DriverError> {
+    let endpoint = endpoint(s)?;
     let spec = &c.station.table;
     let info = TableInfo {
         model: spec.model.clone(),
@@ -132,19 +146,16 @@ fn link_table(c: &mut Context<'_>) -> Result<Box<dyn TableDriver>, DriverError> 
         feedback_hz: spec.feedback_rate.0,
         simulated: false,
     };
-    Ok(Box::new(LinkTable::new(endpoint, info, timeout, c.start)))
+    Ok(Box::new(LinkTable::new(
+        endpoint,
+        info,
+        s.timeout_s(),
+        c.start,
+    )))
 }
 
-fn framed_imu(c: &mut Context<'_>) -> Result<Box<dyn ImuDriver>, DriverError> {
-    let (endpoint, timeout) = match &c.station.imu.driver {
-        ImuDriverSpec::Tcp { address, timeout } => (Endpoint::Tcp(address.clone()), timeout.0),
-        ImuDriverSpec::Serial {
-            port,
-            baud,
-            timeout,
-        } => (Endpoint::Serial(port.clone(), *baud), timeout.0),
-        _ => return Err(mismatch("tcp/serial")),
-    };
+fn framed_imu(c: &mut Context<'_>, s: &Settings) -> Result<Box<dyn ImuDriver>, DriverError> {
+    let endpoint = endpoint(s)?;
     let imu = &c.station.imu;
     let info = ImuInfo {
         model: imu.model.clone(),
@@ -155,7 +166,7 @@ fn framed_imu(c: &mut Context<'_>) -> Result<Box<dyn ImuDriver>, DriverError> {
         gyro_range_dps: imu.gyro_range.0,
         simulated: false,
     };
-    let timeout = Duration::from_secs_f64(timeout);
+    let timeout = Duration::from_secs_f64(s.timeout_s());
     Ok(Box::new(FramedImu::spawn(endpoint, info, timeout, c.start)))
 }
 
@@ -164,35 +175,9 @@ pub fn kind(name: &str) -> Option<&'static DriverKind> {
     DRIVERS.iter().find(|k| k.name == name)
 }
 
-impl TableDriverSpec {
-    /// The registry name of this driver.
-    pub fn kind(&self) -> &'static str {
-        match self {
-            TableDriverSpec::Sim => "sim",
-            TableDriverSpec::Tcp { .. } => "tcp",
-            TableDriverSpec::Serial { .. } => "serial",
-            TableDriverSpec::Replay { .. } => "replay",
-        }
-    }
-}
-
-impl ImuDriverSpec {
-    /// The registry name of this driver.
-    pub fn kind(&self) -> &'static str {
-        match self {
-            ImuDriverSpec::Sim => "sim",
-            ImuDriverSpec::Tcp { .. } => "tcp",
-            ImuDriverSpec::Serial { .. } => "serial",
-            ImuDriverSpec::Replay { .. } => "replay",
-        }
-    }
-}
-
 /// Whether both of a station's drivers are simulations (the run may use virtual time).
 pub fn simulated(station: &Station) -> bool {
-    [station.table.driver.kind(), station.imu.driver.kind()]
-        .iter()
-        .all(|n| kind(n).is_some_and(|k| k.simulated))
+    station.table.driver.kind.simulated && station.imu.driver.kind.simulated
 }
 
 /// A station's table and IMU drivers.
@@ -207,24 +192,16 @@ pub fn build(station: &Station, seed: u64) -> Result<Drivers, DriverError> {
         start: Instant::now(),
         world: None,
     };
-    let find = |name: &str| {
-        kind(name).ok_or_else(|| {
-            DriverError::new(
-                DriverErrorKind::InvalidCommand,
-                format!("no driver `{name}` in the registry"),
-            )
-        })
-    };
-    let table_kind = find(station.table.driver.kind())?;
-    let imu_kind = find(station.imu.driver.kind())?;
+    let (table, imu) = (&station.table.driver, &station.imu.driver);
     let no = |what: &str, k: &DriverKind| {
         DriverError::new(
             DriverErrorKind::InvalidCommand,
             format!("the `{}` driver cannot run {what}", k.name),
         )
     };
-    let table = table_kind.table.ok_or_else(|| no("a table", table_kind))?(&mut ctx)?;
-    let imu = imu_kind.imu.ok_or_else(|| no("an IMU", imu_kind))?(&mut ctx)?;
+    let table =
+        table.kind.table.ok_or_else(|| no("a table", table.kind))?(&mut ctx, &table.settings)?;
+    let imu = imu.kind.imu.ok_or_else(|| no("an IMU", imu.kind))?(&mut ctx, &imu.settings)?;
     Ok((table, imu))
 }
 
@@ -260,9 +237,8 @@ mod tests {
             ),
         ] {
             let s = Station::from_yaml(&yaml(t, i), "s.yaml").unwrap();
-            let (tk, ik) = (s.table.driver.kind(), s.imu.driver.kind());
-            assert!(kind(tk).is_some_and(|k| k.table.is_some()), "{tk}");
-            assert!(kind(ik).is_some_and(|k| k.imu.is_some()), "{ik}");
+            assert!(s.table.driver.kind.table.is_some());
+            assert!(s.imu.driver.kind.imu.is_some());
             assert!(!simulated(&s));
         }
         assert!(simulated(&Station::default_sim()));
