@@ -347,3 +347,63 @@ fn a_corrupted_stored_file_is_found_by_check() {
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["missing"].as_array().unwrap().len(), 1);
 }
+
+/// The report's conclusions use the unit's history when an archive is named: how many
+/// calibrations since when, each determined drift per year, and the recalibration interval
+/// the drift implies against the acceptance limit; without an archive they keep the
+/// procedure's (or the default) interval.
+#[test]
+fn the_report_concludes_from_the_archived_history() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cwd = tmp.path();
+    write_run(
+        &cwd.join("a"),
+        Some("1234"),
+        "2025-03-01T10:00:00Z",
+        0.01,
+        &[],
+    );
+    write_run(
+        &cwd.join("b"),
+        Some("1234"),
+        "2026-03-01T10:00:00Z",
+        0.012,
+        &[],
+    );
+    let o = ratecal(&["archive", "add", "a", "b"], cwd);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let o = ratecal(&["report", "b", "--archive", "archive"], cwd);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let md = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(
+        md.contains("The lab's archive holds 2 calibrations of serial 1234 since 2025-03-01."),
+        "{md}"
+    );
+    // 0.010 -> 0.012 m/s^2 in a year: 0.0020 m/s^2 per year.
+    assert!(md.contains("accel.bias.x 0.0020"), "{md}");
+    assert!(md.contains("m/s²/year.\n- Recalibrate every"), "{md}");
+    // The limit is 0.05 m/s^2: the drift reaches it years on; the interval says by when.
+    let t = ratecal(
+        &[
+            "archive",
+            "trend",
+            "1234",
+            "--param",
+            "accel.bias.x",
+            "--format",
+            "json",
+        ],
+        cwd,
+    );
+    let t: serde_json::Value = serde_json::from_slice(&t.stdout).unwrap();
+    let by = t["parameters"][0]["recalibrate_by"].as_str().unwrap();
+    assert!(
+        md.contains(&format!("(by {by}: the archive's trend of accel.bias.x")),
+        "{md}"
+    );
+    // Without an archive: no history, the default interval.
+    let o = ratecal(&["report", "b"], cwd);
+    let md = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(!md.contains("The lab's archive holds"), "{md}");
+    assert!(md.contains("Recalibrate every 12 months"), "{md}");
+}

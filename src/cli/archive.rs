@@ -279,6 +279,40 @@ async fn add_one(archive: &Archive, dir: &Path) -> Result<String, Report> {
     })
 }
 
+/// The unit's trend across the calibrations the configured archive holds (`--archive` or
+/// `RATECAL_ARCHIVE`), as `archive trend --format json` gives it, for a report's
+/// conclusions; `None` without an archive, without a serial, or when it cannot be read (a
+/// report never fails for want of its history: a warning says why).
+pub fn trend_json(archive: Option<&str>, serial: Option<&str>) -> Option<serde_json::Value> {
+    let serial = serial.filter(|s| !s.is_empty())?;
+    if !Location::configured(archive) {
+        return None;
+    }
+    let loc = Location::resolve(archive, None);
+    let rt = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .ok()?;
+    let opt = TrendOptions {
+        params: Vec::new(),
+        include_dry_runs: false,
+        confidence: 0.95,
+    };
+    let res = rt.block_on(async {
+        let a = Archive::open_existing(&loc).await?;
+        let t = a.trend(serial, &opt).await;
+        a.close().await;
+        t
+    });
+    match res {
+        Ok(t) => serde_json::to_value(&t).ok(),
+        Err(e) => {
+            eprintln!("warning: the report leaves out the archive's history of {serial}:\n{e:?}");
+            None
+        }
+    }
+}
+
 /// `ratecal run`'s hook: adds the finished run when an archive is named (`--archive` or
 /// `RATECAL_ARCHIVE`); a failure is a warning, never the run's exit code.
 pub fn after_run(archive: Option<&str>, dir: &Path) {

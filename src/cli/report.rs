@@ -27,6 +27,10 @@ pub struct Args {
     /// Write the report here instead of standard output.
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
+    /// The lab's archive (folder or postgres:// URL; also $RATECAL_ARCHIVE): the report's
+    /// conclusions then use the unit's trend across the calibrations it holds.
+    #[arg(long, value_name = "DIR_OR_URL")]
+    archive: Option<String>,
 }
 
 /// `--format`.
@@ -75,7 +79,9 @@ pub fn main(args: Args) -> ExitCode {
 }
 
 fn report(args: &Args) -> miette::Result<()> {
-    let input = read_run(&args.run_dir)?;
+    let mut input = read_run(&args.run_dir)?;
+    let serial = serial_of(&input);
+    input.archive_trend = super::archive::trend_json(args.archive.as_deref(), serial.as_deref());
     let mut templates = Templates::bundled();
     let format = match args.format {
         FormatArg::Md => Format::Markdown,
@@ -122,6 +128,15 @@ pub fn write_reports(
         written.push(path);
     }
     Ok(written)
+}
+
+/// The IMU serial a run's manifest names (a YAML number such as `1234` too).
+pub fn serial_of(input: &ReportInput) -> Option<String> {
+    match input.manifest.as_ref()?.get("imu")?.get("serial")? {
+        serde_json::Value::String(s) => Some(s.clone()),
+        serde_json::Value::Number(n) => Some(n.to_string()),
+        _ => None,
+    }
 }
 
 /// Reads what a report needs from a run folder: results.json (required), manifest.yaml
@@ -188,6 +203,7 @@ pub fn read_run(dir: &Path) -> miette::Result<ReportInput> {
         temperature,
         ratecal_version: env!("CARGO_PKG_VERSION").to_string(),
         explain,
+        archive_trend: None,
     })
 }
 

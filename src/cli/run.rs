@@ -95,7 +95,7 @@ fn run(args: Args) -> Result<ExitCode, Report> {
         None => prepare_new(&args)?,
     };
     let dir = prep.dir.clone();
-    match execute_prepared(prep, key.as_ref()) {
+    match execute_prepared(prep, key.as_ref(), args.archive.as_deref()) {
         Ok(code) => {
             // Archived once sealed; a failure to archive is a warning, never the run's fate.
             super::archive::after_run(args.archive.as_deref(), &dir);
@@ -111,7 +111,11 @@ fn run(args: Args) -> Result<ExitCode, Report> {
     }
 }
 
-fn execute_prepared(prep: Prepared, key: Option<&SigningKey>) -> Result<ExitCode, Report> {
+fn execute_prepared(
+    prep: Prepared,
+    key: Option<&SigningKey>,
+    archive: Option<&str>,
+) -> Result<ExitCode, Report> {
     let Prepared {
         dir,
         plan,
@@ -178,6 +182,7 @@ fn execute_prepared(prep: Prepared, key: Option<&SigningKey>) -> Result<ExitCode
         wall_s: wall,
         simulated,
         key,
+        archive,
     };
     Ok(end.finish())
 }

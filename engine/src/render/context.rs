@@ -63,11 +63,18 @@ pub fn build(input: &ReportInput) -> Value {
         Value::Null => recording.get("imu").cloned().unwrap_or(json!({})),
         i => i,
     };
-    let interval = input.plan.as_ref().and_then(|p| {
-        p.meta
-            .get("recalibration_interval")
-            .or_else(|| p.meta.get("recalibration"))
-    });
+    let trend = input.archive_trend.clone().unwrap_or(Value::Null);
+    let from_trend = views::trend_interval(&trend);
+    let interval = input
+        .plan
+        .as_ref()
+        .and_then(|p| {
+            p.meta
+                .get("recalibration_interval")
+                .or_else(|| p.meta.get("recalibration"))
+                .cloned()
+        })
+        .or_else(|| from_trend.clone());
     let repeatability = match results.get("repeatability") {
         Some(r) if r.is_object() => {
             let mut r = r.clone();
@@ -129,6 +136,7 @@ pub fn build(input: &ReportInput) -> Value {
         "sync": sync,
         "warnings": results.get("warnings").cloned().unwrap_or(json!([])),
         "explain": input.explain.clone().unwrap_or(Value::Null),
+        "archive_trend": views::trend_view(&trend),
         "findings": results.get("findings").cloned().unwrap_or(json!([])),
         "summary": summary,
         "history": history(&run),

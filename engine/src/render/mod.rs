@@ -49,6 +49,10 @@ pub struct ReportInput {
     pub ratecal_version: String,
     /// explain.json (`ratecal-explain/1`) when `ratecal explain` was run on the folder.
     pub explain: Option<serde_json::Value>,
+    /// The unit's trend across the calibrations the lab's archive holds
+    /// (`ratecal archive trend SERIAL --format json`), when an archive is configured and
+    /// holds any.
+    pub archive_trend: Option<serde_json::Value>,
 }
 
 impl ReportInput {
@@ -69,6 +73,7 @@ impl ReportInput {
                 .unwrap_or_default(),
             ratecal_version: ratecal_version.to_string(),
             explain: None,
+            archive_trend: None,
         }
     }
 }

@@ -274,3 +274,75 @@ pub fn summary(checks: &Value, results: &Value, params: &Value) -> Value {
         "unobservable": unobservable,
     })
 }
+
+/// The recalibration interval the archive's trend implies: the soonest a determined drift
+/// is expected to cross its acceptance limit, as text for the conclusions.
+pub(crate) fn trend_interval(trend: &Value) -> Option<String> {
+    let params = trend.get("parameters")?.as_array()?;
+    let (days, p) = params
+        .iter()
+        .filter_map(|p| Some((p.get("recalibration_days")?.as_f64()?, p)))
+        .filter(|(d, _)| d.is_finite())
+        .min_by(|a, b| a.0.total_cmp(&b.0))?;
+    let months = (days / 30.44).floor().max(1.0);
+    let conf = trend
+        .get("confidence")
+        .and_then(Value::as_f64)
+        .unwrap_or(0.95)
+        * 100.0;
+    Some(format!(
+        "{months:.0} months (by {}: the archive's trend of {} reaches its acceptance limit then, at {conf:.0} % confidence)",
+        p.get("recalibrate_by")
+            .and_then(Value::as_str)
+            .unwrap_or("?"),
+        p.get("name").and_then(Value::as_str).unwrap_or("?"),
+    ))
+}
+
+/// What the report shows of the archive's trend: how many calibrations, since when, and
+/// each determined drift (`rate`, `u` per year, with the parameter's unit); `null` when no
+/// archive was consulted or it holds no calibration of the unit.
+pub(crate) fn trend_view(trend: &Value) -> Value {
+    let n = trend
+        .get("calibrations")
+        .and_then(Value::as_u64)
+        .unwrap_or(0);
+    if n == 0 {
+        return Value::Null;
+    }
+    let params = trend
+        .get("parameters")
+        .and_then(Value::as_array)
+        .cloned()
+        .unwrap_or_default();
+    let since = params
+        .iter()
+        .filter_map(|p| {
+            p.get("points")?
+                .as_array()?
+                .first()?
+                .get("started")?
+                .as_str()
+        })
+        .min()
+        .map(|s| s.chars().take(10).collect::<String>());
+    let drifts: Vec<Value> = params
+        .iter()
+        .filter_map(|p| {
+            let d = p.get("drift")?;
+            Some(json!({
+                "name": p.get("name"),
+                "unit": format!("{}/year", p.get("unit").and_then(Value::as_str).unwrap_or("")),
+                "rate": d.get("rate_per_year"),
+                "u": d.get("u_rate_per_year"),
+                "recalibrate_by": p.get("recalibrate_by"),
+            }))
+        })
+        .collect();
+    json!({
+        "serial": trend.get("serial"),
+        "calibrations": n,
+        "since": since,
+        "drifts": drifts,
+    })
+}

@@ -45,6 +45,7 @@ pub fn full() -> ReportInput {
         temperature: temperatures(),
         ratecal_version: "0.1.0".into(),
         explain: None,
+        archive_trend: None,
     }
 }
 
@@ -58,6 +59,7 @@ pub fn foreign() -> ReportInput {
         temperature: TemperatureSeries::default(),
         ratecal_version: "0.1.0".into(),
         explain: None,
+        archive_trend: None,
     }
 }
 
@@ -70,5 +72,6 @@ pub fn minimal() -> ReportInput {
         temperature: TemperatureSeries::default(),
         ratecal_version: "0.1.0".into(),
         explain: None,
+        archive_trend: None,
     }
 }

@@ -26,6 +26,8 @@ pub struct End<'a> {
     pub simulated: bool,
     /// The lab's key, to sign the seal.
     pub key: Option<&'a SigningKey>,
+    /// The lab's archive (`--archive`), whose history of the unit the report uses.
+    pub archive: Option<&'a str>,
 }
 
 impl End<'_> {
@@ -88,7 +90,7 @@ impl End<'_> {
                 dir.display()
             );
         }
-        let verdict = analyze(dir, self.plan);
+        let verdict = analyze(dir, self.plan, self.archive);
         if let Err(e) = crate::cli::seal::write(dir, self.key) {
             errln!("cannot seal {}: {e}", dir.display());
             return ExitCode::from(1);
@@ -126,7 +128,7 @@ pub fn journal_warnings(dir: &Path) -> Vec<String> {
 
 /// Analyses the recording kept (complete or not), writes results.json, plan.json and the
 /// reports; the verdict, or `None` when the recording could not be analysed.
-fn analyze(dir: &Path, plan: &Plan) -> Option<RunVerdict> {
+fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict> {
     let rec = match ratecal_engine::recording::read(dir) {
         Ok(r) => r,
         Err(e) => {
@@ -165,13 +167,15 @@ fn analyze(dir: &Path, plan: &Plan) -> Option<RunVerdict> {
     if let Ok(json) = serde_json::to_string_pretty(plan) {
         let _ = std::fs::write(dir.join("plan.json"), json);
     }
-    let input = ratecal_engine::render::ReportInput::from_run(
+    let mut input = ratecal_engine::render::ReportInput::from_run(
         &results,
         &rec.manifest,
         Some(plan),
         Some(&rec),
         env!("CARGO_PKG_VERSION"),
     );
+    let serial = crate::cli::report::serial_of(&input);
+    input.archive_trend = crate::cli::archive::trend_json(archive, serial.as_deref());
     match crate::cli::report::write_reports(dir, &input, None) {
         Ok(paths) => {
             for p in paths {
