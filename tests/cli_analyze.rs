@@ -1,19 +1,9 @@
 //! `ratecal analyze` from the command line: exit codes and the results file.
 
-use std::path::Path;
-use std::process::Command;
+mod support;
 
-fn example() -> Option<std::path::PathBuf> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let found = ["../shared", "../../shared"]
-        .iter()
-        .map(|r| root.join(r).join("examples/standard-with-lever-arm"))
-        .find(|p| p.exists());
-    if found.is_none() {
-        println!("skipped: ../shared/examples/standard-with-lever-arm is absent");
-    }
-    found
-}
+use std::process::Command;
+use support::example;
 
 fn analyze(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_ratecal"))

@@ -3,20 +3,11 @@
 //! applies, after which `ratecal check` accepts the procedure and `ratecal diff` names the
 //! effect.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod support;
 
-fn example() -> Option<PathBuf> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let found = ["../shared", "../../shared"]
-        .iter()
-        .map(|r| root.join(r).join("examples/standard-with-lever-arm"))
-        .find(|p| p.exists());
-    if found.is_none() {
-        println!("skipped: ../shared/examples/standard-with-lever-arm is absent");
-    }
-    found
-}
+use std::path::Path;
+use std::process::{Command, Output};
+use support::{example, text};
 
 fn ratecal(args: &[&str], cwd: &Path) -> Output {
     Command::new(env!("CARGO_BIN_EXE_ratecal"))
@@ -25,14 +16,6 @@ fn ratecal(args: &[&str], cwd: &Path) -> Output {
         .current_dir(cwd)
         .output()
         .unwrap()
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
 }
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");

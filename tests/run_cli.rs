@@ -1,64 +1,11 @@
 //! `ratecal run` end to end: exit codes, the run folder, aborts driven by station files,
 //! `--resume`.
 
+mod support;
+
 use std::path::Path;
-use std::process::{Command, Output};
-
-const MINI: &str = r#"procedure mini version 1.0.0 {
-  title "Two attitudes and one rate"
-  imu class tactical
-
-  abort when table.attitude_error > 5 arcsec for 1 s
-  abort when ambient.temperature outside 18 degC .. 22 degC for 2 s
-
-  step statics "Two static attitudes" {
-    for (n, pitch, roll) in [(1, 0 deg, 0 deg), (2, 90 deg, 0 deg)] {
-      move to pitch pitch, roll roll
-      settle {
-        at least 5 s
-        table.attitude_error <= 5 arcsec
-        timeout 60 s -> abort
-      }
-      acquire accel, gyro, table for 10 s at 100 Hz as "accel_static/{n}"
-    }
-  }
-
-  step rates "One rate point" {
-    for axis in [outer] {
-      for rate in [50] deg/s {
-        spin axis at rate
-        settle {
-          at least 5 s
-          table.rate_error <= 0.5 deg/s
-          timeout 60 s -> abort
-        }
-        acquire gyro, table for 10 s at 100 Hz as "gyro_scale/{axis}/{rate:+}"
-      }
-      stop axis
-    }
-  }
-}
-"#;
-
-fn ratecal(args: &[&str], cwd: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ratecal"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .unwrap()
-}
-
-fn code(o: &Output) -> i32 {
-    o.status.code().unwrap_or(-1)
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
+use std::process::Command;
+use support::{MINI, code, ratecal, station_with, text};
 
 fn manifest(dir: &Path) -> ratecal_engine::recording::Manifest {
     ratecal_engine::recording::parse_manifest(
@@ -161,10 +108,6 @@ fn dry_run_writes_the_run_folder() {
     let same = std::fs::read(dir.join("imu.csv")).unwrap()
         == std::fs::read(tmp.path().join("r2/imu.csv")).unwrap();
     assert!(same, "same seed, different imu.csv");
-}
-
-fn station_with(fault: &str) -> String {
-    ratecal_drivers::DEFAULT_STATION_YAML.replace("faults: []", fault)
 }
 
 #[test]

@@ -2,7 +2,7 @@
 
 #![allow(dead_code)]
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 /// Two attitudes and one rate point: a dry run of it takes well under a second.
@@ -89,4 +89,18 @@ pub fn mini_run(dir: &Path, out: &str, extra: &[&str]) -> Output {
     let mut args = vec!["run", "p.rcal", "--dry-run", "--out", out];
     args.extend_from_slice(extra);
     ratecal(&args, dir)
+}
+
+/// The shared lever-arm example recording (`../shared/examples/standard-with-lever-arm`),
+/// or `None` with a "skipped" line when this machine lacks it.
+pub fn example() -> Option<PathBuf> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let found = ["../shared", "../../shared"]
+        .iter()
+        .map(|r| root.join(r).join("examples/standard-with-lever-arm"))
+        .find(|p| p.exists());
+    if found.is_none() {
+        println!("skipped: ../shared/examples/standard-with-lever-arm is absent");
+    }
+    found
 }
