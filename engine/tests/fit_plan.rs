@@ -193,7 +193,7 @@ fn repeatability_over_three_runs() {
         .collect();
     let mut p = plan();
     p.fits.remove(0);
-    let res = fit::analyze_runs(&runs, Some(&p), &fit::Options::default());
+    let Ok(res) = fit::analyze_runs(&runs, Some(&p), &fit::Options::default());
     let rep = res.repeatability.as_ref().unwrap();
     assert_eq!(rep.runs, 3);
     let bias = rep

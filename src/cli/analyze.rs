@@ -8,7 +8,6 @@ use ratecal_engine::check::{CheckOptions, check_text};
 use ratecal_engine::fit::{self, Options};
 use ratecal_engine::measured::format_measured;
 use ratecal_engine::plan::Plan;
-use ratecal_engine::recording;
 use ratecal_engine::results::{Parameter, Results, RunVerdict};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -47,7 +46,7 @@ pub fn main(args: Args) -> ExitCode {
     };
     let mut runs = Vec::with_capacity(args.runs.len());
     for dir in &args.runs {
-        match recording::read(dir) {
+        match fit::Streamed::open(dir) {
             Ok(r) => runs.push((dir.display().to_string(), r)),
             Err(e) => {
                 errln!("{:?}", miette::Report::new(e));
@@ -59,7 +58,15 @@ pub fn main(args: Args) -> ExitCode {
         with: args.with.clone(),
         ..Options::default()
     };
-    let mut results = fit::analyze_runs(&runs, plan.as_ref(), &opts);
+    // The IMU stream is read a window at a time: a cell found bad there is refused as a
+    // whole read would have refused it.
+    let mut results = match fit::analyze_runs(&runs, plan.as_ref(), &opts) {
+        Ok(r) => r,
+        Err(e) => {
+            errln!("{:?}", miette::Report::new(e));
+            return ExitCode::from(1);
+        }
+    };
     // The procedure given on the command line is identified by its own canonical hash.
     if let (Some(h), Some(p)) = (sha256, results.model.procedure.as_mut()) {
         p.sha256 = h;

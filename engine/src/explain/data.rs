@@ -1,8 +1,7 @@
 //! The recording accumulated once for every model explain will try: every segment, every
 //! registry effect's columns, and which segments are held out.
 
-use crate::fit::joint::{Layout, SegAcc, accumulate, excitation, mean_temperature};
-use crate::fit::prep::geometries;
+use crate::fit::joint::{Layout, SegAcc, excitation};
 use crate::recording::{Recording, SegmentKind};
 use ratecal_physics::Effect;
 
@@ -23,16 +22,9 @@ impl Data {
     /// effects) and chooses the held-out ones: every third segment of each kind, never the
     /// longest static one.
     pub(crate) fn with_effects(rec: &Recording, effects: Vec<&'static dyn Effect>) -> Data {
-        use rayon::prelude::*;
         let layout = Layout::new(effects);
-        let geos = geometries(rec);
-        let t_ref = mean_temperature(rec);
         let segs = &rec.manifest.segments;
-        let accs: Vec<SegAcc> = (0..segs.len())
-            .into_par_iter()
-            .map(|i| accumulate(rec, i, &geos[i], &layout, t_ref, None))
-            .filter(|a| a.n > 0)
-            .collect();
+        let Ok(accs) = crate::fit::accumulate_all(rec, &layout);
         let longest = accs
             .iter()
             .enumerate()

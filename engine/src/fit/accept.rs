@@ -2,12 +2,10 @@
 //! thresholds: value, limit, margin, expanded uncertainty (k = 2), decision rule.
 
 use super::Out;
-use super::prep::SegData;
+use super::segment::{ChannelStats, Summary};
 use super::select::Selection;
-use super::stats::{Inflation, mean, std};
 use crate::plan::{Accept, Cmp, DecisionRule, Plan, Quantity, VerifyPoint};
-use crate::recording::Recording;
-use crate::recording::SegmentKind;
+use crate::recording::{Manifest, SegmentKind};
 use crate::results::{Acceptance, Results, Verdict, VerificationPoint};
 use ratecal_physics::{Mat3, Vec3};
 use std::collections::{BTreeMap, HashMap};
@@ -24,58 +22,54 @@ pub(crate) enum Where {
 /// Compensated output against the reference at every segment no fit used.
 pub(crate) fn verify(
     sel: &Selection,
-    data: &BTreeMap<usize, SegData>,
+    sums: &[Summary],
     out: &Out,
-    rec: &Recording,
+    m: &Manifest,
 ) -> (Vec<VerificationPoint>, HashMap<String, Where>) {
     let mut pts = Vec::new();
     let mut wh = HashMap::new();
     for i in &sel.unused {
-        let Some(s) = data.get(i) else { continue };
-        let seg = &rec.manifest.segments[*i];
-        let w = match (s.kind, &seg.axis, seg.rate_dps) {
+        let Some(s) = sums.iter().find(|s| s.seg == *i && s.prepared) else {
+            continue;
+        };
+        let seg = &m.segments[*i];
+        let w = match (seg.kind, &seg.axis, seg.rate_dps) {
             (SegmentKind::Rate, Some(ax), Some(r)) => Where::Rate(ax.clone(), r),
             _ => Where::Attitude(s.mean_angles_deg.0, s.mean_angles_deg.1),
         };
-        wh.insert(s.id.clone(), w);
-        if s.kind == SegmentKind::Static
-            && let Some(m) = &out.accel_model
+        wh.insert(seg.id.clone(), w);
+        if seg.kind == SegmentKind::Static
+            && let Some(model) = &out.accel_model
         {
-            pts.push(point(s, "accel", m, &s.accel, &s.f_ref, &s.keep_a, "m/s^2"));
+            pts.push(point(&seg.id, "accel", model, &s.channels[..3], "m/s^2"));
         }
-        if let Some(m) = &out.gyro_model {
-            pts.push(point(s, "gyro", m, &s.gyro, &s.w_ref, &s.keep_g, "deg/s"));
+        if let Some(model) = &out.gyro_model {
+            pts.push(point(&seg.id, "gyro", model, &s.channels[3..], "deg/s"));
         }
     }
     (pts, wh)
 }
 
+/// The error of one sensor's compensated mean output against the mean reference.
 fn point(
-    s: &SegData,
+    id: &str,
     sensor: &str,
     model: &(Mat3, Vec3),
-    o: &[std::borrow::Cow<[f64]>; 3],
-    r: &[Vec<f64>; 3],
-    keep: &[bool],
+    ch: &[ChannelStats],
     unit: &str,
 ) -> VerificationPoint {
     let (k, b) = model;
-    let om = Vec3::from_fn(|i, _| mean(&o[i], keep));
-    let rm = Vec3::from_fn(|i, _| mean(&r[i], keep));
+    let n = |i: usize| ch[i].n.max(1) as f64;
+    let om = Vec3::from_fn(|i, _| ch[i].sum_out / n(i));
+    let rm = Vec3::from_fn(|i, _| ch[i].sum_ref / n(i));
     let comp = k.try_inverse().unwrap_or(Mat3::identity()) * (om - b);
     let err = comp - rm;
-    let n = keep.iter().filter(|k| **k).count().max(1) as f64;
-    let u = Vec3::from_fn(|i, _| {
-        let d: Vec<f64> = (0..s.t.len()).map(|j| o[i][j] - r[i][j]).collect();
-        let mut infl = Inflation::default();
-        infl.add(&d, keep);
-        std(&d, keep) * (infl.factor() / n).sqrt()
-    });
+    let u = Vec3::from_fn(|i, _| ch[i].std_d() * (ch[i].inflation.factor() / n(i)).sqrt());
     let imax = (0..3)
         .max_by(|&a, &b| err[a].abs().total_cmp(&err[b].abs()))
         .unwrap_or(0);
     VerificationPoint {
-        segment: s.id.clone(),
+        segment: id.to_string(),
         sensor: sensor.into(),
         max_error: err[imax].abs(),
         error: [err[0], err[1], err[2]],

@@ -1,26 +1,30 @@
 //! Overlapping Allan deviation of the gyros over a static block: angle random walk at
 //! tau = 1 s and bias instability (minimum of the curve / 0.664).
 
-use super::prep::SegData;
 use super::{AXES, Out};
 use crate::results::{AllanCurve, Parameter};
 
 /// Overlapping Allan deviation of `y` sampled every `dt`, at octave cluster sizes
 /// `m = 1, 2, 4, ...` up to a quarter of the series: `(tau, adev, clusters)`.
 pub fn overlapping_adev(y: &[f64], dt: f64) -> Vec<(f64, f64, usize)> {
-    adev_of(y.iter().copied(), y.len(), dt)
+    adev_of_angle(&integrated(y.to_vec(), dt), dt)
 }
 
-/// The same over the `n` values of an iterator (no copy of the series is kept: only the
-/// integrated angle, which the estimator needs).
-fn adev_of(y: impl Iterator<Item = f64>, n: usize, dt: f64) -> Vec<(f64, f64, usize)> {
-    let mut theta = Vec::with_capacity(n + 1);
-    theta.push(0.0);
+/// The integrated angle `theta` of a rate series (`theta[0] = 0`), in the series' own
+/// memory.
+fn integrated(mut y: Vec<f64>, dt: f64) -> Vec<f64> {
+    y.push(0.0);
+    y.rotate_right(1);
     let mut acc = 0.0;
-    for v in y {
-        acc += v * dt;
-        theta.push(acc);
+    for v in &mut y[1..] {
+        acc += *v * dt;
+        *v = acc;
     }
+    y
+}
+
+/// The curve from the integrated angle `theta` (`theta[0] = 0`).
+fn adev_of_angle(theta: &[f64], dt: f64) -> Vec<(f64, f64, usize)> {
     let n = theta.len() - 1;
     let mut out = Vec::new();
     let mut m = 1;
@@ -38,29 +42,22 @@ fn adev_of(y: impl Iterator<Item = f64>, n: usize, dt: f64) -> Vec<(f64, f64, us
     out
 }
 
-/// The three gyro curves of the block (kept samples treated as contiguous): the costly
-/// part of the Allan analysis, free of `Out` so that it can run while the fits do. One
-/// axis at a time, so that a long 1 kHz block holds one integrated series, not three.
+/// The three gyro curves of a block from its kept samples per axis (treated as
+/// contiguous), sampled every `dt`: the costly part of the Allan analysis, free of `Out`
+/// so that it can run while the fits do. Each series is integrated in place, so a long
+/// 1 kHz block holds its three series and nothing more.
 pub(crate) type Curves = Vec<Vec<(f64, f64, usize)>>;
 
-pub(crate) fn curves(block: &SegData) -> Curves {
-    let dt = super::stats::median_step(block.t);
-    let n = block.keep_g.iter().filter(|k| **k).count();
-    (0..3)
-        .map(|ax| {
-            let kept = block.gyro[ax]
-                .iter()
-                .zip(&block.keep_g)
-                .filter(|p| *p.1)
-                .map(|p| *p.0);
-            adev_of(kept, n, dt)
-        })
+pub(crate) fn curves(series: [Vec<f64>; 3], dt: f64) -> Curves {
+    series
+        .into_iter()
+        .map(|y| adev_of_angle(&integrated(y, dt), dt))
         .collect()
 }
 
 /// Allan analysis of the block's gyros from its `curves`: angle random walk at tau = 1 s,
 /// bias instability.
-pub(crate) fn analyse(block: &SegData, curves: &Curves, out: &mut Out) -> Option<AllanCurve> {
+pub(crate) fn analyse(id: &str, curves: &Curves, out: &mut Out) -> Option<AllanCurve> {
     let mut taus = Vec::new();
     let mut adev: [Vec<f64>; 3] = Default::default();
     for (ax, curve) in curves.iter().enumerate() {
@@ -100,13 +97,13 @@ pub(crate) fn analyse(block: &SegData, curves: &Curves, out: &mut Out) -> Option
         if i + 1 == curve.len() && ax == 0 {
             out.warnings.push(format!(
                 "Allan deviation of {} still falls at its longest tau ({:.0} s): the bias instability is an upper bound",
-                block.id,
+                id,
                 curve[i].0
             ));
         }
     }
     Some(AllanCurve {
-        segment: block.id.clone(),
+        segment: id.to_string(),
         tau_s: taus,
         adev_dps: adev,
     })

@@ -16,18 +16,22 @@ mod models;
 pub(crate) mod prep;
 mod repeat;
 mod residuals;
+mod segment;
 mod select;
 pub mod size_effect;
+mod source;
 mod stats;
 
 pub use allan::overlapping_adev;
 pub use repeat::analyze_runs;
+pub use source::{ImuView, Source, Streamed};
 
 use crate::plan::{Outliers, Plan};
 use crate::recording::Recording;
 use crate::results::{self, Parameter, ResidualStats, Results, SyncReport};
-use prep::SegData;
+use joint::{Layout, SegAcc};
 use ratecal_physics::{Mat3, Vec3};
+use segment::Summary;
 use std::collections::BTreeMap;
 
 pub(crate) const AXES: [&str; 3] = ["x", "y", "z"];
@@ -83,53 +87,84 @@ pub fn analyze(rec: &Recording, plan: Option<&Plan>) -> Results {
     analyze_with(rec, plan, &Options::default())
 }
 
-/// Analyses one recording.
+/// Analyses one recording held in memory.
 pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Results {
-    let sel = select::select(rec, plan, opts);
-    let geos = prep::geometries(rec);
+    let Ok(res) = analyze_source(rec, plan, opts);
+    res
+}
+
+/// Analyses one recording read from `src` segment by segment, a window of samples at a
+/// time; fails only when a span of the recording cannot be read.
+pub fn analyze_source<S: Source>(
+    src: &S,
+    plan: Option<&Plan>,
+    opts: &Options,
+) -> Result<Results, S::Error> {
+    let m = src.manifest();
+    let sel = select::select(m, plan, opts);
+    let geos = prep::geometries(m);
     let mut out = Out {
         warnings: sel.warnings.clone(),
         ..Default::default()
     };
-    let mut sync = SyncReport {
-        method: "linear_interpolation".into(),
-        table_step_s: stats::median_step(&rec.table.t),
-        ..Default::default()
+    let declared = models::declared(plan, &opts.with);
+    let thermal = sel.temp_requested && src.has_temp();
+    let design = models::Design::new(&sel, &declared, thermal, &mut out);
+    let rate_hz = mean_rate(src);
+    let t_ref_c = if design.uses_temperature() {
+        mean_temperature(src, rate_hz)?
+    } else {
+        0.0
     };
-    // Segments are independent: prepared in parallel, longest first so that the work
-    // stealing balances; a long segment splits its own work too.
-    let dur = |i: usize| rec.manifest.segments[i].t_end - rec.manifest.segments[i].t_start;
-    let mut order = sel.prep.clone();
-    order.sort_by(|a, b| dur(b.0).total_cmp(&dur(a.0)));
-    let done: Vec<(usize, SegData, SyncReport, Vec<String>)> = {
+    // Segments are independent: passed in parallel, longest first so that the work
+    // stealing balances.
+    let dur = |i: usize| m.segments[i].t_end - m.segments[i].t_start;
+    let mut order: Vec<usize> = (0..m.segments.len()).collect();
+    order.sort_by(|a, b| dur(*b).total_cmp(&dur(*a)));
+    let passed: Vec<(Summary, SegAcc)> = {
         use rayon::prelude::*;
         order
             .par_iter()
-            .map(|&(i, po)| {
-                let mut sync = SyncReport::default();
-                let mut warnings = Vec::new();
-                let seg = &rec.manifest.segments[i];
-                let d = prep::prepare(rec, seg, &geos[i], po, &mut sync, &mut warnings);
-                (i, d, sync, warnings)
+            .map(|&i| {
+                let job = segment::Job {
+                    seg: i,
+                    geo: &geos[i],
+                    layout: &design.layout,
+                    t_ref_c,
+                    prep: sel.prep.iter().find(|p| p.0 == i).map(|p| p.1),
+                    allan: sel.allan == Some(i),
+                    verify: sel.unused.contains(&i),
+                    rate_hz,
+                };
+                segment::pass(src, &job)
             })
-            .collect()
+            .collect::<Result<_, _>>()?
     };
-    let mut data: BTreeMap<usize, SegData> = BTreeMap::new();
-    for (i, d, sy, w) in done {
-        data.insert(i, d);
-        sync.max_gap_s = sync.max_gap_s.max(sy.max_gap_s);
-        sync.max_sync_error_s = sync.max_sync_error_s.max(sy.max_sync_error_s);
-        sync.max_angle_error_deg = sync.max_angle_error_deg.max(sy.max_angle_error_deg);
-        out.warnings.extend(w);
+    let (mut sums, mut accs): (Vec<Summary>, Vec<SegAcc>) = passed.into_iter().unzip();
+    sums.sort_by_key(|s| s.seg);
+    accs.sort_by_key(|a| a.seg);
+    accs.retain(|a| a.n > 0);
+    let mut sync = SyncReport {
+        method: "linear_interpolation".into(),
+        table_step_s: stats::median_step(&src.table().t),
+        ..Default::default()
+    };
+    for s in sums.iter_mut().filter(|s| s.prepared) {
+        sync.max_gap_s = sync.max_gap_s.max(s.sync.max_gap_s);
+        sync.max_sync_error_s = sync.max_sync_error_s.max(s.sync.max_sync_error_s);
+        sync.max_angle_error_deg = sync.max_angle_error_deg.max(s.sync.max_angle_error_deg);
+        out.warnings.append(&mut s.warnings);
     }
 
     // The Allan curves (the costly part of the noise analysis) run beside the fits.
-    let allan_block = sel.allan.and_then(|i| data.get(&i));
-    let declared = models::declared(plan, &opts.with);
-    let temperature = sel.temp_requested && temperature_varies(rec, &sel.temp_segments);
+    let allan_block = sel
+        .allan
+        .and_then(|i| sums.iter_mut().find(|s| s.seg == i))
+        .and_then(|s| Some((s.allan.take()?, s.step_s)));
+    let temperature = sel.temp_requested && temperature_varies(&sums, &sel.temp_segments);
     let (curves, fitted) = rayon::join(
-        || allan_block.map(allan::curves),
-        || models::fit(rec, &sel, &data, &declared, temperature, &mut out),
+        || allan_block.map(|(series, dt)| allan::curves(series, dt)),
+        || models::fit(m, &sel, &design, &accs, temperature, &mut out),
     );
     if sel.temp_requested && !temperature {
         for s in ["accel", "gyro"] {
@@ -155,16 +190,21 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
         }
     }
     residual_means(&fitted.residuals, &mut out);
-    if let (Some((k, b)), Some(block)) = (out.gyro_model, sel.gyro_bias.and_then(|i| data.get(&i)))
-    {
-        gyro::block_noise(block, &k, &b, &mut out);
+    if let (Some(_), Some(b)) = (out.gyro_model, sel.gyro_bias) {
+        let id = &m.segments[b].id;
+        gyro::block_noise(id, fitted.residuals.iter().map(|r| &r.0), &mut out);
     }
     if let Some(ix) = &sel.size_effect {
-        size_effect::fit(rec, ix, &mut out);
+        let span =
+            |f: fn(&crate::recording::Segment) -> f64| ix.iter().map(move |&i| f(&m.segments[i]));
+        let t0 = span(|s| s.t_start).fold(f64::INFINITY, f64::min);
+        let t1 = span(|s| s.t_end).fold(f64::NEG_INFINITY, f64::max);
+        size_effect::fit(&*src.recording(t0, t1)?, ix, &mut out);
     }
-    let allan = allan_block
+    let allan = sel
+        .allan
         .zip(curves.as_ref())
-        .and_then(|(b, c)| allan::analyse(b, c, &mut out));
+        .and_then(|(i, c)| allan::analyse(&m.segments[i].id, c, &mut out));
     // results.json always lists bias and scale of both sensors on every axis.
     for s in ["accel", "gyro"] {
         for what in ["bias", "scale"] {
@@ -178,15 +218,25 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
     }
     out.residuals = fitted.residuals.iter().map(|(r, _)| r.clone()).collect();
     unfitted_residual_warnings(&fitted.residuals, &mut out);
-    let (verification, wh) = accept::verify(&sel, &data, &out, rec);
-    let segments = sel.uses(rec, &data);
+    let (verification, wh) = accept::verify(&sel, &sums, &out, m);
+    let segments = sel.uses(m, &sums);
+    let steps: Vec<f64> = sums
+        .iter()
+        .map(|s| s.step_s)
+        .filter(|s| s.is_finite())
+        .collect();
+    let imu = (src.imu_rows(), src.imu_extent(), median(steps));
+    let temp_range = sums
+        .iter()
+        .filter_map(|s| s.temp_range)
+        .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)));
     let mut res = Results {
         format: results::FORMAT.into(),
         verdict: results::RunVerdict::default(),
         parameters: std::mem::take(&mut out.params),
         acceptance: Vec::new(),
         observability: std::mem::take(&mut out.observability),
-        recording: select::recording_info(rec, &opts.path),
+        recording: select::recording_info(m, src.table(), imu, &opts.path),
         model: sel.model.clone(),
         segments,
         sync,
@@ -194,7 +244,7 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
         allan,
         verification,
         repeatability: None,
-        environment: select::environment(rec),
+        environment: select::environment(m, src.table(), temp_range),
         warnings: Vec::new(),
         fits: Default::default(),
         size_effect: out.size_effect.take(),
@@ -207,8 +257,82 @@ pub fn analyze_with(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Res
     let mut w = std::mem::take(&mut out.warnings);
     w.append(&mut res.warnings);
     res.warnings = w;
-    res.decide(results::ended_early(&rec.manifest));
-    res
+    res.decide(results::ended_early(m));
+    Ok(res)
+}
+
+/// Every segment's raw samples (no preprocessing) accumulated over `layout`, in manifest
+/// order, those without samples left out: what explain fits its models from.
+pub(crate) fn accumulate_all<S: Source>(src: &S, layout: &Layout) -> Result<Vec<SegAcc>, S::Error> {
+    use rayon::prelude::*;
+    let m = src.manifest();
+    let geos = prep::geometries(m);
+    let rate_hz = mean_rate(src);
+    let t_ref_c = if layout.effects.iter().any(|e| e.uses_temperature()) {
+        mean_temperature(src, rate_hz)?
+    } else {
+        0.0
+    };
+    let mut accs: Vec<SegAcc> = (0..m.segments.len())
+        .into_par_iter()
+        .map(|i| {
+            let job = segment::Job {
+                seg: i,
+                geo: &geos[i],
+                layout,
+                t_ref_c,
+                prep: None,
+                allan: false,
+                verify: false,
+                rate_hz,
+            };
+            segment::pass(src, &job).map(|p| p.1)
+        })
+        .collect::<Result<_, _>>()?;
+    accs.retain(|a| a.n > 0);
+    Ok(accs)
+}
+
+/// The median of some values (NaN of none).
+fn median(mut v: Vec<f64>) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// The recording's mean IMU rate, Hz: rows over its extent.
+fn mean_rate<S: Source>(src: &S) -> f64 {
+    let (rows, (t0, t1)) = (src.imu_rows(), src.imu_extent());
+    if rows > 1 && t1 > t0 {
+        (rows - 1) as f64 / (t1 - t0)
+    } else {
+        1.0
+    }
+}
+
+/// The IMU temperature the thermal terms refer to: the recording's mean, read a window at
+/// a time.
+fn mean_temperature<S: Source>(src: &S, rate_hz: f64) -> Result<f64, S::Error> {
+    let (t0, t1) = src.imu_extent();
+    let span = segment::WINDOW_ROWS / rate_hz;
+    let k = (((t1 - t0) / span).ceil() as usize).max(1);
+    let (mut sum, mut n) = (0.0, 0usize);
+    for i in 0..k {
+        let at = |i: usize| t0 + (t1 - t0) * i as f64 / k as f64;
+        let (a, b, last) = (at(i), at(i + 1), i + 1 == k);
+        src.rows(a, if last { t1 } else { b }, |v| {
+            let Some(temp) = v.temp else { return };
+            for (t, x) in v.t.iter().zip(temp) {
+                if (last || *t < b) && x.is_finite() {
+                    sum += x;
+                    n += 1;
+                }
+            }
+        })?;
+    }
+    Ok(if n == 0 { 0.0 } else { sum / n as f64 })
 }
 
 /// Residuals on the segments a sensor's fit did not use (the accelerometers on the rate
@@ -252,21 +376,13 @@ fn unfitted_residual_warnings(rs: &[(ResidualStats, bool)], out: &mut Out) {
 
 /// Whether the IMU temperature varied by at least 1 degC across these segments: a thermal
 /// coefficient needs a temperature span to be determined.
-fn temperature_varies(rec: &Recording, segs: &[usize]) -> bool {
-    let Some(temp) = &rec.imu.temp else {
-        return false;
-    };
-    let (mut lo, mut hi) = (f64::MAX, f64::MIN);
-    for &i in segs {
-        let s = &rec.manifest.segments[i];
-        let a = rec.imu.t.partition_point(|&t| t < s.t_start);
-        let b = rec.imu.t.partition_point(|&t| t <= s.t_end);
-        for &v in temp[a..b].iter().filter(|v| v.is_finite()) {
-            lo = lo.min(v);
-            hi = hi.max(v);
-        }
-    }
-    hi - lo >= 1.0
+fn temperature_varies(sums: &[Summary], segs: &[usize]) -> bool {
+    let range = sums
+        .iter()
+        .filter(|s| segs.contains(&s.seg))
+        .filter_map(|s| s.temp_range)
+        .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)));
+    range.is_some_and(|(lo, hi)| hi - lo >= 1.0)
 }
 
 /// The largest mean residual of each sensor's fitted segments (`accel.residual.mean`,

@@ -6,14 +6,10 @@
 //! to every segment that excites it (a lever arm brings the rate segments into the
 //! accelerometer fit). The covariance accounts for the wandering gyro bias (`joint::solve`).
 
-use super::joint::{
-    Layout, SegAcc, Terms, accumulate, excitation, excites, fit_terms, latitude_of,
-    mean_temperature,
-};
-use super::prep::{SegData, geometries};
+use super::joint::{Layout, SegAcc, Terms, excitation, excites, fit_terms, latitude_of};
 use super::select::Selection;
 use super::{AXES, Out};
-use crate::recording::Recording;
+use crate::recording::Manifest;
 use crate::results::{JointFit, Parameter, ResidualStats};
 use ratecal_physics::effects::{EarthRate, Sensor};
 use ratecal_physics::{Mat3, Vec3};
@@ -90,58 +86,101 @@ fn key(id: &str, param: &str, unit: &'static str, nominal: &[&str]) -> (String, 
     }
 }
 
-/// Fits the models and writes their parameters into `out`.
+/// The columns any fit of one analysis may use, fixed before the samples pass: the
+/// selection's nominal terms, thermal drift when a temperature compensation is asked (left
+/// out of the fit again if the temperature did not vary), the declared effects, and the
+/// Earth's rate.
+#[derive(Debug)]
+pub(crate) struct Design {
+    /// Every column.
+    pub layout: Layout,
+    nominal: Vec<&'static str>,
+    added: Vec<&'static str>,
+    earth_fitted: bool,
+}
+
+impl Design {
+    /// The design of a selection with these declared effects; `thermal`: whether the
+    /// thermal terms may enter (asked for, and the IMU reports its temperature).
+    pub(crate) fn new(sel: &Selection, declared: &[String], thermal: bool, out: &mut Out) -> Self {
+        let mut nominal = nominal_ids(sel);
+        if thermal {
+            nominal.extend(["accel_thermal_drift", "gyro_thermal_drift"]);
+        }
+        let mut added: Vec<&'static str> = Vec::new();
+        let mut unknown = Vec::new();
+        for id in declared {
+            match ratecal_physics::effect(id) {
+                Some(e) if !e.nominal() => {
+                    if !nominal.contains(&e.id()) && !added.contains(&e.id()) {
+                        added.push(e.id());
+                    }
+                }
+                _ => unknown.push(id.clone()),
+            }
+        }
+        if !unknown.is_empty() {
+            out.warnings.push(format!(
+                "unknown effects ignored: {} (the catalogue: {})",
+                unknown.join(", "),
+                ratecal_physics::effects::catalogue()
+                    .map(|e| e.id())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+        }
+        let mut ids: Vec<&'static str> = nominal.iter().chain(&added).copied().collect();
+        let earth_fitted = ids.contains(&"earth_rate");
+        if !earth_fitted {
+            ids.push("earth_rate");
+        }
+        let layout = Layout::new(
+            ids.iter()
+                .map(|id| ratecal_physics::effect(id).expect("a registry id"))
+                .collect(),
+        );
+        Design {
+            layout,
+            nominal,
+            added,
+            earth_fitted,
+        }
+    }
+
+    /// Whether a term of the design reads the IMU temperature.
+    pub(crate) fn uses_temperature(&self) -> bool {
+        self.layout.effects.iter().any(|e| e.uses_temperature())
+    }
+}
+
+/// Fits the models from the segments' accumulations (`accs`, those with samples) and
+/// writes their parameters into `out`; `temperature`: whether the thermal terms the design
+/// holds are fitted.
 pub(crate) fn fit(
-    rec: &Recording,
+    m: &Manifest,
     sel: &Selection,
-    data: &BTreeMap<usize, SegData>,
-    declared: &[String],
+    design: &Design,
+    accs: &[SegAcc],
     temperature: bool,
     out: &mut Out,
 ) -> Models {
-    let mut nominal = nominal_ids(sel);
-    if temperature {
-        nominal.extend(["accel_thermal_drift", "gyro_thermal_drift"]);
-    }
-    let mut added: Vec<&'static str> = Vec::new();
-    let mut unknown = Vec::new();
-    for id in declared {
-        match ratecal_physics::effect(id) {
-            Some(e) if !e.nominal() => {
-                if !nominal.contains(&e.id()) && !added.contains(&e.id()) {
-                    added.push(e.id());
-                }
-            }
-            _ => unknown.push(id.clone()),
-        }
-    }
-    if !unknown.is_empty() {
-        out.warnings.push(format!(
-            "unknown effects ignored: {} (the catalogue: {})",
-            unknown.join(", "),
-            ratecal_physics::effects::catalogue()
-                .map(|e| e.id())
-                .collect::<Vec<_>>()
-                .join(", ")
-        ));
-    }
-    let mut ids: Vec<&'static str> = nominal.iter().chain(&added).copied().collect();
-    let earth_fitted = ids.contains(&"earth_rate");
-    if !earth_fitted {
-        ids.push("earth_rate");
-    }
-    let layout = Layout::new(
-        ids.iter()
-            .map(|id| ratecal_physics::effect(id).expect("a registry id"))
-            .collect(),
-    );
+    let layout = &design.layout;
+    let thermal = ["accel_thermal_drift", "gyro_thermal_drift"];
+    let nominal: Vec<&'static str> = design
+        .nominal
+        .iter()
+        .copied()
+        .filter(|id| temperature || !thermal.contains(id))
+        .collect();
+    let added = &design.added;
+    let earth_fitted = design.earth_fitted;
     let e_of = |id: &str| layout.index(id).expect("in the layout");
     let mut terms = Terms::default();
-    for id in nominal.iter().chain(&added) {
+    for id in nominal.iter().chain(added) {
         terms.effects.push(e_of(id));
     }
     if !earth_fitted {
-        let lat = rec.manifest.station.site.latitude_deg;
+        let lat = m.station.site.latitude_deg;
         terms
             .fixed
             .push((e_of("earth_rate"), EarthRate::values(lat).to_vec()));
@@ -164,26 +203,14 @@ pub(crate) fn fit(
         .chain(sel.gyro_scale.iter().flat_map(|(ix, _)| ix.iter().copied()))
         .chain(sel.gyro_full.iter().flat_map(|ix| ix.iter().copied()))
         .collect();
-    let nseg = rec.manifest.segments.len();
-    let wanted: Vec<usize> = (0..nseg).collect();
-    let geos = geometries(rec);
-    let t_ref = mean_temperature(rec);
-    let accs: Vec<SegAcc> = {
-        use rayon::prelude::*;
-        wanted
-            .par_iter()
-            .map(|&i| accumulate(rec, i, &geos[i], &layout, t_ref, data.get(&i)))
-            .filter(|a| a.n > 0)
-            .collect()
-    };
-    let ex: Vec<Vec<f64>> = accs.iter().map(|a| excitation(&layout, a)).collect();
+    let ex: Vec<Vec<f64>> = accs.iter().map(|a| excitation(layout, a)).collect();
     let acc_of = |seg: usize| accs.iter().position(|a| a.seg == seg);
     let mut accel: Vec<usize> = accel_segs.iter().filter_map(|&s| acc_of(s)).collect();
     let mut gyro: Vec<usize> = gyro_segs.iter().filter_map(|&s| acc_of(s)).collect();
-    for id in &added {
+    for id in added {
         let e = e_of(id);
         for i in 0..accs.len() {
-            if !excites(&layout, &ex, e, i) {
+            if !excites(layout, &ex, e, i) {
                 continue;
             }
             for (s, set) in [(Sensor::Accel, &mut accel), (Sensor::Gyro, &mut gyro)] {
@@ -200,7 +227,7 @@ pub(crate) fn fit(
     if accel.is_empty() && gyro.is_empty() {
         return Models::default();
     }
-    let (f, unobservable) = fit_terms(&layout, &accs, &ex, &terms, &accel, &gyro);
+    let (f, unobservable) = fit_terms(layout, accs, &ex, &terms, &accel, &gyro);
 
     // Parameters, under their keys, and the sensor models.
     let mut models = Models::default();
@@ -242,14 +269,14 @@ pub(crate) fn fit(
                 _ => {}
             }
         }
-        if let Some((lat, ul)) = latitude_of(&layout, &f, e) {
+        if let Some((lat, ul)) = latitude_of(layout, &f, e) {
             out.params.insert(
                 "earth_rate.latitude_deg".into(),
                 Parameter::estimate(lat, ul, "deg"),
             );
         }
     }
-    let names = terms.names(&layout);
+    let names = terms.names(layout);
     for (si, (sensor, segs)) in [("accel", &accel), ("gyro", &gyro)].into_iter().enumerate() {
         if segs.is_empty() || order[si].is_empty() {
             continue;
@@ -286,9 +313,9 @@ pub(crate) fn fit(
             continue;
         }
         for (i, a) in accs.iter().enumerate() {
-            let id = &rec.manifest.segments[a.seg].id;
+            let id = &m.segments[a.seg].id;
             for c in 3 * si..3 * si + 3 {
-                let r = super::residuals::of_segment(a, &layout, c, &f.theta, id);
+                let r = super::residuals::of_segment(a, layout, c, &f.theta, id);
                 models.residuals.push((r, set.contains(&i)));
             }
         }

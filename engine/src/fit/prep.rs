@@ -1,49 +1,12 @@
-//! Preprocessing of one segment: synchronisation of the table feedback onto the IMU
-//! stamps (linear interpolation), references through the physics kinematics, outlier
-//! removal within the segment, zero-phase Butterworth low-pass.
+//! Preprocessing of a segment's window of samples (`segment::pass` drives it): outlier
+//! removal, zero-phase Butterworth low-pass, and the table feedback's steady rates and
+//! rest attitude.
 
 use crate::plan::Outliers;
-use crate::recording::{Recording, Segment, SegmentKind};
-use crate::results::SyncReport;
-use ratecal_physics::{AxisMotion, DEG, Geometry, Mat3, Site, TableState, Vec3};
+use crate::recording::{Manifest, TableStream};
+use ratecal_physics::{Geometry, Mat3, Vec3};
 use std::borrow::Cow;
-
-/// One segment's IMU samples with their references, ready for the fits. The samples are
-/// the recording's own (borrowed); only a filtered channel is a copy.
-#[derive(Debug, Clone)]
-pub(crate) struct SegData<'a> {
-    /// Segment id.
-    pub id: String,
-    /// Kind.
-    pub kind: SegmentKind,
-    /// IMU stamps.
-    pub t: &'a [f64],
-    /// Accelerometer outputs per axis, m/s^2 (filtered if asked).
-    pub accel: [Cow<'a, [f64]>; 3],
-    /// Gyro outputs per axis, deg/s (filtered if asked).
-    pub gyro: [Cow<'a, [f64]>; 3],
-    /// Specific-force reference at the IMU reference point, body axes, m/s^2.
-    pub f_ref: [Vec<f64>; 3],
-    /// Inertial-rate reference (table motion and Earth rate), body axes, deg/s.
-    pub w_ref: [Vec<f64>; 3],
-    /// Accelerometer samples kept after outlier removal.
-    pub keep_a: Vec<bool>,
-    /// Gyro samples kept.
-    pub keep_g: Vec<bool>,
-    /// Mean feedback angles (outer, inner), deg.
-    pub mean_angles_deg: (f64, f64),
-}
-
-impl SegData<'_> {
-    /// Samples removed from either sensor.
-    pub(crate) fn outliers(&self) -> usize {
-        self.keep_a
-            .iter()
-            .zip(&self.keep_g)
-            .filter(|(a, g)| !**a || !**g)
-            .count()
-    }
-}
+use std::ops::Range;
 
 /// How to preprocess.
 #[derive(Debug, Clone, Copy)]
@@ -55,20 +18,19 @@ pub(crate) struct PrepOptions {
 }
 
 /// The station geometry in force for each segment (station mount, then per-segment remounts).
-pub(crate) fn geometries(rec: &Recording) -> Vec<Geometry> {
-    let st = &rec.manifest.station;
+pub(crate) fn geometries(m: &Manifest) -> Vec<Geometry> {
+    let st = &m.station;
     let v = |a: [f64; 3]| Vec3::new(a[0], a[1], a[2]);
-    let m = |r: &[[f64; 3]; 3]| Mat3::from_fn(|i, j| r[i][j]);
+    let mat = |r: &[[f64; 3]; 3]| Mat3::from_fn(|i, j| r[i][j]);
     let mut c_pb = st
         .mount
         .as_ref()
-        .map_or(Mat3::identity(), |mt| m(&mt.rotation));
-    rec.manifest
-        .segments
+        .map_or(Mat3::identity(), |mt| mat(&mt.rotation));
+    m.segments
         .iter()
         .map(|s| {
             if let Some(mt) = &s.mount {
-                c_pb = m(&mt.rotation);
+                c_pb = mat(&mt.rotation);
             }
             Geometry {
                 outer_axis: v(st.table.outer_axis),
@@ -79,264 +41,72 @@ pub(crate) fn geometries(rec: &Recording) -> Vec<Geometry> {
         .collect()
 }
 
-/// Builds a segment's data; `warnings` collects what could not be done as asked.
-pub(crate) fn prepare<'a>(
-    rec: &'a Recording,
-    seg: &Segment,
-    geo: &Geometry,
-    opts: PrepOptions,
-    sync: &mut SyncReport,
-    warnings: &mut Vec<String>,
-) -> SegData<'a> {
-    let imu = &rec.imu;
-    let a = imu.t.partition_point(|&t| t < seg.t_start);
-    let b = imu.t.partition_point(|&t| t <= seg.t_end);
-    let t = &imu.t[a..b];
-    let n = t.len();
-    let accel = std::array::from_fn(|k| Cow::Borrowed(&imu.accel[k][a..b]));
-    let gyro = std::array::from_fn(|k| Cow::Borrowed(&imu.gyro[k][a..b]));
-    let rest = (seg.kind == SegmentKind::Static)
-        .then(|| rest_angles(rec, seg.t_start, seg.t_end))
-        .flatten();
-    // The references of a long segment are computed in two halves side by side.
-    let mut f_ref: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; n]);
-    let mut w_ref: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; n]);
-    let refs = {
-        let [f0, f1, f2] = &mut f_ref;
-        let [w0, w1, w2] = &mut w_ref;
-        if n >= PARALLEL_MIN {
-            // Each half fills its own part of the same arrays.
-            let h = n / 2;
-            let (f0, f0b) = f0.split_at_mut(h);
-            let (f1, f1b) = f1.split_at_mut(h);
-            let (f2, f2b) = f2.split_at_mut(h);
-            let (w0, w0b) = w0.split_at_mut(h);
-            let (w1, w1b) = w1.split_at_mut(h);
-            let (w2, w2b) = w2.split_at_mut(h);
-            let (mut a, b) = rayon::join(
-                || {
-                    references(
-                        rec,
-                        seg.kind,
-                        rest,
-                        geo,
-                        &t[..h],
-                        [f0, f1, f2],
-                        [w0, w1, w2],
-                    )
-                },
-                || {
-                    references(
-                        rec,
-                        seg.kind,
-                        rest,
-                        geo,
-                        &t[h..],
-                        [f0b, f1b, f2b],
-                        [w0b, w1b, w2b],
-                    )
-                },
-            );
-            a.merge(&b);
-            a
-        } else {
-            references(rec, seg.kind, rest, geo, t, [f0, f1, f2], [w0, w1, w2])
+/// Flags the outliers of one sensor in a window: `resid(k)` is axis `k`'s residual series
+/// (outputs minus references) over the whole window; the test runs on the `core` rows, axis
+/// after axis (a sample removed on one axis is out of the next axis's statistics). Rows
+/// outside the core (a low-pass's margins) are judged against the core's final threshold.
+pub(crate) fn flag_window(
+    resid: impl Fn(usize) -> Vec<f64>,
+    rule: Outliers,
+    core: &Range<usize>,
+    keep: &mut [bool],
+) {
+    for k in 0..3 {
+        let r = resid(k);
+        flag_outliers(&r[core.clone()], rule, &mut keep[core.clone()]);
+        if core.start == 0 && core.end == r.len() {
+            continue;
         }
-    };
-    sync.max_gap_s = sync.max_gap_s.max(refs.sync.max_gap_s);
-    sync.max_sync_error_s = sync.max_sync_error_s.max(refs.sync.max_sync_error_s);
-    sync.max_angle_error_deg = sync.max_angle_error_deg.max(refs.sync.max_angle_error_deg);
-    let (so, si) = refs.angle_sums;
-    let mut d = SegData {
-        id: seg.id.clone(),
-        kind: seg.kind,
-        t,
-        accel,
-        gyro,
-        f_ref,
-        w_ref,
-        keep_a: vec![true; n],
-        keep_g: vec![true; n],
-        mean_angles_deg: (so / n as f64, si / n as f64),
-    };
-    if let Some(rule) = opts.outliers {
-        // Each sensor's three channels in turn (a sample removed on one axis is out of
-        // the next axis's statistics); the two sensors side by side.
-        let chain = |out: &[Cow<[f64]>; 3], refs: &[Vec<f64>; 3], keep: &mut Vec<bool>| {
-            let mut r = Vec::with_capacity(n);
-            for k in 0..3 {
-                r.clear();
-                r.extend(out[k].iter().zip(&refs[k]).map(|(o, r)| o - r));
-                flag_outliers(&r, rule, keep);
+        if let Some((m, limit)) = threshold(&r[core.clone()], rule, &keep[core.clone()]) {
+            for i in (0..core.start).chain(core.end..r.len()) {
+                if (r[i] - m).abs() > limit {
+                    keep[i] = false;
+                }
             }
-        };
-        let (mut keep_a, mut keep_g) =
-            (std::mem::take(&mut d.keep_a), std::mem::take(&mut d.keep_g));
-        rayon::join(
-            || chain(&d.accel, &d.f_ref, &mut keep_a),
-            || chain(&d.gyro, &d.w_ref, &mut keep_g),
-        );
-        (d.keep_a, d.keep_g) = (keep_a, keep_g);
-    }
-    if let Some((order, cutoff)) = opts.lowpass {
-        let fs = 1.0 / super::stats::median_step(d.t);
-        if cutoff >= fs / 2.0 {
-            warnings.push(format!(
-                "segment {}: low-pass cutoff {cutoff} Hz is at or above the Nyquist frequency ({:.1} Hz); not filtered",
-                d.id,
-                fs / 2.0
-            ));
-        } else if let Some(sos) = butter(order, cutoff, fs) {
-            use rayon::prelude::*;
-            // Outliers are replaced by interpolation before filtering, and stay excluded.
-            let (keep_a, keep_g) = (&d.keep_a, &d.keep_g);
-            d.accel
-                .par_iter_mut()
-                .map(|x| (x, keep_a))
-                .chain(d.gyro.par_iter_mut().map(|x| (x, keep_g)))
-                .for_each(|(x, keep)| {
-                    let mut v = x.to_vec();
-                    fill_removed(&mut v, keep);
-                    filtfilt_in_place(&sos, &mut v);
-                    *x = Cow::Owned(v);
-                });
-        } else {
-            warnings.push(format!("segment {}: Butterworth order {order} at {cutoff} Hz could not be designed; not filtered", d.id));
         }
     }
-    d
 }
 
-/// Segments at least this long are split over threads.
-const PARALLEL_MIN: usize = 20_000;
-
-/// What the synchronisation of a run of IMU stamps saw.
-struct Refs {
-    sync: SyncReport,
-    /// Sums of the interpolated feedback angles (outer, inner), deg.
-    angle_sums: (f64, f64),
-}
-
-impl Refs {
-    fn merge(&mut self, o: &Refs) {
-        self.sync.max_gap_s = self.sync.max_gap_s.max(o.sync.max_gap_s);
-        self.sync.max_sync_error_s = self.sync.max_sync_error_s.max(o.sync.max_sync_error_s);
-        self.sync.max_angle_error_deg = self
-            .sync
-            .max_angle_error_deg
-            .max(o.sync.max_angle_error_deg);
-        self.angle_sums.0 += o.angle_sums.0;
-        self.angle_sums.1 += o.angle_sums.1;
+/// The mean and the largest deviation from it that `rule` keeps, over the kept samples.
+fn threshold(r: &[f64], rule: Outliers, keep: &[bool]) -> Option<(f64, f64)> {
+    let (m, s) = super::stats::mean_std(r, keep);
+    let n = keep.iter().filter(|k| **k).count();
+    match rule {
+        Outliers::Sigma(k) => Some((m, k * s)),
+        Outliers::Grubbs(alpha) => grubbs_critical(n, alpha).map(|g| (m, g * s)),
     }
 }
 
-/// Table feedback interpolated onto the stamps `t`, and the references through the
-/// kinematics of ratecal_physics, written into `f_ref` and `w_ref` (as long as `t`).
-fn references(
-    rec: &Recording,
-    kind: SegmentKind,
-    rest: Option<(f64, f64)>,
-    geo: &Geometry,
+/// Low-passes the six outputs of a window (the outliers replaced by interpolation before
+/// filtering; they stay excluded); why it could not, if it could not.
+pub(crate) fn lowpass(
+    outputs: &mut [Cow<[f64]>; 6],
+    keep_a: &[bool],
+    keep_g: &[bool],
     t: &[f64],
-    f_ref: [&mut [f64]; 3],
-    w_ref: [&mut [f64]; 3],
-) -> Refs {
-    let site: Site = rec.manifest.station.site;
-    let mut sync = SyncReport::default();
-    let (mut so, mut si) = (0.0, 0.0);
-    let tab = &rec.table;
-    if t.is_empty() {
-        return Refs {
-            sync,
-            angle_sums: (so, si),
-        };
+    order: u32,
+    cutoff: f64,
+) -> Result<(), String> {
+    use rayon::prelude::*;
+    let fs = 1.0 / super::stats::median_step(t);
+    if cutoff >= fs / 2.0 {
+        return Err(format!(
+            "low-pass cutoff {cutoff} Hz is at or above the Nyquist frequency ({:.1} Hz); not filtered",
+            fs / 2.0
+        ));
     }
-    // The step `j`..`j + 1` holding t[0]; the last step for a stamp at or past the last
-    // feedback sample (a segment may end half a step after the table stream).
-    let mut j = tab
-        .t
-        .partition_point(|&x| x <= t[0])
-        .saturating_sub(1)
-        .min(tab.t.len().saturating_sub(2));
-    // Table state at feedback sample `j` plus a fraction `w` of the step to `j + 1`,
-    // through the kinematics of ratecal_physics: (specific force m/s^2, rate deg/s).
-    // A static segment is at rest and a rate segment turns at its mean feedback rate: the
-    // feedback's rate ripple is the table's measurement noise, not motion the IMU felt (it
-    // would otherwise leak into the gyro residuals and their noise figures).
-    let steady = match kind {
-        SegmentKind::Static => Some((0.0, 0.0)),
-        SegmentKind::Rate => Some(steady_rates(rec, t[0], t[t.len() - 1])),
-        SegmentKind::Oscillation => None,
+    let Some(sos) = butter(order, cutoff, fs) else {
+        return Err(format!(
+            "Butterworth order {order} at {cutoff} Hz could not be designed; not filtered"
+        ));
     };
-    let refs_at = |j: usize, w: f64| -> (Vec3, Vec3) {
-        let j = j.min(tab.t.len() - 2);
-        let lerp = |x: &[f64]| x[j] + w * (x[j + 1] - x[j]);
-        let lerp_angle = |x: &[f64]| x[j] + w * unwrap(x[j + 1] - x[j]);
-        let mut state = TableState {
-            outer: AxisMotion {
-                angle: lerp_angle(&tab.outer) * DEG,
-                rate: lerp(&tab.outer_rate) * DEG,
-                accel: rate_derivative(&tab.t, &tab.outer_rate, j) * DEG,
-            },
-            inner: AxisMotion {
-                angle: lerp_angle(&tab.inner) * DEG,
-                rate: lerp(&tab.inner_rate) * DEG,
-                accel: rate_derivative(&tab.t, &tab.inner_rate, j) * DEG,
-            },
-        };
-        if let Some((ro, ri)) = steady {
-            state.outer.rate = ro * DEG;
-            state.inner.rate = ri * DEG;
-            state.outer.accel = 0.0;
-            state.inner.accel = 0.0;
-        }
-        let snap = state.snapshot(geo, &site);
-        (snap.f_b(&Vec3::zeros()), snap.w_ib() / DEG)
-    };
-    let rest_refs = rest.map(|(o, i)| {
-        let still = |angle: f64| AxisMotion {
-            angle: angle * DEG,
-            rate: 0.0,
-            accel: 0.0,
-        };
-        let snap = TableState {
-            outer: still(o),
-            inner: still(i),
-        }
-        .snapshot(geo, &site);
-        (snap.f_b(&Vec3::zeros()), snap.w_ib() / DEG)
+    outputs.par_iter_mut().enumerate().for_each(|(c, x)| {
+        let mut v = x.to_vec();
+        fill_removed(&mut v, if c < 3 { keep_a } else { keep_g });
+        filtfilt_in_place(&sos, &mut v);
+        *x = Cow::Owned(v);
     });
-    for (i, &ti) in t.iter().enumerate() {
-        while j + 2 < tab.t.len() && tab.t[j + 1] <= ti {
-            j += 1;
-        }
-        let (t0, t1) = (tab.t[j], tab.t[j + 1]);
-        let w = ((ti - t0) / (t1 - t0)).clamp(0.0, 1.0);
-        let gap = t1 - t0;
-        sync.max_gap_s = sync.max_gap_s.max(gap);
-        sync.max_sync_error_s = sync
-            .max_sync_error_s
-            .max((ti - t0).abs().min((t1 - ti).abs()));
-        let acc_o = rate_derivative(&tab.t, &tab.outer_rate, j);
-        let acc_i = rate_derivative(&tab.t, &tab.inner_rate, j);
-        let max_acc = acc_o.abs().max(acc_i.abs());
-        sync.max_angle_error_deg = sync.max_angle_error_deg.max(gap * gap / 8.0 * max_acc);
-        so += tab.outer[j] + w * unwrap(tab.outer[j + 1] - tab.outer[j]);
-        si += tab.inner[j] + w * unwrap(tab.inner[j + 1] - tab.inner[j]);
-        let (f, wi) = match rest_refs {
-            // At rest: one attitude for the whole segment (its mean feedback angles).
-            Some(r) => r,
-            None => refs_at(j, w),
-        };
-        for k in 0..3 {
-            f_ref[k][i] = f[k];
-            w_ref[k][i] = wi[k];
-        }
-    }
-    Refs {
-        sync,
-        angle_sums: (so, si),
-    }
+    Ok(())
 }
 
 /// The constant rates (outer, inner), deg/s, of a rate segment between `t0` and `t1`: the
@@ -344,8 +114,7 @@ fn references(
 /// encoders determine far better than the mean of the rate feedback (whose ripple is
 /// measurement noise: 0.003 deg/s over 500 samples leaves 1e-4 deg/s, a slope over 10 s of
 /// 0.5 arcsec angles 2e-6 deg/s). With fewer than three feedback samples, the mean rate.
-pub(crate) fn steady_rates(rec: &Recording, t0: f64, t1: f64) -> (f64, f64) {
-    let tab = &rec.table;
+pub(crate) fn steady_rates(tab: &TableStream, t0: f64, t1: f64) -> (f64, f64) {
     let lo = tab.t.partition_point(|&x| x < t0);
     let hi = tab.t.partition_point(|&x| x <= t1);
     let slope = |angle: &[f64], rate: &[f64]| {
@@ -383,8 +152,7 @@ pub(crate) fn steady_rates(rec: &Recording, t0: f64, t1: f64) -> (f64, f64) {
 /// The attitude (outer, inner), deg, of a static segment between `t0` and `t1`: the mean of
 /// the unwrapped feedback angles. The table is at rest; the encoder's sample-to-sample
 /// noise is measurement noise, which the mean averages out. `None` without feedback there.
-pub(crate) fn rest_angles(rec: &Recording, t0: f64, t1: f64) -> Option<(f64, f64)> {
-    let tab = &rec.table;
+pub(crate) fn rest_angles(tab: &TableStream, t0: f64, t1: f64) -> Option<(f64, f64)> {
     let lo = tab.t.partition_point(|&x| x < t0);
     let hi = tab.t.partition_point(|&x| x <= t1);
     if hi <= lo {
@@ -409,7 +177,7 @@ pub(crate) fn unwrap(d: f64) -> f64 {
 
 /// Angular acceleration (deg/s^2) at table sample `j` by a central difference over about
 /// 0.1 s of feedback rates: the table reports rates, not accelerations.
-fn rate_derivative(t: &[f64], r: &[f64], j: usize) -> f64 {
+pub(crate) fn rate_derivative(t: &[f64], r: &[f64], j: usize) -> f64 {
     let h = 5;
     let lo = j.saturating_sub(h);
     let hi = (j + 1 + h).min(t.len() - 1);
@@ -439,7 +207,6 @@ pub(crate) fn flag_outliers(r: &[f64], rule: Outliers, keep: &mut [bool]) {
             }
         }
         Outliers::Grubbs(alpha) => {
-            use statrs::distribution::{ContinuousCDF, StudentsT};
             for _ in 0..1000 {
                 let n = keep.iter().filter(|k| **k).count();
                 if n < 7 {
@@ -454,12 +221,9 @@ pub(crate) fn flag_outliers(r: &[f64], rule: Outliers, keep: &mut [bool]) {
                 else {
                     break;
                 };
-                let nf = n as f64;
-                let Ok(dist) = StudentsT::new(0.0, 1.0, nf - 2.0) else {
+                let Some(g_crit) = grubbs_critical(n, alpha) else {
                     break;
                 };
-                let tq = dist.inverse_cdf(1.0 - alpha / (2.0 * nf));
-                let g_crit = (nf - 1.0) / nf.sqrt() * (tq * tq / (nf - 2.0 + tq * tq)).sqrt();
                 if s > 0.0 && dev / s > g_crit {
                     keep[imax] = false;
                 } else {
@@ -468,6 +232,15 @@ pub(crate) fn flag_outliers(r: &[f64], rule: Outliers, keep: &mut [bool]) {
             }
         }
     }
+}
+
+/// Grubbs' two-sided critical value for `n` samples at significance `alpha`.
+fn grubbs_critical(n: usize, alpha: f64) -> Option<f64> {
+    use statrs::distribution::{ContinuousCDF, StudentsT};
+    let nf = n as f64;
+    let dist = StudentsT::new(0.0, 1.0, nf - 2.0).ok()?;
+    let tq = dist.inverse_cdf(1.0 - alpha / (2.0 * nf));
+    Some((nf - 1.0) / nf.sqrt() * (tq * tq / (nf - 2.0 + tq * tq)).sqrt())
 }
 
 fn fill_removed(x: &mut [f64], keep: &[bool]) {

@@ -3,19 +3,22 @@
 //! near zero and a CV would be meaningless).
 
 use super::accept::{judge, not_evaluated};
-use super::{Options, analyze_with};
+use super::{Options, Source, analyze_source};
 use crate::plan::Plan;
-use crate::recording::Recording;
 use crate::results::{Parameter, RepeatParameter, Repeatability, Results};
 
 /// Analyses several runs of the same procedure: parameters are the runs' means, each
 /// run's checks are listed (named `[run k]`), and repeatability thresholds are evaluated.
 /// `runs` pairs each recording with the name (folder) it is reported under.
-pub fn analyze_runs(runs: &[(String, Recording)], plan: Option<&Plan>, opts: &Options) -> Results {
+pub fn analyze_runs<S: Source>(
+    runs: &[(String, S)],
+    plan: Option<&Plan>,
+    opts: &Options,
+) -> Result<Results, S::Error> {
     let each: Vec<Results> = runs
         .iter()
         .map(|(p, r)| {
-            analyze_with(
+            analyze_source(
                 r,
                 plan,
                 &Options {
@@ -24,10 +27,10 @@ pub fn analyze_runs(runs: &[(String, Recording)], plan: Option<&Plan>, opts: &Op
                 },
             )
         })
-        .collect();
+        .collect::<Result<_, _>>()?;
     let mut res = each[0].clone();
     if each.len() == 1 {
-        return res;
+        return Ok(res);
     }
     res.recording.paths = runs.iter().map(|(p, _)| p.clone()).collect();
     let n = each.len() as f64;
@@ -117,7 +120,7 @@ pub fn analyze_runs(runs: &[(String, Recording)], plan: Option<&Plan>, opts: &Op
     });
     res.decide(
         runs.iter()
-            .any(|(_, r)| crate::results::ended_early(&r.manifest)),
+            .any(|(_, r)| crate::results::ended_early(r.manifest())),
     );
-    res
+    Ok(res)
 }

@@ -1,11 +1,12 @@
 //! Which segments feed which fit: the procedure's fit statements, or segment kinds.
 
 use super::Options;
-use super::prep::{PrepOptions, SegData};
+use super::prep::PrepOptions;
+use super::segment::Summary;
 use crate::plan::{FitModel, Plan, segment_matches};
-use crate::recording::{Recording, SegmentKind};
+use crate::recording::{Manifest, SegmentKind, TableStream};
 use crate::results::{AmbientStats, EnvironmentInfo, ModelInfo, RecordingInfo, SegmentUse};
-use std::collections::{BTreeMap, HashMap};
+use std::collections::HashMap;
 
 /// The analysis plan for one recording.
 #[derive(Debug, Default, Clone)]
@@ -52,16 +53,14 @@ impl Selection {
     }
 
     /// The segment table of the results.
-    pub(crate) fn uses(&self, rec: &Recording, data: &BTreeMap<usize, SegData>) -> Vec<SegmentUse> {
-        rec.manifest
-            .segments
+    pub(crate) fn uses(&self, m: &Manifest, sums: &[Summary]) -> Vec<SegmentUse> {
+        m.segments
             .iter()
             .enumerate()
             .map(|(i, s)| {
-                let a = rec.imu.t.partition_point(|&t| t < s.t_start);
-                let b = rec.imu.t.partition_point(|&t| t <= s.t_end);
+                let sum = sums.iter().find(|x| x.seg == i);
                 let mut used_for = self.used_for.get(&i).cloned().unwrap_or_default();
-                if self.unused.contains(&i) && data.contains_key(&i) {
+                if self.unused.contains(&i) && sum.is_some_and(|x| x.prepared) {
                     used_for.push("verification".into());
                 }
                 SegmentUse {
@@ -69,8 +68,8 @@ impl Selection {
                     kind: kind_name(s.kind).into(),
                     t_start: s.t_start,
                     t_end: s.t_end,
-                    imu_samples: b - a,
-                    outliers_removed: data.get(&i).map_or(0, SegData::outliers),
+                    imu_samples: sum.map_or(0, |x| x.rows),
+                    outliers_removed: sum.filter(|x| x.prepared).map_or(0, |x| x.outliers),
                     used_for,
                 }
             })
@@ -87,8 +86,8 @@ fn kind_name(k: SegmentKind) -> &'static str {
 }
 
 /// Chooses segments for each fit.
-pub(crate) fn select(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Selection {
-    let segs = &rec.manifest.segments;
+pub(crate) fn select(m: &Manifest, plan: Option<&Plan>, opts: &Options) -> Selection {
+    let segs = &m.segments;
     let dur = |i: &usize| segs[*i].t_end - segs[*i].t_start;
     let longest = |ix: &[usize]| {
         ix.iter()
@@ -105,8 +104,7 @@ pub(crate) fn select(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Se
         Some(plan) => {
             sel.model.selection = "procedure".into();
             // The recording names the procedure it ran, with its hash: the same one here.
-            let sha256 = rec
-                .manifest
+            let sha256 = m
                 .procedure
                 .as_ref()
                 .filter(|p| p.name == plan.name && p.version == plan.version)
@@ -247,10 +245,15 @@ pub(crate) fn select(rec: &Recording, plan: Option<&Plan>, opts: &Options) -> Se
     sel
 }
 
-/// Identity of the recording.
-pub(crate) fn recording_info(rec: &Recording, path: &str) -> RecordingInfo {
-    let m = &rec.manifest;
-    let rate = |t: &[f64]| 1.0 / super::stats::median_step(t);
+/// Identity of the recording: `imu` is its IMU rows, first and last stamp and the median
+/// step, s.
+pub(crate) fn recording_info(
+    m: &Manifest,
+    table: &TableStream,
+    imu: (usize, (f64, f64), f64),
+    path: &str,
+) -> RecordingInfo {
+    let (rows, (first, last), step) = imu;
     RecordingInfo {
         paths: if path.is_empty() {
             Vec::new()
@@ -262,41 +265,34 @@ pub(crate) fn recording_info(rec: &Recording, path: &str) -> RecordingInfo {
         run_id: m.run.as_ref().map(|r| r.id.clone()),
         latitude_deg: m.station.site.latitude_deg,
         gravity_mps2: m.station.site.gravity_mps2,
-        imu_rows: rec.imu.t.len(),
-        table_rows: rec.table.t.len(),
-        imu_rate_hz: rate(&rec.imu.t),
-        table_rate_hz: rate(&rec.table.t),
-        duration_s: rec.imu.t.last().copied().unwrap_or(0.0)
-            - rec.imu.t.first().copied().unwrap_or(0.0),
+        imu_rows: rows,
+        table_rows: table.t.len(),
+        imu_rate_hz: 1.0 / step,
+        table_rate_hz: 1.0 / super::stats::median_step(&table.t),
+        duration_s: last - first,
     }
 }
 
-/// Lab conditions: the manifest's block and the `ambient` column.
-pub(crate) fn environment(rec: &Recording) -> EnvironmentInfo {
-    let ambient = rec
-        .table
-        .ambient
-        .as_ref()
-        .filter(|a| !a.is_empty())
-        .map(|a| {
-            let keep = vec![true; a.len()];
-            let (mean, _, slope) = super::stats::mean_std_slope(&rec.table.t, a, &keep);
-            AmbientStats {
-                mean_c: mean,
-                min_c: a.iter().copied().fold(f64::MAX, f64::min),
-                max_c: a.iter().copied().fold(f64::MIN, f64::max),
-                drift_c_per_h: slope * 3600.0,
-            }
-        });
-    let imu_temp_range_c = rec.imu.temp.as_ref().filter(|t| !t.is_empty()).map(|t| {
-        [
-            t.iter().copied().fold(f64::MAX, f64::min),
-            t.iter().copied().fold(f64::MIN, f64::max),
-        ]
+/// Lab conditions: the manifest's block, the `ambient` column, and the IMU temperature
+/// range over the segments' samples (`imu_temp`).
+pub(crate) fn environment(
+    m: &Manifest,
+    table: &TableStream,
+    imu_temp: Option<(f64, f64)>,
+) -> EnvironmentInfo {
+    let ambient = table.ambient.as_ref().filter(|a| !a.is_empty()).map(|a| {
+        let keep = vec![true; a.len()];
+        let (mean, _, slope) = super::stats::mean_std_slope(&table.t, a, &keep);
+        AmbientStats {
+            mean_c: mean,
+            min_c: a.iter().copied().fold(f64::MAX, f64::min),
+            max_c: a.iter().copied().fold(f64::MIN, f64::max),
+            drift_c_per_h: slope * 3600.0,
+        }
     });
     EnvironmentInfo {
-        recorded: rec.manifest.environment.clone(),
+        recorded: m.environment.clone(),
         ambient,
-        imu_temp_range_c,
+        imu_temp_range_c: imu_temp.map(|(lo, hi)| [lo, hi]),
     }
 }

@@ -139,6 +139,11 @@ pub trait Effect: Send + Sync + std::fmt::Debug {
     }
     /// The sensors whose outputs it touches.
     fn sensors(&self) -> &'static [Sensor];
+    /// Whether its regressors read the IMU temperature (`Signals::dtemp_c`): the analysis
+    /// then needs the reference temperature before the samples pass.
+    fn uses_temperature(&self) -> bool {
+        false
+    }
 }
 
 /// Every effect, the nominal terms first, then the catalogue in physics.md's order.

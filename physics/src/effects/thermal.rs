@@ -47,6 +47,10 @@ impl Effect for ThermalDrift {
         self.params
     }
 
+    fn uses_temperature(&self) -> bool {
+        true
+    }
+
     fn sensors(&self) -> &'static [Sensor] {
         self.sensor.only()
     }

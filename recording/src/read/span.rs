@@ -23,6 +23,9 @@ pub struct OpenRecording {
     manifest: Manifest,
     imu: StreamIndex,
     table: StreamIndex,
+    /// IMU rows, first and last stamp.
+    imu_rows: usize,
+    imu_extent: (f64, f64),
 }
 
 /// The rows of both streams whose time lies in a span.
@@ -67,10 +70,13 @@ impl Recording {
             table_times.extent(),
             |a, b| imu_times.holds_sample(a, b),
         )?;
+        let extent = imu_times.extent();
         Ok(OpenRecording {
             manifest,
             imu,
             table,
+            imu_rows: imu_times.rows,
+            imu_extent: (extent.first, extent.last),
         })
     }
 }
@@ -89,6 +95,31 @@ impl OpenRecording {
             imu: span::<ImuStream>(&self.imu, t0, t1)?,
             table: span::<TableStream>(&self.table, t0, t1)?,
         })
+    }
+
+    /// The IMU rows with `t0 <= t <= t1` (as [`OpenRecording::read_span`], the IMU only).
+    pub fn read_imu_span(&self, t0: f64, t1: f64) -> Result<ImuStream, RecordingError> {
+        span::<ImuStream>(&self.imu, t0, t1)
+    }
+
+    /// The whole table feedback stream (a small file beside the IMU's: 50 Hz against 1 kHz).
+    pub fn read_table(&self) -> Result<TableStream, RecordingError> {
+        span::<TableStream>(&self.table, f64::NEG_INFINITY, f64::INFINITY)
+    }
+
+    /// How many IMU rows the file holds.
+    pub fn imu_rows(&self) -> usize {
+        self.imu_rows
+    }
+
+    /// The first and the last IMU stamp, s.
+    pub fn imu_extent(&self) -> (f64, f64) {
+        self.imu_extent
+    }
+
+    /// Whether `imu.csv` has the optional `temp` column.
+    pub fn imu_has_temp(&self) -> bool {
+        self.imu.optional
     }
 }
 

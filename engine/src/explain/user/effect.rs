@@ -114,6 +114,11 @@ impl Effect for UserEffect {
         self.params
     }
 
+    // A user's expression may read `dtemp_c`: taken to, so the reference is always known.
+    fn uses_temperature(&self) -> bool {
+        true
+    }
+
     fn sensors(&self) -> &'static [Sensor] {
         self.sensors
     }

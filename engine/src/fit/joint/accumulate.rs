@@ -1,14 +1,11 @@
-//! One pass over a segment's samples: the kinematic signals at each IMU stamp (table
-//! feedback interpolated, through `ratecal_physics`), every effect's regressors, and per
-//! output channel the triangular factor of `[X y]` plus one-second block sums.
+//! A segment's samples folded into the joint fit as they stream past: every effect's
+//! regressors from the kinematic signals at each stamp, and per output channel the
+//! triangular factor of `[X y]` plus one-second block sums.
 
 use super::tri::Tri;
 use super::{Layout, channel};
-use crate::fit::prep::{SegData, rest_angles, steady_rates, unwrap};
-use crate::recording::Recording;
 use nalgebra::{DMatrix, DVector};
 use ratecal_physics::effects::{Partials, Signals};
-use ratecal_physics::{AxisMotion, DEG, Geometry, Site, TableState};
 
 /// Length of the blocks kept for the noise analysis, s.
 pub(crate) const BLOCK_S: f64 = 1.0;
@@ -39,158 +36,52 @@ pub(crate) struct SegAcc {
     pub n: usize,
 }
 
-/// The table state at each IMU stamp, from the feedback by linear interpolation; the
-/// angular acceleration is the slope of the interpolated rate (one feedback step: a wider
-/// difference would smear the start of the next motion into the end of a segment).
-pub(crate) fn state_at(rec: &Recording, j: &mut usize, t: f64) -> TableState {
-    let tab = &rec.table;
-    let last = tab.t.len().saturating_sub(2);
-    while *j < last && tab.t[*j + 1] <= t {
-        *j += 1;
-    }
-    let jj = (*j).min(last);
-    let (t0, t1) = (tab.t[jj], tab.t[jj + 1]);
-    let w = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
-    let lerp = |x: &[f64]| x[jj] + w * (x[jj + 1] - x[jj]);
-    let angle = |x: &[f64]| x[jj] + w * unwrap(x[jj + 1] - x[jj]);
-    let slope = |x: &[f64]| (x[jj + 1] - x[jj]) / (t1 - t0);
-    TableState {
-        outer: AxisMotion {
-            angle: angle(&tab.outer) * DEG,
-            rate: lerp(&tab.outer_rate) * DEG,
-            accel: slope(&tab.outer_rate) * DEG,
-        },
-        inner: AxisMotion {
-            angle: angle(&tab.inner) * DEG,
-            rate: lerp(&tab.inner_rate) * DEG,
-            accel: slope(&tab.inner_rate) * DEG,
-        },
-    }
-}
-
-/// The IMU temperature the thermal terms refer to: the recording's mean.
-pub(crate) fn mean_temperature(rec: &Recording) -> f64 {
-    rec.imu.temp.as_ref().map_or(0.0, |t| {
-        let (s, n) = t
-            .iter()
-            .filter(|x| x.is_finite())
-            .fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
-        if n == 0 { 0.0 } else { s / n as f64 }
-    })
-}
-
-/// Accumulates one segment. `t_ref_c` is the temperature the thermal terms refer to.
-/// With the segment's preprocessed data (`prepped`, over the same samples), the outputs
-/// are its (filtered) ones and the samples it flagged as outliers are left out.
-pub(crate) fn accumulate(
-    rec: &Recording,
+/// Folds one segment's samples into the factors and block sums of every channel, a sample
+/// at a time, so a segment of any length streams through.
+pub(crate) struct Accumulator<'l> {
     seg: usize,
-    geo: &Geometry,
-    layout: &Layout,
-    t_ref_c: f64,
-    prepped: Option<&SegData>,
-) -> SegAcc {
-    let s = &rec.manifest.segments[seg];
-    let site: Site = rec.manifest.station.site;
-    let imu = &rec.imu;
-    let a = imu.t.partition_point(|&t| t < s.t_start);
-    let b = imu.t.partition_point(|&t| t <= s.t_end);
-    let prepped = prepped.filter(|d| d.t.len() == b - a);
-    let ncol = layout.cols.len();
-    let at_rest = s.kind == crate::recording::SegmentKind::Static;
-    let rest = if at_rest {
-        rest_angles(rec, s.t_start, s.t_end)
-    } else {
-        None
-    };
-    // At rest the kinematic state is the same at every sample: evaluated once.
-    let mut rest_snap = None;
-    let steady = s.kind == crate::recording::SegmentKind::Rate;
-    let mean_rates = {
-        let (o, i) = steady_rates(rec, s.t_start, s.t_end);
-        (o * DEG, i * DEG)
-    };
-    let mut tris: Vec<Tri> = (0..6)
-        .map(|c| Tri::new(layout.by_channel[c].len() + 1))
-        .collect();
-    let mut parts = vec![Partials::default(); ncol];
-    let mut row: Vec<f64> = Vec::with_capacity(ncol + 1);
-    let mut blocks: Vec<Block> = Vec::new();
-    let new_block = |layout: &Layout| Block {
-        t: 0.0,
-        n: 0,
-        sx: std::array::from_fn(|c| vec![0.0; layout.by_channel[c].len()]),
-        sy: [0.0; 6],
-    };
-    let mut cur = new_block(layout);
-    let mut block_end = s.t_start + BLOCK_S;
-    let mut j = 0usize;
-    if rec.table.t.len() >= 2 {
-        j = rec
-            .table
-            .t
-            .partition_point(|&x| x <= imu.t.get(a).copied().unwrap_or(0.0))
-            .saturating_sub(1);
+    layout: &'l Layout,
+    tris: Vec<Tri>,
+    parts: Vec<Partials>,
+    row: Vec<f64>,
+    blocks: Vec<Block>,
+    cur: Block,
+    block_end: f64,
+}
+
+impl<'l> Accumulator<'l> {
+    /// An empty accumulation of segment `seg`, whose blocks start at `t_start`.
+    pub(crate) fn new(seg: usize, t_start: f64, layout: &'l Layout) -> Self {
+        let ncol = layout.cols.len();
+        Accumulator {
+            seg,
+            layout,
+            tris: (0..6)
+                .map(|c| Tri::new(layout.by_channel[c].len() + 1))
+                .collect(),
+            parts: vec![Partials::default(); ncol],
+            row: Vec::with_capacity(ncol + 1),
+            blocks: Vec::new(),
+            cur: Self::new_block(layout),
+            block_end: t_start + BLOCK_S,
+        }
     }
-    for i in a..b {
-        let t = imu.t[i];
-        if rec.table.t.len() < 2 {
-            break;
+
+    fn new_block(layout: &Layout) -> Block {
+        Block {
+            t: 0.0,
+            n: 0,
+            sx: std::array::from_fn(|c| vec![0.0; layout.by_channel[c].len()]),
+            sy: [0.0; 6],
         }
-        if prepped.is_some_and(|d| !d.keep_a[i - a] || !d.keep_g[i - a]) {
-            continue;
-        }
-        if t > block_end && cur.n > 0 {
-            cur.t /= cur.n as f64;
-            blocks.push(std::mem::replace(&mut cur, new_block(layout)));
-            block_end += BLOCK_S * ((t - block_end) / BLOCK_S).ceil().max(1.0);
-        }
-        let mut state = state_at(rec, &mut j, t);
-        if let Some((o, i)) = rest {
-            // At rest: one attitude for the segment, the mean of its feedback angles.
-            state.outer.angle = o * DEG;
-            state.inner.angle = i * DEG;
-        }
-        if at_rest {
-            // A static segment is at rest: the feedback's rate ripple is the table's
-            // measurement noise, not motion the IMU felt.
-            for ax in [&mut state.outer, &mut state.inner] {
-                ax.rate = 0.0;
-                ax.accel = 0.0;
-            }
-        } else if steady {
-            // A rate segment turns at a constant rate: the feedback's ripple is measurement
-            // noise (differencing it would invent angular accelerations), so the rates are
-            // the segment's steady rates from the angle feedback.
-            state.outer.rate = mean_rates.0;
-            state.inner.rate = mean_rates.1;
-            state.outer.accel = 0.0;
-            state.inner.accel = 0.0;
-        }
-        let snap = match (&rest_snap, rest) {
-            (Some(snap), Some(_)) => *snap,
-            _ => state.snapshot(geo, &site),
-        };
-        if rest.is_some() && rest_snap.is_none() {
-            rest_snap = Some(snap);
-        }
-        let dtemp = imu.temp.as_ref().map_or(0.0, |tc| tc[i] - t_ref_c);
-        let sig = Signals::new(&snap, &site, if dtemp.is_finite() { dtemp } else { 0.0 }).at(t);
-        for (e, fx) in layout.effects.iter().enumerate() {
-            fx.regressors(&sig, &mut parts[layout.columns_of(e)]);
-        }
+    }
+
+    /// Adds the sample stamped `t` (`sig` at that instant) with these outputs; a sample
+    /// with a non-finite output (a saturated channel) is left out.
+    pub(crate) fn push(&mut self, sig: &Signals, t: f64, acc: [f64; 3], gyr: [f64; 3]) {
+        let layout = self.layout;
         let base_a = sig.f_b;
         let base_g = sig.w_b_dps();
-        let (acc, gyr) = match prepped {
-            Some(d) => (
-                [d.accel[0][i - a], d.accel[1][i - a], d.accel[2][i - a]],
-                [d.gyro[0][i - a], d.gyro[1][i - a], d.gyro[2][i - a]],
-            ),
-            None => (
-                [imu.accel[0][i], imu.accel[1][i], imu.accel[2][i]],
-                [imu.gyro[0][i], imu.gyro[1][i], imu.gyro[2][i]],
-            ),
-        };
         let out = [
             acc[0] - base_a.x,
             acc[1] - base_a.y,
@@ -200,35 +91,48 @@ pub(crate) fn accumulate(
             gyr[2] - base_g.z,
         ];
         if out.iter().any(|v| !v.is_finite()) {
-            continue;
+            return;
+        }
+        if t > self.block_end && self.cur.n > 0 {
+            self.cur.t /= self.cur.n as f64;
+            let full = std::mem::replace(&mut self.cur, Self::new_block(layout));
+            self.blocks.push(full);
+            self.block_end += BLOCK_S * ((t - self.block_end) / BLOCK_S).ceil().max(1.0);
+        }
+        for (e, fx) in layout.effects.iter().enumerate() {
+            fx.regressors(sig, &mut self.parts[layout.columns_of(e)]);
         }
         for c in 0..6 {
             let (sensor, ax) = channel(c);
-            row.clear();
+            self.row.clear();
             for &g in &layout.by_channel[c] {
-                row.push(parts[g].of(sensor)[ax]);
+                self.row.push(self.parts[g].of(sensor)[ax]);
             }
-            row.push(out[c]);
-            tris[c].push(&row);
-            for (k, v) in row[..row.len() - 1].iter().enumerate() {
-                cur.sx[c][k] += v;
+            self.row.push(out[c]);
+            self.tris[c].push(&self.row);
+            for (k, v) in self.row[..self.row.len() - 1].iter().enumerate() {
+                self.cur.sx[c][k] += v;
             }
-            cur.sy[c] += out[c];
+            self.cur.sy[c] += out[c];
         }
-        cur.t += t;
-        cur.n += 1;
+        self.cur.t += t;
+        self.cur.n += 1;
     }
-    if cur.n > 0 {
-        cur.t /= cur.n as f64;
-        blocks.push(cur);
-    }
-    let n = tris[0].n;
-    let mut it = tris.into_iter().map(Tri::finish);
-    SegAcc {
-        seg,
-        r: std::array::from_fn(|_| it.next().expect("six channels")),
-        blocks,
-        n,
+
+    /// The segment's contribution.
+    pub(crate) fn finish(mut self) -> SegAcc {
+        if self.cur.n > 0 {
+            self.cur.t /= self.cur.n as f64;
+            self.blocks.push(self.cur);
+        }
+        let n = self.tris[0].n;
+        let mut it = self.tris.into_iter().map(Tri::finish);
+        SegAcc {
+            seg: self.seg,
+            r: std::array::from_fn(|_| it.next().expect("six channels")),
+            blocks: self.blocks,
+            n,
+        }
     }
 }
 

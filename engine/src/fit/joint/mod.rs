@@ -1,7 +1,7 @@
 //! One joint least-squares over every output channel, built from the effect registry.
 //!
 //! A [`Layout`] lists the terms that may enter a model (registry effects) and gives each
-//! parameter a column. [`accumulate`] passes once over a segment's samples and keeps, per
+//! parameter a column. An [`Accumulator`] passes once over a segment's samples and keeps, per
 //! output channel, the triangular factor of `[X y]` over that channel's columns plus short
 //! block sums for the noise analysis. Any model (a subset of columns) over any set of
 //! segments is then solved from those factors alone ([`solve`]): forward selection and
@@ -13,7 +13,7 @@ mod solve;
 mod terms;
 mod tri;
 
-pub(crate) use accumulate::{SegAcc, accumulate, mean_temperature, seg_rss};
+pub(crate) use accumulate::{Accumulator, SegAcc, seg_rss};
 pub(crate) use solve::{Fit, FitRequest, rss_on, solve};
 pub(crate) use terms::{Terms, excitation, excites, fit_terms, latitude_of};
 

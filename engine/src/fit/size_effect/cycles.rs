@@ -40,7 +40,7 @@ pub struct SegmentDrift {
 /// Drifts of the oscillation segments `ix`, and warnings for what had to be left out.
 pub(crate) fn drifts(rec: &Recording, ix: &[usize]) -> (Vec<SegmentDrift>, Vec<String>) {
     let segs = &rec.manifest.segments;
-    let geos = geometries(rec);
+    let geos = geometries(&rec.manifest);
     let mut warnings = Vec::new();
     let mut osc: Vec<usize> = Vec::new();
     for &i in ix {
@@ -102,7 +102,7 @@ fn cycle_drifts(
     all_osc: &[usize],
 ) -> Result<CycleOut, String> {
     let segs = &rec.manifest.segments;
-    let geos = geometries(rec);
+    let geos = geometries(&rec.manifest);
     let first = &segs[cycle[0]];
     let last = &segs[cycle[cycle.len() - 1]];
     // The static block to align on: the last one before the cycle under the same mount,

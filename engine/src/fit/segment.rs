@@ -1,0 +1,448 @@
+//! One pass over a segment: its IMU rows are read a window at a time from the
+//! [`Source`], and each window is synchronised with the table feedback (the kinematic
+//! signals at every stamp, evaluated once), cleaned of outliers, low-passed, and folded into
+//! the joint fit's factors ([`Accumulator`]) and into the few sums the rest of the analysis
+//! reads (verification means, the Allan series, temperature span, synchronisation). What
+//! is left of a segment is its [`Summary`]: a 1 kHz hour-long block never sits in memory.
+//!
+//! A window holds at most [`WINDOW_ROWS`] rows (a moving segment's, whose signals are kept
+//! per row, [`WINDOW_ROWS_MOVING`]); the outlier test runs within a window. A low-pass over
+//! a segment of several windows reads each window with a margin on both sides, so that the
+//! filter's start-up is spent outside the rows it keeps.
+
+use super::joint::{Accumulator, Layout, SegAcc};
+use super::prep::{self, PrepOptions};
+use super::source::{ImuView, Source};
+use super::stats::{Inflation, median_step};
+use crate::recording::{Segment, SegmentKind, TableStream};
+use crate::results::SyncReport;
+use ratecal_physics::effects::Signals;
+use ratecal_physics::{AxisMotion, DEG, Geometry, Site, TableState};
+use std::borrow::Cow;
+
+/// Rows per window of a static segment: 87 minutes at 100 Hz, 8.7 at 1 kHz.
+pub(crate) const WINDOW_ROWS: f64 = 524_288.0;
+/// Rows per window of a moving segment (its signals are kept per row).
+pub(crate) const WINDOW_ROWS_MOVING: f64 = 65_536.0;
+/// Margin on each side of a window for a low-pass, in periods of the cutoff.
+const MARGIN_PERIODS: f64 = 30.0;
+
+/// What to do with one segment.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Job<'a> {
+    /// Index in the manifest.
+    pub seg: usize,
+    /// Station geometry in force.
+    pub geo: &'a Geometry,
+    /// Columns of the joint fit.
+    pub layout: &'a Layout,
+    /// Temperature the thermal terms refer to, degC.
+    pub t_ref_c: f64,
+    /// Preprocessing; `None` accumulates the raw samples.
+    pub prep: Option<PrepOptions>,
+    /// Whether to keep the kept gyro series for the Allan analysis.
+    pub allan: bool,
+    /// Whether to keep the outputs against their references (a verification segment).
+    pub verify: bool,
+    /// Mean IMU rate of the recording, Hz (sizes the windows).
+    pub rate_hz: f64,
+}
+
+/// Means and spread of one output channel against its reference over kept samples.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct ChannelStats {
+    /// Kept samples.
+    pub n: usize,
+    /// Sum of the outputs.
+    pub sum_out: f64,
+    /// Sum of the references.
+    pub sum_ref: f64,
+    /// Mean and sum of squared deviations of `out - ref` (merged by Chan's rule).
+    pub mean_d: f64,
+    /// Sum of squared deviations of `out - ref`.
+    pub m2_d: f64,
+    /// Correlation of `out - ref` (batch means).
+    pub inflation: Inflation,
+}
+
+impl ChannelStats {
+    fn add_window(&mut self, out: &[f64], refs: &[f64], keep: &[bool]) {
+        let d: Vec<f64> = out.iter().zip(refs).map(|(o, r)| o - r).collect();
+        let (mut n, mut so, mut sr, mut sd) = (0usize, 0.0, 0.0, 0.0);
+        for i in 0..d.len() {
+            if keep[i] {
+                n += 1;
+                so += out[i];
+                sr += refs[i];
+                sd += d[i];
+            }
+        }
+        if n == 0 {
+            return;
+        }
+        let m = sd / n as f64;
+        let m2: f64 = (0..d.len())
+            .filter(|&i| keep[i])
+            .map(|i| (d[i] - m).powi(2))
+            .sum();
+        let (na, nb) = (self.n as f64, n as f64);
+        let delta = m - self.mean_d;
+        self.m2_d += m2 + delta * delta * na * nb / (na + nb);
+        self.mean_d += delta * nb / (na + nb);
+        self.n += n;
+        self.sum_out += so;
+        self.sum_ref += sr;
+        self.inflation.add(&d, keep);
+    }
+
+    /// Sample standard deviation of `out - ref`.
+    pub(crate) fn std_d(&self) -> f64 {
+        if self.n < 2 {
+            0.0
+        } else {
+            (self.m2_d / (self.n - 1) as f64).sqrt()
+        }
+    }
+}
+
+/// What is left of a segment once its rows have passed.
+#[derive(Debug, Clone)]
+pub(crate) struct Summary {
+    /// Index in the manifest.
+    pub seg: usize,
+    /// IMU rows in the segment.
+    pub rows: usize,
+    /// Rows removed as outliers of either sensor.
+    pub outliers: usize,
+    /// Whether the segment was preprocessed.
+    pub prepared: bool,
+    /// Lowest and highest finite IMU temperature, degC.
+    pub temp_range: Option<(f64, f64)>,
+    /// Synchronisation seen.
+    pub sync: SyncReport,
+    /// What could not be done as asked.
+    pub warnings: Vec<String>,
+    /// Mean feedback angles (outer, inner) at the IMU stamps, deg.
+    pub mean_angles_deg: (f64, f64),
+    /// Median IMU step of the first window, s.
+    pub step_s: f64,
+    /// Per output channel (`ax ay az gx gy gz`), outputs against references (prepared only).
+    pub channels: [ChannelStats; 6],
+    /// The kept gyro outputs per axis, in order (the Allan block only).
+    pub allan: Option<[Vec<f64>; 3]>,
+}
+
+/// The kinematic signals of one segment at any stamp, the feedback cursor kept between
+/// calls (stamps come in order).
+struct Kin<'a> {
+    tab: &'a TableStream,
+    geo: &'a Geometry,
+    site: Site,
+    /// At rest with known angles: the one set of signals.
+    rest: Option<Signals>,
+    /// At rest without feedback inside: rates and accelerations are zero.
+    still: bool,
+    /// A rate segment's steady rates, rad/s.
+    steady: Option<(f64, f64)>,
+    j: usize,
+}
+
+impl<'a> Kin<'a> {
+    fn new(tab: &'a TableStream, seg: &Segment, geo: &'a Geometry, site: Site) -> Self {
+        let still = seg.kind == SegmentKind::Static;
+        let rest = still
+            .then(|| prep::rest_angles(tab, seg.t_start, seg.t_end))
+            .flatten()
+            .map(|(o, i)| {
+                let at = |angle: f64| AxisMotion {
+                    angle: angle * DEG,
+                    rate: 0.0,
+                    accel: 0.0,
+                };
+                let state = TableState {
+                    outer: at(o),
+                    inner: at(i),
+                };
+                Signals::new(&state.snapshot(geo, &site), &site, 0.0)
+            });
+        let steady = (seg.kind == SegmentKind::Rate).then(|| {
+            let (o, i) = prep::steady_rates(tab, seg.t_start, seg.t_end);
+            (o * DEG, i * DEG)
+        });
+        let j = tab
+            .t
+            .partition_point(|&x| x <= seg.t_start)
+            .saturating_sub(1);
+        Kin {
+            tab,
+            geo,
+            site,
+            rest,
+            still,
+            steady,
+            j,
+        }
+    }
+
+    /// Moves the cursor to the feedback step holding `t`; the step `j..j + 1` and the
+    /// fraction of it.
+    fn advance(&mut self, t: f64) -> (usize, f64) {
+        let tab = &self.tab.t;
+        let last = tab.len().saturating_sub(2);
+        while self.j < last && tab[self.j + 1] <= t {
+            self.j += 1;
+        }
+        let j = self.j.min(last);
+        let w = ((t - tab[j]) / (tab[j + 1] - tab[j])).clamp(0.0, 1.0);
+        (j, w)
+    }
+
+    /// Signals at step `j`, fraction `w` (temperature offset zero, stamp `t`).
+    fn signals(&self, j: usize, w: f64, t: f64) -> Signals {
+        if let Some(s) = self.rest {
+            return s.at(t);
+        }
+        let tab = self.tab;
+        let (t0, t1) = (tab.t[j], tab.t[j + 1]);
+        let lerp = |x: &[f64]| x[j] + w * (x[j + 1] - x[j]);
+        let angle = |x: &[f64]| x[j] + w * prep::unwrap(x[j + 1] - x[j]);
+        let slope = |x: &[f64]| (x[j + 1] - x[j]) / (t1 - t0);
+        let mut state = TableState {
+            outer: AxisMotion {
+                angle: angle(&tab.outer) * DEG,
+                rate: lerp(&tab.outer_rate) * DEG,
+                accel: slope(&tab.outer_rate) * DEG,
+            },
+            inner: AxisMotion {
+                angle: angle(&tab.inner) * DEG,
+                rate: lerp(&tab.inner_rate) * DEG,
+                accel: slope(&tab.inner_rate) * DEG,
+            },
+        };
+        // At rest or turning steadily, the feedback's rate ripple is the table's
+        // measurement noise, not motion the IMU felt: rates are zero or the steady ones.
+        let fixed = if self.still {
+            Some((0.0, 0.0))
+        } else {
+            self.steady
+        };
+        if let Some((o, i)) = fixed {
+            state.outer.rate = o;
+            state.inner.rate = i;
+            state.outer.accel = 0.0;
+            state.inner.accel = 0.0;
+        }
+        Signals::new(&state.snapshot(self.geo, &self.site), &self.site, 0.0).at(t)
+    }
+}
+
+/// Runs the pass over one segment.
+pub(crate) fn pass<S: Source>(src: &S, job: &Job) -> Result<(Summary, SegAcc), S::Error> {
+    let m = src.manifest();
+    let seg = &m.segments[job.seg];
+    let mut kin = Kin::new(src.table(), seg, job.geo, m.station.site);
+    let moving = kin.rest.is_none() && !kin.still;
+    let per = if moving {
+        WINDOW_ROWS_MOVING
+    } else {
+        WINDOW_ROWS
+    };
+    let dur = seg.t_end - seg.t_start;
+    let k = ((dur * job.rate_hz / per).ceil() as usize).max(1);
+    let margin = match job.prep.and_then(|p| p.lowpass) {
+        Some((_, fc)) if k > 1 && fc > 0.0 => MARGIN_PERIODS / fc,
+        _ => 0.0,
+    };
+    let mut w = Window {
+        job,
+        seg,
+        acc: Accumulator::new(job.seg, seg.t_start, job.layout),
+        sum: Summary {
+            seg: job.seg,
+            rows: 0,
+            outliers: 0,
+            prepared: job.prep.is_some(),
+            temp_range: None,
+            sync: SyncReport::default(),
+            warnings: Vec::new(),
+            mean_angles_deg: (0.0, 0.0),
+            step_s: f64::NAN,
+            channels: Default::default(),
+            allan: (job.allan && job.prep.is_some()).then(Default::default),
+        },
+        angle_sums: (0.0, 0.0),
+    };
+    // Without two feedback samples there is no reference to fit against.
+    let k = if src.table().t.len() < 2 { 0 } else { k };
+    for i in 0..k {
+        let at = |i: usize| seg.t_start + dur * i as f64 / k as f64;
+        let (c0, c1) = (at(i), if i + 1 == k { seg.t_end } else { at(i + 1) });
+        let (r0, r1) = ((c0 - margin).max(seg.t_start), (c1 + margin).min(seg.t_end));
+        src.rows(r0, r1, |v| w.window(&mut kin, v, c0, c1, i + 1 == k))?;
+    }
+    let Window {
+        acc,
+        mut sum,
+        angle_sums,
+        ..
+    } = w;
+    let n = sum.rows.max(1) as f64;
+    sum.mean_angles_deg = (angle_sums.0 / n, angle_sums.1 / n);
+    Ok((sum, acc.finish()))
+}
+
+/// A window's references per output channel: one set at rest, else per row.
+enum Refs {
+    Constant([f64; 6]),
+    PerRow([Vec<f64>; 6]),
+}
+
+impl Refs {
+    fn at(&self, c: usize, i: usize) -> f64 {
+        match self {
+            Refs::Constant(r) => r[c],
+            Refs::PerRow(r) => r[c][i],
+        }
+    }
+}
+
+/// What ideal sensors read: specific force, m/s^2, and inertial rate, deg/s.
+fn reference(s: &Signals) -> [f64; 6] {
+    let (f, w) = (s.f_b, s.w_ib_dps());
+    [f.x, f.y, f.z, w.x, w.y, w.z]
+}
+
+/// The state of one segment's pass between windows.
+struct Window<'a> {
+    job: &'a Job<'a>,
+    seg: &'a Segment,
+    acc: Accumulator<'a>,
+    sum: Summary,
+    angle_sums: (f64, f64),
+}
+
+impl Window<'_> {
+    /// One window: rows `v`, of which those in `[c0, c1)` (`[c0, c1]` for the last) are
+    /// its own; the others are the low-pass's margins.
+    fn window(&mut self, kin: &mut Kin, v: ImuView, c0: f64, c1: f64, last: bool) {
+        let n = v.t.len();
+        let ca = v.t.partition_point(|&t| t < c0);
+        let cb = if last {
+            n
+        } else {
+            v.t.partition_point(|&t| t < c1)
+        };
+        if self.sum.step_s.is_nan() && cb > ca + 1 {
+            self.sum.step_s = median_step(&v.t[ca..cb]);
+        }
+        // Signals at every stamp (one set at rest), with the synchronisation seen.
+        let mut sigs: Vec<Signals> = Vec::new();
+        let constant = kin.rest;
+        for (i, &t) in v.t.iter().enumerate() {
+            let (j, w) = kin.advance(t);
+            if (ca..cb).contains(&i) {
+                self.see_sync(kin.tab, j, w, t);
+            }
+            if constant.is_none() {
+                sigs.push(kin.signals(j, w, t));
+            }
+        }
+        let sig_at = |i: usize| match constant {
+            Some(s) => s.at(v.t[i]),
+            None => sigs[i],
+        };
+        // References: specific force and inertial rate (with the Earth's), per channel.
+        let refs = match constant {
+            Some(s) => Refs::Constant(reference(&s)),
+            None if self.job.prep.is_some() => {
+                let mut r: [Vec<f64>; 6] = std::array::from_fn(|_| Vec::with_capacity(n));
+                for s in &sigs {
+                    for (c, v) in reference(s).into_iter().enumerate() {
+                        r[c].push(v);
+                    }
+                }
+                Refs::PerRow(r)
+            }
+            None => Refs::Constant([0.0; 6]),
+        };
+        let mut keep_a = vec![true; n];
+        let mut keep_g = vec![true; n];
+        let mut outputs: [Cow<[f64]>; 6] =
+            std::array::from_fn(|c| Cow::Borrowed(if c < 3 { v.accel[c] } else { v.gyro[c - 3] }));
+        if let Some(po) = self.job.prep {
+            if let Some(rule) = po.outliers {
+                let core = ca..cb;
+                let resid = |c: usize| -> Vec<f64> {
+                    outputs[c]
+                        .iter()
+                        .enumerate()
+                        .map(|(i, o)| o - refs.at(c, i))
+                        .collect()
+                };
+                rayon::join(
+                    || prep::flag_window(|k| resid(k), rule, &core, &mut keep_a),
+                    || prep::flag_window(|k| resid(3 + k), rule, &core, &mut keep_g),
+                );
+            }
+            if let Some((order, cutoff)) = po.lowpass {
+                let first = self.sum.rows == 0;
+                let id = &self.seg.id;
+                match prep::lowpass(&mut outputs, &keep_a, &keep_g, v.t, order, cutoff) {
+                    Ok(()) => {}
+                    Err(why) if first => self.sum.warnings.push(format!("segment {id}: {why}")),
+                    Err(_) => {}
+                }
+            }
+        }
+        // The window's own rows, into the fit and the sums.
+        let temp_at = |i: usize| v.temp.map_or(f64::NAN, |x| x[i]);
+        for i in ca..cb {
+            let tc = temp_at(i);
+            if tc.is_finite() {
+                let r = self.sum.temp_range.get_or_insert((tc, tc));
+                *r = (r.0.min(tc), r.1.max(tc));
+            }
+            if !keep_a[i] || !keep_g[i] {
+                self.sum.outliers += 1;
+                continue;
+            }
+            let mut s = sig_at(i);
+            let dt = tc - self.job.t_ref_c;
+            s.dtemp_c = if dt.is_finite() { dt } else { 0.0 };
+            let o = |c: usize| outputs[c][i];
+            self.acc
+                .push(&s, v.t[i], [o(0), o(1), o(2)], [o(3), o(4), o(5)]);
+        }
+        self.sum.rows += cb - ca;
+        if self.job.prep.is_some() && self.job.verify {
+            for c in 0..6 {
+                let keep = if c < 3 { &keep_a } else { &keep_g };
+                let r: Vec<f64> = (ca..cb).map(|i| refs.at(c, i)).collect();
+                self.sum.channels[c].add_window(&outputs[c][ca..cb], &r, &keep[ca..cb]);
+            }
+        }
+        if let Some(series) = &mut self.sum.allan {
+            for (ax, s) in series.iter_mut().enumerate() {
+                let o = &outputs[3 + ax];
+                s.extend((ca..cb).filter(|&i| keep_g[i]).map(|i| o[i]));
+            }
+        }
+    }
+
+    /// The synchronisation of the stamp `t` in feedback step `j` at fraction `w`.
+    fn see_sync(&mut self, tab: &TableStream, j: usize, w: f64, t: f64) {
+        let (t0, t1) = (tab.t[j], tab.t[j + 1]);
+        let gap = t1 - t0;
+        let sync = &mut self.sum.sync;
+        sync.max_gap_s = sync.max_gap_s.max(gap);
+        sync.max_sync_error_s = sync
+            .max_sync_error_s
+            .max((t - t0).abs().min((t1 - t).abs()));
+        let acc_o = prep::rate_derivative(&tab.t, &tab.outer_rate, j);
+        let acc_i = prep::rate_derivative(&tab.t, &tab.inner_rate, j);
+        let max_acc = acc_o.abs().max(acc_i.abs());
+        sync.max_angle_error_deg = sync.max_angle_error_deg.max(gap * gap / 8.0 * max_acc);
+        self.angle_sums.0 += tab.outer[j] + w * prep::unwrap(tab.outer[j + 1] - tab.outer[j]);
+        self.angle_sums.1 += tab.inner[j] + w * prep::unwrap(tab.inner[j + 1] - tab.inner[j]);
+    }
+}

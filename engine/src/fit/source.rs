@@ -1,0 +1,155 @@
+//! Where the analysis reads a recording from: a [`Recording`] held in memory, or a
+//! recording folder read span by span ([`Streamed`]) so that a long 1 kHz run is analysed
+//! in bounded memory. Either way the analysis sees the manifest, the table feedback (small:
+//! tens of hertz) and the IMU rows of one time span at a time ([`ImuView`]).
+
+use crate::recording::{Manifest, OpenRecording, Recording, RecordingError, TableStream};
+use std::borrow::Cow;
+use std::convert::Infallible;
+use std::path::Path;
+
+/// The IMU rows of one span, borrowed column by column.
+#[derive(Debug, Clone, Copy)]
+pub struct ImuView<'a> {
+    /// Stamps, s.
+    pub t: &'a [f64],
+    /// Accelerometer outputs per axis, m/s^2.
+    pub accel: [&'a [f64]; 3],
+    /// Gyro outputs per axis, deg/s.
+    pub gyro: [&'a [f64]; 3],
+    /// IMU internal temperature, degC.
+    pub temp: Option<&'a [f64]>,
+}
+
+impl<'a> ImuView<'a> {
+    /// Rows `a..b` of a stream.
+    pub fn of(s: &'a crate::recording::ImuStream, a: usize, b: usize) -> Self {
+        ImuView {
+            t: &s.t[a..b],
+            accel: std::array::from_fn(|k| &s.accel[k][a..b]),
+            gyro: std::array::from_fn(|k| &s.gyro[k][a..b]),
+            temp: s.temp.as_ref().map(|x| &x[a..b]),
+        }
+    }
+}
+
+/// A recording as the analysis reads it.
+pub trait Source: Sync {
+    /// Why a span could not be read.
+    type Error: Send;
+    /// The manifest.
+    fn manifest(&self) -> &Manifest;
+    /// The whole table feedback stream.
+    fn table(&self) -> &TableStream;
+    /// IMU rows in the recording.
+    fn imu_rows(&self) -> usize;
+    /// First and last IMU stamp, s.
+    fn imu_extent(&self) -> (f64, f64);
+    /// Whether the IMU stream has the temperature column.
+    fn has_temp(&self) -> bool;
+    /// Hands `f` the IMU rows with `t0 <= t <= t1`.
+    fn rows<R>(&self, t0: f64, t1: f64, f: impl FnOnce(ImuView<'_>) -> R)
+    -> Result<R, Self::Error>;
+    /// The recording between `t0` and `t1` in memory (every segment of the manifest kept):
+    /// for the analyses that navigate the raw stream (the size effect's cycles).
+    fn recording(&self, t0: f64, t1: f64) -> Result<Cow<'_, Recording>, Self::Error>;
+}
+
+impl Source for Recording {
+    type Error = Infallible;
+
+    fn manifest(&self) -> &Manifest {
+        &self.manifest
+    }
+
+    fn table(&self) -> &TableStream {
+        &self.table
+    }
+
+    fn imu_rows(&self) -> usize {
+        self.imu.t.len()
+    }
+
+    fn imu_extent(&self) -> (f64, f64) {
+        let t = &self.imu.t;
+        (
+            t.first().copied().unwrap_or(0.0),
+            t.last().copied().unwrap_or(0.0),
+        )
+    }
+
+    fn has_temp(&self) -> bool {
+        self.imu.temp.is_some()
+    }
+
+    fn rows<R>(&self, t0: f64, t1: f64, f: impl FnOnce(ImuView<'_>) -> R) -> Result<R, Infallible> {
+        let t = &self.imu.t;
+        let a = t.partition_point(|&x| x < t0);
+        let b = t.partition_point(|&x| x <= t1).max(a);
+        Ok(f(ImuView::of(&self.imu, a, b)))
+    }
+
+    fn recording(&self, _t0: f64, _t1: f64) -> Result<Cow<'_, Recording>, Infallible> {
+        Ok(Cow::Borrowed(self))
+    }
+}
+
+/// A recording folder opened for reading by time span, with its table feedback in memory.
+#[derive(Debug, Clone)]
+pub struct Streamed {
+    open: OpenRecording,
+    table: TableStream,
+}
+
+impl Streamed {
+    /// Opens `dir`: the manifest, an index of both streams by time, and the table feedback.
+    /// The IMU cells outside the time column are checked when their span is read.
+    #[allow(clippy::result_large_err)]
+    pub fn open(dir: &Path) -> Result<Self, RecordingError> {
+        let open = Recording::open(dir)?;
+        let table = open.read_table()?;
+        Ok(Streamed { open, table })
+    }
+}
+
+impl Source for Streamed {
+    type Error = RecordingError;
+
+    fn manifest(&self) -> &Manifest {
+        self.open.manifest()
+    }
+
+    fn table(&self) -> &TableStream {
+        &self.table
+    }
+
+    fn imu_rows(&self) -> usize {
+        self.open.imu_rows()
+    }
+
+    fn imu_extent(&self) -> (f64, f64) {
+        self.open.imu_extent()
+    }
+
+    fn has_temp(&self) -> bool {
+        self.open.imu_has_temp()
+    }
+
+    fn rows<R>(
+        &self,
+        t0: f64,
+        t1: f64,
+        f: impl FnOnce(ImuView<'_>) -> R,
+    ) -> Result<R, RecordingError> {
+        let s = self.open.read_imu_span(t0, t1)?;
+        Ok(f(ImuView::of(&s, 0, s.t.len())))
+    }
+
+    fn recording(&self, t0: f64, t1: f64) -> Result<Cow<'_, Recording>, RecordingError> {
+        Ok(Cow::Owned(Recording {
+            manifest: self.open.manifest().clone(),
+            imu: self.open.read_imu_span(t0, t1)?,
+            table: self.table.clone(),
+        }))
+    }
+}
