@@ -112,3 +112,31 @@ fn failed_check_exits_three_and_names_the_procedure_hash() {
     let want = ratecal_grammar::canonical(&strict).unwrap().sha256;
     assert_eq!(v["model"]["procedure"]["sha256"], want.as_str());
 }
+
+/// The IMU stream is read a window at a time: a bad cell deep inside a segment is still
+/// refused, located at its line and column in imu.csv, with exit 1 and no results file.
+#[test]
+fn a_bad_cell_inside_a_segment_is_located() {
+    let Some(ex) = example() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("run");
+    std::fs::create_dir(&dir).unwrap();
+    for f in ["manifest.yaml", "imu.csv", "table.csv"] {
+        std::fs::copy(ex.join(f), dir.join(f)).unwrap();
+    }
+    let imu = std::fs::read_to_string(dir.join("imu.csv")).unwrap();
+    let mut lines: Vec<String> = imu.lines().map(String::from).collect();
+    // A row in the middle of the recording (inside the long gyro block), its gy cell.
+    let row = lines.len() / 2;
+    let mut cells: Vec<&str> = lines[row].split(',').collect();
+    cells[5] = "0.0.1";
+    lines[row] = cells.join(",");
+    std::fs::write(dir.join("imu.csv"), lines.join("\n") + "\n").unwrap();
+    let out = tmp.path().join("results.json");
+    let o = analyze(&[dir.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("imu.csv"), "{err}");
+    assert!(err.contains(&format!(":{}:", row + 1)), "{err}");
+    assert!(!out.exists());
+}

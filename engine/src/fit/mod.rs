@@ -47,6 +47,9 @@ pub struct Options {
     pub path: String,
     /// Catalogue effects added to whatever model applies (`--with`).
     pub with: Vec<String>,
+    /// Most IMU rows of a static segment held at once (its outlier test runs within each
+    /// window of that many rows); a moving segment's windows are an eighth of it.
+    pub window_rows: usize,
 }
 
 impl Default for Options {
@@ -56,6 +59,7 @@ impl Default for Options {
             lowpass: None,
             path: String::new(),
             with: Vec::new(),
+            window_rows: segment::WINDOW_ROWS,
         }
     }
 }
@@ -112,7 +116,7 @@ pub fn analyze_source<S: Source>(
     let design = models::Design::new(&sel, &declared, thermal, &mut out);
     let rate_hz = mean_rate(src);
     let t_ref_c = if design.uses_temperature() {
-        mean_temperature(src, rate_hz)?
+        mean_temperature(src, rate_hz, opts.window_rows)?
     } else {
         0.0
     };
@@ -135,6 +139,7 @@ pub fn analyze_source<S: Source>(
                     allan: sel.allan == Some(i),
                     verify: sel.unused.contains(&i),
                     rate_hz,
+                    window_rows: opts.window_rows,
                 };
                 segment::pass(src, &job)
             })
@@ -195,11 +200,7 @@ pub fn analyze_source<S: Source>(
         gyro::block_noise(id, fitted.residuals.iter().map(|r| &r.0), &mut out);
     }
     if let Some(ix) = &sel.size_effect {
-        let span =
-            |f: fn(&crate::recording::Segment) -> f64| ix.iter().map(move |&i| f(&m.segments[i]));
-        let t0 = span(|s| s.t_start).fold(f64::INFINITY, f64::min);
-        let t1 = span(|s| s.t_end).fold(f64::NEG_INFINITY, f64::max);
-        size_effect::fit(&*src.recording(t0, t1)?, ix, &mut out);
+        size_effect::fit(&*src.recording()?, ix, &mut out);
     }
     let allan = sel
         .allan
@@ -269,7 +270,7 @@ pub(crate) fn accumulate_all<S: Source>(src: &S, layout: &Layout) -> Result<Vec<
     let geos = prep::geometries(m);
     let rate_hz = mean_rate(src);
     let t_ref_c = if layout.effects.iter().any(|e| e.uses_temperature()) {
-        mean_temperature(src, rate_hz)?
+        mean_temperature(src, rate_hz, segment::WINDOW_ROWS)?
     } else {
         0.0
     };
@@ -285,6 +286,7 @@ pub(crate) fn accumulate_all<S: Source>(src: &S, layout: &Layout) -> Result<Vec<
                 allan: false,
                 verify: false,
                 rate_hz,
+                window_rows: segment::WINDOW_ROWS,
             };
             segment::pass(src, &job).map(|p| p.1)
         })
@@ -314,9 +316,9 @@ fn mean_rate<S: Source>(src: &S) -> f64 {
 
 /// The IMU temperature the thermal terms refer to: the recording's mean, read a window at
 /// a time.
-fn mean_temperature<S: Source>(src: &S, rate_hz: f64) -> Result<f64, S::Error> {
+fn mean_temperature<S: Source>(src: &S, rate_hz: f64, rows: usize) -> Result<f64, S::Error> {
     let (t0, t1) = src.imu_extent();
-    let span = segment::WINDOW_ROWS / rate_hz;
+    let span = rows.max(1) as f64 / rate_hz;
     let k = (((t1 - t0) / span).ceil() as usize).max(1);
     let (mut sum, mut n) = (0.0, 0usize);
     for i in 0..k {

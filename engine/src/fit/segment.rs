@@ -5,8 +5,8 @@
 //! reads (verification means, the Allan series, temperature span, synchronisation). What
 //! is left of a segment is its [`Summary`]: a 1 kHz hour-long block never sits in memory.
 //!
-//! A window holds at most [`WINDOW_ROWS`] rows (a moving segment's, whose signals are kept
-//! per row, [`WINDOW_ROWS_MOVING`]); the outlier test runs within a window. A low-pass over
+//! A window holds at most [`WINDOW_ROWS`] rows by default (a moving segment's, whose
+//! signals are kept per row, an eighth of that); the outlier test runs within a window. A low-pass over
 //! a segment of several windows reads each window with a margin on both sides, so that the
 //! filter's start-up is spent outside the rows it keeps.
 
@@ -20,10 +20,10 @@ use ratecal_physics::effects::Signals;
 use ratecal_physics::{AxisMotion, DEG, Geometry, Site, TableState};
 use std::borrow::Cow;
 
-/// Rows per window of a static segment: 87 minutes at 100 Hz, 8.7 at 1 kHz.
-pub(crate) const WINDOW_ROWS: f64 = 524_288.0;
-/// Rows per window of a moving segment (its signals are kept per row).
-pub(crate) const WINDOW_ROWS_MOVING: f64 = 65_536.0;
+/// Rows per window of a static segment by default: 87 minutes at 100 Hz, 8.7 at 1 kHz.
+pub(crate) const WINDOW_ROWS: usize = 524_288;
+/// A moving segment's windows are this much shorter (its signals are kept per row).
+const MOVING_DIVISOR: usize = 8;
 /// Margin on each side of a window for a low-pass, in periods of the cutoff.
 const MARGIN_PERIODS: f64 = 30.0;
 
@@ -46,6 +46,8 @@ pub(crate) struct Job<'a> {
     pub verify: bool,
     /// Mean IMU rate of the recording, Hz (sizes the windows).
     pub rate_hz: f64,
+    /// Rows per window of a static segment.
+    pub window_rows: usize,
 }
 
 /// Means and spread of one output channel against its reference over kept samples.
@@ -169,19 +171,23 @@ impl<'a> Kin<'a> {
             let (o, i) = prep::steady_rates(tab, seg.t_start, seg.t_end);
             (o * DEG, i * DEG)
         });
-        let j = tab
-            .t
-            .partition_point(|&x| x <= seg.t_start)
-            .saturating_sub(1);
-        Kin {
+        let mut kin = Kin {
             tab,
             geo,
             site,
             rest,
             still,
             steady,
-            j,
-        }
+            j: 0,
+        };
+        kin.seek(seg.t_start);
+        kin
+    }
+
+    /// Puts the cursor at the feedback step holding `t` (a window's first stamp: a window
+    /// read with a margin starts before where the last one ended).
+    fn seek(&mut self, t: f64) {
+        self.j = self.tab.t.partition_point(|&x| x <= t).saturating_sub(1);
     }
 
     /// Moves the cursor to the feedback step holding `t`; the step `j..j + 1` and the
@@ -243,10 +249,11 @@ pub(crate) fn pass<S: Source>(src: &S, job: &Job) -> Result<(Summary, SegAcc), S
     let mut kin = Kin::new(src.table(), seg, job.geo, m.station.site);
     let moving = kin.rest.is_none() && !kin.still;
     let per = if moving {
-        WINDOW_ROWS_MOVING
+        job.window_rows / MOVING_DIVISOR
     } else {
-        WINDOW_ROWS
-    };
+        job.window_rows
+    }
+    .max(1) as f64;
     let dur = seg.t_end - seg.t_start;
     let k = ((dur * job.rate_hz / per).ceil() as usize).max(1);
     let margin = match job.prep.and_then(|p| p.lowpass) {
@@ -338,6 +345,9 @@ impl Window<'_> {
         // Signals at every stamp (one set at rest), with the synchronisation seen.
         let mut sigs: Vec<Signals> = Vec::new();
         let constant = kin.rest;
+        if let Some(&t0) = v.t.first() {
+            kin.seek(t0);
+        }
         for (i, &t) in v.t.iter().enumerate() {
             let (j, w) = kin.advance(t);
             if (ca..cb).contains(&i) {

@@ -50,9 +50,9 @@ pub trait Source: Sync {
     /// Hands `f` the IMU rows with `t0 <= t <= t1`.
     fn rows<R>(&self, t0: f64, t1: f64, f: impl FnOnce(ImuView<'_>) -> R)
     -> Result<R, Self::Error>;
-    /// The recording between `t0` and `t1` in memory (every segment of the manifest kept):
-    /// for the analyses that navigate the raw stream (the size effect's cycles).
-    fn recording(&self, t0: f64, t1: f64) -> Result<Cow<'_, Recording>, Self::Error>;
+    /// The whole recording in memory: for the analyses that navigate the raw stream (the
+    /// size effect's cycles, from the static blocks before them).
+    fn recording(&self) -> Result<Cow<'_, Recording>, Self::Error>;
 }
 
 impl Source for Recording {
@@ -89,26 +89,25 @@ impl Source for Recording {
         Ok(f(ImuView::of(&self.imu, a, b)))
     }
 
-    fn recording(&self, _t0: f64, _t1: f64) -> Result<Cow<'_, Recording>, Infallible> {
+    fn recording(&self) -> Result<Cow<'_, Recording>, Infallible> {
         Ok(Cow::Borrowed(self))
     }
 }
 
-/// A recording folder opened for reading by time span, with its table feedback in memory.
+/// A recording folder opened for reading by time span (its table feedback in memory).
 #[derive(Debug, Clone)]
 pub struct Streamed {
     open: OpenRecording,
-    table: TableStream,
 }
 
 impl Streamed {
-    /// Opens `dir`: the manifest, an index of both streams by time, and the table feedback.
+    /// Opens `dir`: the manifest, an index of the IMU stream by time, the table feedback.
     /// The IMU cells outside the time column are checked when their span is read.
     #[allow(clippy::result_large_err)]
     pub fn open(dir: &Path) -> Result<Self, RecordingError> {
-        let open = Recording::open(dir)?;
-        let table = open.read_table()?;
-        Ok(Streamed { open, table })
+        Ok(Streamed {
+            open: Recording::open(dir)?,
+        })
     }
 }
 
@@ -120,7 +119,7 @@ impl Source for Streamed {
     }
 
     fn table(&self) -> &TableStream {
-        &self.table
+        self.open.table()
     }
 
     fn imu_rows(&self) -> usize {
@@ -145,11 +144,11 @@ impl Source for Streamed {
         Ok(f(ImuView::of(&s, 0, s.t.len())))
     }
 
-    fn recording(&self, t0: f64, t1: f64) -> Result<Cow<'_, Recording>, RecordingError> {
+    fn recording(&self) -> Result<Cow<'_, Recording>, RecordingError> {
         Ok(Cow::Owned(Recording {
             manifest: self.open.manifest().clone(),
-            imu: self.open.read_imu_span(t0, t1)?,
-            table: self.table.clone(),
+            imu: self.open.read_imu_span(f64::NEG_INFINITY, f64::INFINITY)?,
+            table: self.open.table().clone(),
         }))
     }
 }

@@ -20,7 +20,7 @@ pub(super) fn layout<S: Stream>(names: &[String], data_start: u64) -> Option<(La
     if let Some(i) = opt {
         want[i] = S::REQUIRED.len();
     }
-    Some((Layout { want, data_start }, opt.is_some()))
+    Some((Layout::new(want, data_start), opt.is_some()))
 }
 
 /// The header of `path` (names, where the data starts) and the file's length.

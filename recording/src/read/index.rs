@@ -121,6 +121,7 @@ impl StreamIndex {
             let only_t = Layout {
                 want: want.collect(),
                 data_start,
+                lazy_tail: true,
             };
             let mut fast = Times::new(times.starts);
             if let Some(entries) = fast_entries(&path, &only_t, len, &mut fast) {

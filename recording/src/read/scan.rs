@@ -28,6 +28,20 @@ pub(crate) struct Layout {
     pub want: Vec<usize>,
     /// Byte offset of the first data line (after the header).
     pub data_start: u64,
+    /// Whether the cells after the last wanted one are left unread (the index's time-only
+    /// pass: those cells are checked when a span holding them is read).
+    pub lazy_tail: bool,
+}
+
+impl Layout {
+    /// A layout that reads the wanted fields and checks every line's cells.
+    pub(crate) fn new(want: Vec<usize>, data_start: u64) -> Self {
+        Layout {
+            want,
+            data_start,
+            lazy_tail: false,
+        }
+    }
 }
 
 pub(crate) const SKIP: usize = usize::MAX;
@@ -180,6 +194,8 @@ fn parse_lines<S: RowSink>(
     sink: &mut S,
 ) -> Result<bool, GiveUp> {
     let width = layout.want.len();
+    let last_wanted = layout.want.iter().rposition(|&w| w != SKIP);
+    let tail_from = if layout.lazy_tail { last_wanted } else { None };
     let mut row = [0.0f64; MAX_SLOTS];
     while pos < buf.len() {
         if pos >= limit {
@@ -215,6 +231,15 @@ fn parse_lines<S: RowSink>(
             };
             if slot != SKIP {
                 row[slot] = v;
+            }
+            if tail_from == Some(field) {
+                // The rest of the line unread: on to the next one.
+                field = width;
+                pos = match memchr::memchr(b'\n', &buf[next..]) {
+                    Some(p) => next + p + 1,
+                    None => buf.len(),
+                };
+                break;
             }
             field += 1;
             match buf.get(next) {
@@ -258,7 +283,7 @@ fn skip_field(buf: &[u8], mut pos: usize) -> Option<usize> {
 }
 
 fn memchr(needle: u8, hay: &[u8]) -> Option<usize> {
-    hay.iter().position(|&b| b == needle)
+    memchr::memchr(needle, hay)
 }
 
 /// Splits `sizes` bytes of work over two threads: byte offsets in the first file where
@@ -303,7 +328,7 @@ mod tests {
                 _ => SKIP,
             })
             .collect();
-        let layout = Layout { want, data_start };
+        let layout = Layout::new(want, data_start);
         let len = text.len() as u64;
         let mid = chunks_at.clamp(data_start, len);
         let mut a = Rows(Vec::new(), 2);

@@ -6,23 +6,25 @@
 #![allow(clippy::result_large_err)]
 
 use super::check;
+use super::check::Extent;
 use super::csvread::read_rows;
 use super::index::{StreamIndex, Times};
 use super::scan::{self, MAX_SLOTS, RowSink};
 use super::stream::Stream;
-use super::{io_error, read_manifest};
+use super::{io_error, read_manifest, read_stream};
 use crate::error::RecordingError;
 use crate::{ImuStream, Manifest, Recording, TableStream};
 use std::io::{Read, Seek, SeekFrom};
 use std::path::Path;
 
-/// A recording folder opened for reading by time span: its manifest, and both streams
-/// indexed by time (one entry per 256 KiB of CSV), never held whole.
+/// A recording folder opened for reading by time span: its manifest, the IMU stream indexed
+/// by time (one entry per 256 KiB of CSV), never held whole, and the table feedback stream
+/// (tens of hertz beside the IMU's hundreds or thousands), read whole.
 #[derive(Debug, Clone)]
 pub struct OpenRecording {
     manifest: Manifest,
     imu: StreamIndex,
-    table: StreamIndex,
+    table: TableStream,
     /// IMU rows, first and last stamp.
     imu_rows: usize,
     imu_extent: (f64, f64),
@@ -39,35 +41,33 @@ pub struct SpanRows {
 
 impl Recording {
     /// Opens `dir` for reading by time span. It checks what [`crate::read`] checks, with
-    /// the same located errors, except the cells outside the time column, which are
-    /// checked when a span holding them is read (a stream whose time column the range
+    /// the same located errors, except the IMU cells outside the time column, which are
+    /// checked when a span holding them is read (an `imu.csv` whose time column the range
     /// parser gives up on, quoted cells for one, is read whole once here, and checked whole).
     pub fn open(dir: &Path) -> Result<OpenRecording, RecordingError> {
         let (manifest_name, manifest_text, manifest) = read_manifest(dir)?;
         let mut starts: Vec<f64> = manifest.segments.iter().map(|s| s.t_start).collect();
         starts.sort_by(f64::total_cmp);
         let mut imu_times = Times::new(&starts);
-        let mut table_times = Times::new(&[]);
         let (imu, table) = std::thread::scope(|s| {
-            let h = s.spawn(|| StreamIndex::build::<TableStream>(dir, &mut table_times));
+            let h = s.spawn(|| read_stream::<TableStream>(&dir.join(TableStream::FILE)));
             let imu = StreamIndex::build::<ImuStream>(dir, &mut imu_times);
-            (imu, h.join().expect("index thread"))
+            (imu, h.join().expect("table thread"))
         });
-        let (imu, table) = (imu?, table?);
-        for (times, index) in [(&imu_times, &imu), (&table_times, &table)] {
-            if times.rows < 2 {
-                return Err(check::too_few(&index.path));
-            }
-            if let Some((row, prev, t)) = times.backwards {
-                return Err(check::time_error(&index.path, row, prev, t));
-            }
+        let imu = imu?;
+        if imu_times.rows < 2 {
+            return Err(check::too_few(&imu.path));
         }
+        if let Some((row, prev, t)) = imu_times.backwards {
+            return Err(check::time_error(&imu.path, row, prev, t));
+        }
+        let table = table?;
         check::check_segments(
             &manifest_name,
             &manifest_text,
             &manifest,
             imu_times.extent(),
-            table_times.extent(),
+            Extent::of(&table.t),
             |a, b| imu_times.holds_sample(a, b),
         )?;
         let extent = imu_times.extent();
@@ -93,7 +93,7 @@ impl OpenRecording {
     pub fn read_span(&self, t0: f64, t1: f64) -> Result<SpanRows, RecordingError> {
         Ok(SpanRows {
             imu: span::<ImuStream>(&self.imu, t0, t1)?,
-            table: span::<TableStream>(&self.table, t0, t1)?,
+            table: table_span(&self.table, t0, t1),
         })
     }
 
@@ -102,9 +102,9 @@ impl OpenRecording {
         span::<ImuStream>(&self.imu, t0, t1)
     }
 
-    /// The whole table feedback stream (a small file beside the IMU's: 50 Hz against 1 kHz).
-    pub fn read_table(&self) -> Result<TableStream, RecordingError> {
-        span::<TableStream>(&self.table, f64::NEG_INFINITY, f64::INFINITY)
+    /// The whole table feedback stream.
+    pub fn table(&self) -> &TableStream {
+        &self.table
     }
 
     /// How many IMU rows the file holds.
@@ -120,6 +120,21 @@ impl OpenRecording {
     /// Whether `imu.csv` has the optional `temp` column.
     pub fn imu_has_temp(&self) -> bool {
         self.imu.optional
+    }
+}
+
+/// The table rows with `t0 <= t <= t1`.
+fn table_span(tab: &TableStream, t0: f64, t1: f64) -> TableStream {
+    let a = tab.t.partition_point(|&x| x < t0);
+    let b = tab.t.partition_point(|&x| x <= t1).max(a);
+    let cut = |v: &[f64]| v[a..b].to_vec();
+    TableStream {
+        t: cut(&tab.t),
+        outer: cut(&tab.outer),
+        inner: cut(&tab.inner),
+        outer_rate: cut(&tab.outer_rate),
+        inner_rate: cut(&tab.inner_rate),
+        ambient: tab.ambient.as_deref().map(cut),
     }
 }
 

@@ -9,11 +9,13 @@ const BLOCK: usize = 256;
 
 /// The triangular factor `R` of `[X y]` (the last column is the observation): `R^T R =
 /// [X y]^T [X y]`, so any least-squares question about the rows can be answered from it.
+/// Rows are written straight below `R` into one column-major stack, folded every
+/// [`BLOCK`] rows.
 #[derive(Debug, Clone)]
 pub(crate) struct Tri {
     cols: usize,
-    r: DMatrix<f64>,
-    buf: Vec<f64>,
+    /// `R` in the first `cols` rows, then the pending rows.
+    stack: DMatrix<f64>,
     rows: usize,
     /// Rows folded in so far.
     pub n: usize,
@@ -24,8 +26,7 @@ impl Tri {
     pub(crate) fn new(cols: usize) -> Self {
         Tri {
             cols,
-            r: DMatrix::zeros(cols, cols),
-            buf: Vec::with_capacity(BLOCK * cols),
+            stack: DMatrix::zeros(cols + BLOCK, cols),
             rows: 0,
             n: 0,
         }
@@ -34,7 +35,10 @@ impl Tri {
     /// Adds one row (regressors then the observation).
     pub(crate) fn push(&mut self, row: &[f64]) {
         debug_assert_eq!(row.len(), self.cols);
-        self.buf.extend_from_slice(row);
+        let i = self.cols + self.rows;
+        for (j, v) in row.iter().enumerate() {
+            self.stack[(i, j)] = *v;
+        }
         self.rows += 1;
         self.n += 1;
         if self.rows == BLOCK {
@@ -47,22 +51,22 @@ impl Tri {
             return;
         }
         let c = self.cols;
-        let mut m = DMatrix::zeros(c + self.rows, c);
-        m.view_mut((0, 0), (c, c)).copy_from(&self.r);
-        for (k, row) in self.buf.chunks_exact(c).enumerate() {
-            for j in 0..c {
-                m[(c + k, j)] = row[j];
-            }
-        }
-        self.r = triangle(m, c);
-        self.buf.clear();
+        let full = std::mem::replace(&mut self.stack, DMatrix::zeros(c + BLOCK, c));
+        let used = if self.rows == BLOCK {
+            full
+        } else {
+            full.rows(0, c + self.rows).into_owned()
+        };
+        let r = triangle(used, c);
+        self.stack.view_mut((0, 0), (c, c)).copy_from(&r);
         self.rows = 0;
     }
 
     /// The factor, every pending row folded in.
     pub(crate) fn finish(mut self) -> DMatrix<f64> {
         self.flush();
-        self.r
+        let c = self.cols;
+        self.stack.rows(0, c).into_owned()
     }
 }
 

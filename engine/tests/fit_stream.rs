@@ -1,0 +1,100 @@
+//! The analysis read span by span (`fit::Streamed`, what `ratecal analyze` uses) against
+//! the same recording held in memory, and segments cut into windows against one window:
+//! how the samples are held must not change what is found.
+
+mod fit_support;
+
+use fit_support::{SimSpec, standard_windows, write};
+use ratecal_engine::plan::Outliers;
+use ratecal_engine::results::Results;
+use ratecal_engine::{fit, recording};
+
+fn sim(spec: &SimSpec) -> tempfile::TempDir {
+    let tmp = tempfile::tempdir().unwrap();
+    write(tmp.path(), spec, &standard_windows(spec.block_s));
+    tmp
+}
+
+/// Every estimate of `a` and `b` differs by at most `tol` times its uncertainty.
+fn agree(a: &Results, b: &Results, tol: f64) -> f64 {
+    let mut worst = 0.0f64;
+    for name in a.parameters.keys() {
+        match (a.value(name), b.value(name)) {
+            (Some((va, ua)), Some((vb, _))) => {
+                let z = (va - vb).abs() / ua;
+                assert!(z <= tol, "{name}: {va} vs {vb} (u {ua}, {z:.3e} u apart)");
+                worst = worst.max(z);
+            }
+            (None, None) => {}
+            (x, y) => panic!("{name}: {x:?} vs {y:?}"),
+        }
+    }
+    worst
+}
+
+#[test]
+fn read_span_by_span_gives_the_results_of_a_whole_read() {
+    let mut spec = SimSpec::tactical(21);
+    spec.temp = Some((22.0, 3.0));
+    let tmp = sim(&spec);
+    let opts = fit::Options {
+        with: vec!["lever_arm".into(), "gyro_thermal_drift".into()],
+        ..Default::default()
+    };
+    let rec = recording::read(tmp.path()).unwrap();
+    let whole = fit::analyze_with(&rec, None, &opts);
+    let streamed = fit::Streamed::open(tmp.path()).unwrap();
+    let spans = fit::analyze_source(&streamed, None, &opts).unwrap();
+    // The same rows in the same windows in the same order: the same numbers, bit for bit.
+    assert_eq!(whole.to_json(), spans.to_json());
+    assert!(whole.parameters.contains_key("lever_arm.rxx_mm"));
+    assert_eq!(whole.recording.imu_rows, rec.imu.t.len());
+}
+
+/// Without an outlier test, windows change nothing but where the samples are cut: the
+/// low-pass, read with margins, filters each window as it filters the whole segment (to
+/// rounding: each window's sampling rate comes from its own stamps; a sample lost or
+/// counted twice at a window's edge would move the gyro bias by about 2e-3 u).
+#[test]
+fn windows_with_margins_filter_as_one_window_does() {
+    let tmp = sim(&SimSpec::tactical(22));
+    let rec = recording::read(tmp.path()).unwrap();
+    let opts = |rows: usize| fit::Options {
+        outliers: None,
+        lowpass: Some((4, 5.0)),
+        window_rows: rows,
+        ..Default::default()
+    };
+    let one = fit::analyze_with(&rec, None, &opts(fit::Options::default().window_rows));
+    // 12,000 rows of gyro block in 2,000-row windows; the 1,000-row rate segments in 250.
+    let many = fit::analyze_with(&rec, None, &opts(2_000));
+    let worst = agree(&one, &many, 1e-8);
+    eprintln!("worst difference {worst:.2e} u");
+    let (a, b) = (one.allan.unwrap(), many.allan.unwrap());
+    let pairs = a.adev_dps.iter().flatten().zip(b.adev_dps.iter().flatten());
+    for (x, y) in a.tau_s.iter().zip(&b.tau_s).chain(pairs) {
+        assert!((x - y).abs() <= 1e-9 * x, "{x} vs {y}");
+    }
+}
+
+/// With the 3-sigma test, each window is judged on its own statistics: a few samples at
+/// the edge of the threshold change sides, and the estimates stay well inside their
+/// uncertainty of each other.
+#[test]
+fn outliers_judged_per_window_move_estimates_by_a_fraction_of_u() {
+    let tmp = sim(&SimSpec::tactical(23));
+    let rec = recording::read(tmp.path()).unwrap();
+    let opts = |rows: usize| fit::Options {
+        outliers: Some(Outliers::Sigma(3.0)),
+        window_rows: rows,
+        ..Default::default()
+    };
+    let one = fit::analyze_with(&rec, None, &opts(fit::Options::default().window_rows));
+    let many = fit::analyze_with(&rec, None, &opts(2_000));
+    let worst = agree(&one, &many, 0.5);
+    eprintln!("worst difference {worst:.2e} u");
+    let removed = |r: &Results| r.segments.iter().map(|s| s.outliers_removed).sum::<usize>();
+    let (a, b) = (removed(&one), removed(&many));
+    assert!(a > 0 && b > 0, "{a} {b}");
+    assert!(a.abs_diff(b) * 10 < a.max(b), "{a} vs {b} samples removed");
+}
