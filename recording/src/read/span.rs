@@ -125,6 +125,10 @@ impl OpenRecording {
 
 /// The table rows with `t0 <= t <= t1`.
 fn table_span(tab: &TableStream, t0: f64, t1: f64) -> TableStream {
+    // Bounds no time lies between (upside down, NaN): no rows.
+    if t0.partial_cmp(&t1).is_none_or(|o| o.is_gt()) {
+        return TableStream::default();
+    }
     let a = tab.t.partition_point(|&x| x < t0);
     let b = tab.t.partition_point(|&x| x <= t1).max(a);
     let cut = |v: &[f64]| v[a..b].to_vec();
