@@ -66,6 +66,7 @@ fn dry_run(plan: &Plan, st: &Station, dir: &std::path::Path) -> f64 {
             Columns {
                 imu_temp: true,
                 ambient: true,
+                ..Columns::default()
             },
         )
         .unwrap();

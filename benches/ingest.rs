@@ -8,9 +8,9 @@
 //! it on the disk. Sessions last `RATECAL_INGEST_S` seconds (default 3, under Criterion).
 //! From 60 s on, one session runs alone, without Criterion's repetitions, and prints its
 //! figures: the full figure is `RATECAL_INGEST_S=600 cargo bench --bench ingest`.
-//! The delay to the disk is bracketed per sample: from its stamp (device time mapped onto
-//! the host clock: at or before its arrival) and from the tick that drained it from the link
-//! (at or after its arrival).
+//! The delay to the disk is reported per sample from its stamp (device time mapped onto
+//! the host clock) and from its arrival (`t_host`, the instant of the read that delivered
+//! it; both on the drivers' host clock, which starts within microseconds of the session's).
 
 use criterion::{Criterion, Throughput, criterion_group};
 use ratecal_drivers::Station;
@@ -119,15 +119,15 @@ struct Session {
     cpu: Duration,
     /// Per sample, flush time minus stamp, ms.
     from_stamp_ms: Vec<f32>,
-    /// Per sample, flush time minus the tick that drained it, ms.
-    from_drain_ms: Vec<f32>,
+    /// Per sample, flush time minus its host arrival, ms.
+    from_arrival_ms: Vec<f32>,
 }
 
 impl Session {
     fn report(&self, k: usize, secs: f64) -> String {
         let n = self.imu + self.table;
         format!(
-            "session {k}: {secs} s, imu {} (expected {:.0}), table {} (expected {:.0}), lost {}, corrupted {}, cpu {:.2} us/sample, to disk from stamp {}, from drain {}",
+            "session {k}: {secs} s, imu {} (expected {:.0}), table {} (expected {:.0}), lost {}, corrupted {}, cpu {:.2} us/sample, to disk from stamp {}, from arrival {}",
             self.imu,
             IMU_HZ * secs,
             self.table,
@@ -136,7 +136,7 @@ impl Session {
             self.corrupted,
             self.cpu.as_secs_f64() * 1e6 / n.max(1) as f64,
             percentiles(&self.from_stamp_ms),
-            percentiles(&self.from_drain_ms),
+            percentiles(&self.from_arrival_ms),
         )
     }
 }
@@ -169,11 +169,13 @@ fn session(st: &Station, secs: f64, dir: &Path) -> Session {
         let columns = Columns {
             imu_temp: true,
             ambient: true,
+            imu_t_host: true,
+            table_t_host: true,
         };
         let mut w = RecordingWriter::create(dir, manifest(st), columns).unwrap();
         let (mut ib, mut tb) = (Vec::new(), Vec::new());
         let mut s = Session::default();
-        // (stamp, drained at) of every sample written since the last flush.
+        // (stamp, arrival) of every sample written since the last flush.
         let mut pending: Vec<(f64, f64)> = Vec::new();
         let mut tick = tokio::time::interval(Duration::from_millis(20));
         let mut last_sync = Instant::now();
@@ -187,16 +189,19 @@ fn session(st: &Station, secs: f64, dir: &Path) -> Session {
             w.write_table(&tb).unwrap();
             s.imu += ib.len() as u64;
             s.table += tb.len() as u64;
+            // A link driver stamps every sample's arrival; the tick that drained it is the
+            // latest it can have arrived, should one not.
             let drained = t0.elapsed().as_secs_f64();
-            let stamps = ib.iter().map(|x| x.t).chain(tb.iter().map(|x| x.t));
-            pending.extend(stamps.map(|t| (t, drained)));
+            let times = ib.iter().map(|x| (x.t, x.t_host));
+            let times = times.chain(tb.iter().map(|x| (x.t, x.t_host)));
+            pending.extend(times.map(|(t, h)| (t, h.unwrap_or(drained))));
             if last_sync.elapsed() >= Duration::from_millis(500) {
                 last_sync = Instant::now();
                 w.sync().unwrap();
                 let h = t0.elapsed().as_secs_f64();
-                for (t, d) in pending.drain(..) {
+                for (t, a) in pending.drain(..) {
                     s.from_stamp_ms.push(((h - t) * 1e3) as f32);
-                    s.from_drain_ms.push(((h - d) * 1e3) as f32);
+                    s.from_arrival_ms.push(((h - a) * 1e3) as f32);
                 }
             }
         }

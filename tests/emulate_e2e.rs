@@ -1,8 +1,12 @@
 //! `procedures/station-check` in real time against `ratecal emulate` over loopback: a clean
 //! run over TCP and over pseudo-terminals, and one run per fault type (each ends cleanly:
 //! exit 4, the manifest says why and when, the recording is one `ratecal analyze` reads;
-//! the faults a run survives are counted in `run.sync`). The scenarios run side by side
+//! the faults a run survives are counted in `run.sync`; a clean run's per-sample host
+//! arrival times agree with it, `host_times.rs`). The scenarios run side by side
 //! (they mostly wait on the clock), so the whole file takes about one run's time.
+
+#[path = "emulate_e2e/host_times.rs"]
+mod host_times;
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
@@ -63,6 +67,8 @@ struct Seen {
     code: i32,
     output: String,
     manifest: String,
+    /// `manifest.yaml`, `imu.csv` and `table.csv` as written.
+    files: [String; 3],
     analyze_code: i32,
 }
 
@@ -97,6 +103,8 @@ fn run_scenario(name: &'static str, faults: &str, pty: bool, interrupt_at: Optio
         .iter()
         .map(|f| std::fs::read_to_string(out.join(f)).unwrap_or_default())
         .collect::<String>();
+    let files = ["manifest.yaml", "imu.csv", "table.csv"]
+        .map(|f| std::fs::read_to_string(out.join(f)).unwrap_or_default());
     let analyze = Command::new(BIN)
         .arg("analyze")
         .arg(&out)
@@ -112,6 +120,7 @@ fn run_scenario(name: &'static str, faults: &str, pty: bool, interrupt_at: Optio
             String::from_utf8_lossy(&o.stderr)
         ),
         manifest,
+        files,
         analyze_code: analyze.status.code().unwrap_or(-1),
     }
 }
@@ -153,6 +162,11 @@ fn check(s: &Seen, code: i32, status: &str, needles: &[&str]) -> Vec<String> {
             if lost.iter().any(|l| *l != Some(0)) {
                 wrong.push(format!("lost frames {lost:?} (expected none): {}", ctx()));
             }
+        } else if *n == "host times" {
+            let [manifest, imu, table] = &s.files;
+            for w in host_times::check(s.name, manifest, imu, table) {
+                wrong.push(format!("{w}: {}", s.name));
+            }
         } else if !s.manifest.contains(n) && !s.output.contains(n) {
             wrong.push(format!("`{n}` missing: {}", ctx()));
         }
@@ -188,6 +202,7 @@ fn station_check_against_the_emulator() {
                 "imu link: ",
                 "Table-to-IMU sync",
                 "no lost frames",
+                "host times",
             ],
         ),
         #[cfg(unix)]
@@ -198,7 +213,7 @@ fn station_check_against_the_emulator() {
             None,
             0,
             "completed",
-            &["table_minus_imu_s", "no lost frames"],
+            &["table_minus_imu_s", "no lost frames", "host times"],
         ),
         (
             "link back within its timeout, corrupted frames",

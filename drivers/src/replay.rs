@@ -57,6 +57,7 @@ impl ReplayTable {
                 outer_rate_dps: s.outer_rate[i],
                 inner_rate_dps: s.inner_rate[i],
                 ambient_c: s.ambient.as_ref().map(|a| a[i]),
+                t_host: None,
             })
             .collect();
         let t = &station.table;
@@ -119,6 +120,7 @@ impl ReplayImu {
                 accel: row(&s.accel, i),
                 gyro: row(&s.gyro, i),
                 temp_c: s.temp.as_ref().map(|c| c[i]),
+                t_host: None,
             })
             .collect();
         let imu = &station.imu;

@@ -20,6 +20,7 @@ async fn run_on(dir: &Path, plan: &Plan, faults: Faults, opts: RunOptions) -> (R
         Columns {
             imu_temp: true,
             ambient: true,
+            ..Columns::default()
         },
     )
     .unwrap();

@@ -26,6 +26,7 @@ async fn run(dir: &Path, plan: &Plan, st: &Station, seed: u64) -> RunOutcome {
     let columns = Columns {
         imu_temp: true,
         ambient: true,
+        ..Columns::default()
     };
     let mut m = manifest(&plan.name);
     m.station.site = st.site();

@@ -18,6 +18,9 @@ pub struct TableSample {
     pub inner_rate_dps: f64,
     /// Lab air temperature, degC, if the station measures it.
     pub ambient_c: Option<f64>,
+    /// Host arrival time of the feedback line, s, on the clock of `t` (hardware links only;
+    /// `t_host - t` is the sample's arrival delay).
+    pub t_host: Option<f64>,
 }
 
 /// One IMU sample (a row of `imu.csv`).
@@ -31,6 +34,9 @@ pub struct ImuSample {
     pub gyro: [f64; 3],
     /// Internal temperature, degC.
     pub temp_c: Option<f64>,
+    /// Host arrival time of the frame, s, on the clock of `t` (hardware links only;
+    /// `t_host - t` is the sample's arrival delay).
+    pub t_host: Option<f64>,
 }
 
 /// The IMU stream, one vector per column: the analysis borrows a segment's channels as

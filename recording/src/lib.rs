@@ -21,10 +21,12 @@
 //! let mut w = RecordingWriter::create(dir.path(), manifest, Columns::default())?;
 //! for i in 0..5 {
 //!     let t = 0.1 * i as f64;
-//!     w.write_imu(&[ImuSample { t, accel: [0.0, 0.0, 9.8], gyro: [0.0; 3], temp_c: None }])?;
+//!     w.write_imu(&[ImuSample {
+//!         t, accel: [0.0, 0.0, 9.8], gyro: [0.0; 3], temp_c: None, t_host: None,
+//!     }])?;
 //!     w.write_table(&[TableSample {
 //!         t, outer_deg: 0.0, inner_deg: 0.0, outer_rate_dps: 0.0, inner_rate_dps: 0.0,
-//!         ambient_c: None,
+//!         ambient_c: None, t_host: None,
 //!     }])?;
 //! }
 //! w.finish()?;

@@ -228,9 +228,12 @@ fn prepare_new(args: &Args) -> Result<Prepared, Report> {
         changed_after_release: changed,
     };
     let manifest = setup::manifest(&st, &pr, &facts);
+    // Hardware links stamp each sample with its host arrival time as well (`t_host`).
     let columns = Columns {
         imu_temp: true,
         ambient: st.station.temperature.report_ambient,
+        imu_t_host: st.station.imu.driver.kind.host_arrival,
+        table_t_host: st.station.table.driver.kind.host_arrival,
     };
     let writer = RecordingWriter::create(&dir, manifest, columns).map_err(io)?;
     Ok(Prepared {

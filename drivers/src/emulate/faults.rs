@@ -53,11 +53,14 @@ impl LinkFaults {
         f
     }
 
-    /// Whether `link` refuses connections at `t` (inside a drop's outage).
-    pub fn outage(&self, link: LinkName, t: f64) -> bool {
+    /// When the outage of `link` that holds at `t` ends (it refuses connections until
+    /// then: inside a drop's outage).
+    pub fn outage(&self, link: LinkName, t: f64) -> Option<f64> {
         self.drops
             .iter()
-            .any(|d| d.link == link && within(t, d.at, d.duration))
+            .filter(|d| d.link == link && within(t, d.at, d.duration))
+            .map(|d| d.at + d.duration)
+            .reduce(f64::max)
     }
 
     /// When the stall of `link` that holds at `t` ends.

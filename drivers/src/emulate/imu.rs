@@ -34,6 +34,7 @@ pub(super) async fn serve<S: AsyncRead + AsyncWrite>(stream: S, s: &Session, pty
                 Ok(n) if n > 0 => continue,
                 _ => return End::Client,
             },
+            () = s.ended() => return End::Ended,
         }
         if s.take_drop(LinkName::Imu, s.now()) {
             return End::Dropped;
@@ -53,7 +54,9 @@ pub(super) async fn serve<S: AsyncRead + AsyncWrite>(stream: S, s: &Session, pty
         buf.clear();
         for smp in &samples {
             let counter = s.counter.fetch_add(1, Ordering::Relaxed);
-            if s.faults.stall_end(LinkName::Imu, smp.t).is_some() {
+            if let Some(end) = s.faults.stall_end(LinkName::Imu, smp.t) {
+                // Silent: the client gives up on the link and reconnects within the session.
+                s.disturb(LinkName::Imu, end);
                 continue;
             }
             let mut f = FrameFields {

@@ -2,26 +2,27 @@
 //! run in real time, served over the two hardware protocols (`docs/protocols.md`): the
 //! table's line protocol and the IMU's binary frames, on TCP or pseudo-terminals. It serves
 //! one session after another: a session (a fresh simulated world, clock at 0) starts with
-//! the first connection and ends when the client has closed every link it opened. The
+//! the first connection and ends when the client has closed every link it opened, or when
+//! a new client connects (`session.rs` tells a reconnect from a new client). The
 //! station file's link faults (a dropped connection, a stall, corrupted frames, the table's
 //! fault flag, IMU saturation) are played on their session's clock, the simulator's own
 //! faults by the simulator.
 
 mod faults;
 mod imu;
+mod session;
 mod station;
 mod table;
 
 pub use station::{Served, connecting_station};
 
-use crate::sim::{SimImu, SimTable};
 use crate::station::{LinkName, Station};
 use faults::LinkFaults;
-use std::sync::atomic::{AtomicU32, AtomicU64, AtomicUsize, Ordering};
+use session::Session;
+use std::sync::atomic::Ordering;
 use std::sync::{Arc, Mutex};
 use tokio::io::{AsyncRead, AsyncWrite};
 use tokio::net::TcpListener;
-use tokio::time::Instant;
 
 /// How a served link ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -30,46 +31,8 @@ enum End {
     Client,
     /// A rehearsed fault dropped it.
     Dropped,
-}
-
-/// One session: a simulated world from its first connection on.
-struct Session {
-    number: u64,
-    start: Instant,
-    table: tokio::sync::Mutex<SimTable>,
-    imu: tokio::sync::Mutex<SimImu>,
-    /// Frame counter, kept across reconnects.
-    counter: AtomicU32,
-    /// The newest IMU link's number: an older link still being served (its client gone,
-    /// not yet noticed) stops before taking another sample, so that it never takes samples
-    /// from between the ones the newest link sends (they were lost frames on that link).
-    imu_link: AtomicU64,
-    faults: Arc<LinkFaults>,
-    /// Drops already played.
-    fired: Mutex<Vec<bool>>,
-    open: AtomicUsize,
-    ranges: (f64, f64),
-}
-
-impl Session {
-    /// Session time, s.
-    fn now(&self) -> f64 {
-        self.start.elapsed().as_secs_f64()
-    }
-
-    /// Whether a drop of `link` is due now (each drop plays once).
-    fn take_drop(&self, link: LinkName, t: f64) -> bool {
-        let Ok(mut fired) = self.fired.lock() else {
-            return false;
-        };
-        for (i, d) in self.faults.drops.iter().enumerate() {
-            if d.link == link && t >= d.at && !fired[i] {
-                fired[i] = true;
-                return true;
-            }
-        }
-        false
-    }
+    /// Its session ended under it (a new client took over).
+    Ended,
 }
 
 /// The emulator: a station, a seed, and the session being served.
@@ -108,27 +71,37 @@ impl Emulator {
         }
     }
 
-    /// The current session (a new one if none), with one more link open.
-    fn join(&self) -> Arc<Session> {
+    /// A fresh session (the next number).
+    fn fresh(&self) -> Arc<Session> {
+        let mut n = self.sessions.lock().expect("emulator state");
+        *n += 1;
+        self.note(&format!("session {} starts", *n));
+        let imu = &self.station.imu;
+        Arc::new(Session::new(
+            *n,
+            crate::sim::build(&self.station, self.seed),
+            self.faults.clone(),
+            (imu.accel_range.0, imu.gyro_range.0),
+        ))
+    }
+
+    /// The session a new connection of `which` belongs to, with one more link open: the
+    /// current one if it admits the link (`session.rs`), else a fresh one, the current one
+    /// ended (its links closed).
+    fn join(&self, which: LinkName) -> Arc<Session> {
         let mut cur = self.current.lock().expect("emulator state");
+        if let Some(old) = cur.take_if(|s| !s.admits(which)) {
+            self.note(&format!(
+                "session {} ends at t = {:.3} s: a new client connected",
+                old.number,
+                old.now()
+            ));
+            old.end();
+        }
         let s = cur.get_or_insert_with(|| {
-            let mut n = self.sessions.lock().expect("emulator state");
-            *n += 1;
-            let (table, imu) = crate::sim::build(&self.station, self.seed);
-            let imu_spec = &self.station.imu;
-            self.note(&format!("session {} starts", *n));
-            Arc::new(Session {
-                number: *n,
-                start: Instant::now(),
-                table: tokio::sync::Mutex::new(table),
-                imu: tokio::sync::Mutex::new(imu),
-                counter: AtomicU32::new(0),
-                imu_link: AtomicU64::new(0),
-                faults: self.faults.clone(),
-                fired: Mutex::new(vec![false; self.faults.drops.len()]),
-                open: AtomicUsize::new(0),
-                ranges: (imu_spec.accel_range.0, imu_spec.gyro_range.0),
-            })
+            let s = self.fresh();
+            s.admits(which);
+            s
         });
         s.open.fetch_add(1, Ordering::SeqCst);
         s.clone()
@@ -157,9 +130,10 @@ impl Emulator {
 
     /// Serves one accepted link of `which` kind until it ends.
     async fn serve<S: AsyncRead + AsyncWrite + Unpin + Send>(&self, which: LinkName, stream: S) {
-        let s = self.join();
-        if self.faults.outage(which, s.now()) {
+        let s = self.join(which);
+        if let Some(until) = self.faults.outage(which, s.now()) {
             // Refused: the link is down for a while (a dropped connection that stays down).
+            s.disturb(which, until);
             self.leave(&s, End::Dropped);
             return;
         }
@@ -200,7 +174,7 @@ impl Emulator {
             // The emulator keeps the slave ends open, so that a client closing its end
             // does not end the terminal.
             let _keep = (table_slave, imu_slave);
-            let s = self.join();
+            let s = self.fresh();
             let me = self.clone();
             let s2 = s.clone();
             let t = tokio::spawn(async move {

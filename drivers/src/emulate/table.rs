@@ -15,17 +15,26 @@ pub(super) async fn serve<S: AsyncRead + AsyncWrite + Unpin>(stream: S, s: &Sess
     let mut reply = String::new();
     loop {
         line.clear();
-        match io.read_line(&mut line).await {
-            Ok(0) | Err(_) => return End::Client,
-            Ok(_) => {}
+        tokio::select! {
+            r = io.read_line(&mut line) => match r {
+                Ok(0) | Err(_) => return End::Client,
+                Ok(_) => {}
+            },
+            () = s.ended() => return End::Ended,
         }
         let t = s.now();
         if s.take_drop(LinkName::Table, t) {
             return End::Dropped;
         }
         if let Some(end) = s.faults.stall_end(LinkName::Table, t) {
-            // A stalled table answers late (after the stall), if the client still listens.
-            tokio::time::sleep_until(s.start + std::time::Duration::from_secs_f64(end)).await;
+            // A stalled table answers late (after the stall), if the client still listens;
+            // a client that gave up meanwhile reconnects within the session.
+            s.disturb(LinkName::Table, end);
+            let until = s.start + std::time::Duration::from_secs_f64(end);
+            tokio::select! {
+                () = tokio::time::sleep_until(until) => {}
+                () = s.ended() => return End::Ended,
+            }
         }
         reply.clear();
         answer(line.trim(), s, &mut reply).await;

@@ -226,6 +226,7 @@ impl<S: AsyncRead + AsyncWrite + Unpin + Send> LineTable<S> {
             outer_rate_dps: fields[3],
             inner_rate_dps: fields[4],
             ambient_c: fields.get(5).copied(),
+            t_host: None,
         })
     }
 }
@@ -264,7 +265,13 @@ impl<S: AsyncRead + AsyncWrite + Unpin + Send> TableDriver for LineTable<S> {
                     } else if let Some(rest) = line.strip_prefix("ERR ") {
                         return Err(instrument_error(rest));
                     } else if line.starts_with('F') {
-                        got.push(me.parse_feedback(&line)?);
+                        // Arrival: when the line came off the link (the lines of a reply
+                        // over a slow serial port arrive one by one).
+                        let host = me.start.elapsed().as_secs_f64();
+                        got.push(TableSample {
+                            t_host: Some(host),
+                            ..me.parse_feedback(&line)?
+                        });
                     } else {
                         return Err(transport(format!("unexpected reply `{line}` to `FEED?`")));
                     }

@@ -60,6 +60,7 @@ fn decode(f: &Frame<'_>) -> (u32, ImuSample) {
         accel: nan_if(FLAG_ACCEL_SATURATED, f.accel()),
         gyro: nan_if(FLAG_GYRO_SATURATED, f.gyro()),
         temp_c: f.temp_c(),
+        t_host: None,
     };
     (f.counter(), s)
 }
@@ -116,8 +117,10 @@ async fn pump(endpoint: Endpoint, timeout: Duration, shared: Arc<Mutex<Shared>>,
                     }
                 }
                 counter = Some(*c);
+                // Every frame of a read arrived with it: the read's instant is theirs.
                 samples.push(ImuSample {
                     t: clock.map(s.t),
+                    t_host: Some(host),
                     ..*s
                 });
             }

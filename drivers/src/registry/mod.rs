@@ -46,6 +46,9 @@ pub struct DriverKind {
     pub name: &'static str,
     /// Whether it is a simulation (runs on the paused clock) rather than a device.
     pub simulated: bool,
+    /// Whether its samples carry their host arrival time (`t_host`, a column of the
+    /// recording's streams).
+    pub host_arrival: bool,
     /// The settings it takes, each with whether it is required (none: written `driver:
     /// NAME`).
     pub keys: &'static [(&'static str, bool)],
@@ -68,6 +71,7 @@ pub const DRIVERS: &[DriverKind] = &[
     DriverKind {
         name: "sim",
         simulated: true,
+        host_arrival: false,
         keys: &[],
         table: Some(|c, _| Ok(Box::new(SimTable::new(c.station, c.world(), c.seed)))),
         imu: Some(sim_imu),
@@ -76,6 +80,7 @@ pub const DRIVERS: &[DriverKind] = &[
     DriverKind {
         name: "tcp",
         simulated: false,
+        host_arrival: true,
         keys: &[("address", true), ("timeout", false)],
         table: Some(link_table),
         imu: Some(framed_imu),
@@ -84,6 +89,7 @@ pub const DRIVERS: &[DriverKind] = &[
     DriverKind {
         name: "serial",
         simulated: false,
+        host_arrival: true,
         keys: &[("port", true), ("baud", false), ("timeout", false)],
         table: Some(link_table),
         imu: Some(framed_imu),
@@ -92,6 +98,7 @@ pub const DRIVERS: &[DriverKind] = &[
     DriverKind {
         name: "replay",
         simulated: false,
+        host_arrival: false,
         keys: &[("recording", true)],
         table: Some(|c, s| {
             let dir = required(s.recording.as_ref(), "recording")?;

@@ -187,6 +187,7 @@ impl SimImu {
                 accel: [0.0; 3],
                 gyro: [0.0; 3],
                 temp_c: None,
+                t_host: None,
             };
             for j in 0..3 {
                 let na: f64 = self.rng.sample(StandardNormal);
@@ -211,6 +212,7 @@ impl SimImu {
                     accel: [f64::NAN; 3],
                     gyro: [f64::NAN; 3],
                     temp_c: s.temp_c,
+                    t_host: None,
                 }),
                 Some(DropoutMode::Stuck) => {
                     let last = self.last_good.unwrap_or(s);

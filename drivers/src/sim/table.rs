@@ -173,6 +173,7 @@ impl TableDriver for SimTable {
                 ambient_c: self
                     .report_ambient
                     .then(|| self.temps.ambient(t) + self.ambient_noise * n()),
+                t_host: None,
             };
             out.push(sample);
             self.next_k += 1;

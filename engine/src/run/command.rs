@@ -229,6 +229,7 @@ mod tests {
             outer_rate_dps: wo,
             inner_rate_dps: wi,
             ambient_c: None,
+            t_host: None,
         }
     }
 

@@ -592,6 +592,8 @@ impl Exec<'_> {
         let first_imu = self.imu_samples == 0;
         self.imu_buf.retain_mut(|s| {
             s.t += shift;
+            // The host arrival time is on the clock of `t`: it moves with it.
+            s.t_host = s.t_host.map(|h| h + shift);
             let keep = (first_imu && s.t >= last) || s.t > last;
             if keep {
                 last = s.t;
@@ -602,6 +604,8 @@ impl Exec<'_> {
         let first_table = self.table_samples == 0;
         self.table_buf.retain_mut(|s| {
             s.t += shift;
+            // The host arrival time is on the clock of `t`: it moves with it.
+            s.t_host = s.t_host.map(|h| h + shift);
             let keep = (first_table && s.t >= last) || s.t > last;
             if keep {
                 last = s.t;

@@ -247,6 +247,7 @@ impl TableDriver for FakeTable {
                 outer_rate_dps: s.outer.rate,
                 inner_rate_dps: s.inner.rate,
                 ambient_c: Some(ambient),
+                t_host: None,
             });
         }
         if s.faults.table_fault_at.is_some_and(|f| now >= f) {
@@ -306,6 +307,7 @@ impl ImuDriver for FakeImu {
                     s.outer.rate * ph.sin() + wob,
                 ],
                 temp_c: Some(25.0),
+                t_host: None,
             };
             if s.faults.imu_stuck_at.is_some_and(|f| t >= f)
                 && let Some(last) = s.last_imu

@@ -32,6 +32,7 @@ pub fn record(st: &Station, plan: &Plan, seed: u64, dir: &Path) {
         let cols = Columns {
             imu_temp: true,
             ambient: true,
+            ..Columns::default()
         };
         let mut w = RecordingWriter::create(dir, m, cols).unwrap();
         let out = execute(

@@ -18,7 +18,7 @@ use std::fs::{File, OpenOptions};
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
-use streams::{IMU_HEADER, Stream, Streams, TABLE_HEADER};
+use streams::{Stream, Streams};
 
 /// What the interpreter's thread asks the writer thread.
 enum Msg {
@@ -119,16 +119,8 @@ impl RecordingWriter {
     /// Creates `dir` (if needed) and the recording's files; writes the manifest once.
     pub fn create(dir: &Path, manifest: Manifest, columns: Columns) -> io::Result<Self> {
         std::fs::create_dir_all(dir)?;
-        let mut imu_header = IMU_HEADER.to_string();
-        if columns.imu_temp {
-            imu_header.push_str(",temp");
-        }
-        let mut table_header = TABLE_HEADER.to_string();
-        if columns.ambient {
-            table_header.push_str(",ambient");
-        }
-        let imu = Stream::create(&dir.join("imu.csv"), &imu_header)?;
-        let table = Stream::create(&dir.join("table.csv"), &table_header)?;
+        let imu = Stream::create(&dir.join("imu.csv"), &columns.imu_header())?;
+        let table = Stream::create(&dir.join("table.csv"), &columns.table_header())?;
         let journal = File::create(dir.join("journal.jsonl"))?;
         let mut manifest = manifest;
         manifest.format = FORMAT.to_string();
@@ -157,10 +149,7 @@ impl RecordingWriter {
             .map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e.to_string()))?;
         let (imu, imu_header) = Stream::append(&dir.join("imu.csv"))?;
         let (table, table_header) = Stream::append(&dir.join("table.csv"))?;
-        let columns = Columns {
-            imu_temp: imu_header.split(',').any(|c| c == "temp"),
-            ambient: table_header.split(',').any(|c| c == "ambient"),
-        };
+        let columns = Columns::of_headers(&imu_header, &table_header);
         let journal = OpenOptions::new()
             .append(true)
             .create(true)

@@ -30,6 +30,56 @@ pub struct Columns {
     pub imu_temp: bool,
     /// `table.csv` has an `ambient` column.
     pub ambient: bool,
+    /// `imu.csv` has a `t_host` column (host arrival times: hardware links).
+    pub imu_t_host: bool,
+    /// `table.csv` has a `t_host` column.
+    pub table_t_host: bool,
+}
+
+impl Columns {
+    /// The header line of `imu.csv` (without the newline).
+    pub(crate) fn imu_header(&self) -> String {
+        let mut h = IMU_HEADER.to_string();
+        if self.imu_temp {
+            h.push_str(",temp");
+        }
+        if self.imu_t_host {
+            h.push_str(",t_host");
+        }
+        h
+    }
+
+    /// The header line of `table.csv` (without the newline).
+    pub(crate) fn table_header(&self) -> String {
+        let mut h = TABLE_HEADER.to_string();
+        if self.ambient {
+            h.push_str(",ambient");
+        }
+        if self.table_t_host {
+            h.push_str(",t_host");
+        }
+        h
+    }
+
+    /// The optional columns a pair of headers carries (a recording being continued).
+    pub(crate) fn of_headers(imu: &str, table: &str) -> Self {
+        let has = |h: &str, c: &str| h.split(',').any(|n| n.trim() == c);
+        Columns {
+            imu_temp: has(imu, "temp"),
+            ambient: has(table, "ambient"),
+            imu_t_host: has(imu, "t_host"),
+            table_t_host: has(table, "t_host"),
+        }
+    }
+}
+
+/// Appends a `t_host` cell: empty when a sample does not carry it (a column of host times
+/// is only asked for hardware links, which always stamp their samples).
+fn t_host_cell(l: &mut Line, t_host: Option<f64>) {
+    l.byte(b',');
+    if let Some(h) = t_host.filter(|h| h.is_finite()) {
+        l.fixed::<T_DEC>(h);
+    }
 }
 
 /// One CSV stream: an append-only file, a byte buffer, and the running hash of the file.
@@ -144,6 +194,9 @@ impl Streams {
                 l.byte(b',');
                 l.fixed::<TEMP_DEC>(s.temp_c.unwrap_or(f64::NAN));
             }
+            if self.columns.imu_t_host {
+                t_host_cell(&mut l, s.t_host);
+            }
             self.imu.buf.extend_from_slice(l.as_bytes());
             self.imu.end_row()?;
         }
@@ -175,6 +228,9 @@ impl Streams {
             if self.columns.ambient {
                 l.byte(b',');
                 l.fixed::<TEMP_DEC>(s.ambient_c.unwrap_or(f64::NAN));
+            }
+            if self.columns.table_t_host {
+                t_host_cell(&mut l, s.t_host);
             }
             self.table.buf.extend_from_slice(l.as_bytes());
             self.table.end_row()?;
