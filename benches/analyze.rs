@@ -3,7 +3,7 @@
 //! `target/analyze-bench-recording/` (also read by `benches/analyze_pandas.py`).
 //!
 //! `analyze/cli` is the figure: the whole `ratecal analyze` process from the command
-//! line. Beside it, when python3 with pandas, numpy and PyYAML is installed, the equivalent
+//! line (which reads the IMU stream a window at a time: `open+stream+json` in process). Beside it, when python3 with pandas, numpy and PyYAML is installed, the equivalent
 //! script `benches/analyze_pandas.py` is timed the same way (whole process) and the ratio
 //! printed.
 
@@ -72,6 +72,15 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             let rec = ratecal_engine::recording::read(&dir).unwrap();
             ratecal_engine::fit::analyze(&rec, None).to_json()
+        })
+    });
+    // What `ratecal analyze` does: the IMU stream read a window at a time.
+    g.bench_function("open+stream+json", |b| {
+        b.iter(|| {
+            let src = ratecal_engine::fit::Streamed::open(&dir).unwrap();
+            let opts = ratecal_engine::fit::Options::default();
+            let res = ratecal_engine::fit::analyze_source(&src, None, &opts).unwrap();
+            res.to_json()
         })
     });
     g.bench_function("cli", |b| b.iter(|| cli(&dir, &out)));

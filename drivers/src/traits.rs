@@ -146,6 +146,9 @@ pub struct LinkStats {
     pub latency_mean_s: f64,
     /// Largest delay, s.
     pub latency_max_s: f64,
+    /// Host time minus device time at the map's latest anchor, s: a sample's device stamp
+    /// is its host-clock `t` minus this (`None` before the first batch).
+    pub device_offset_s: Option<f64>,
 }
 
 /// A rate table.

@@ -240,6 +240,10 @@ pub struct LinkRecord {
     pub latency_mean_ms: f64,
     /// Largest delay, ms.
     pub latency_max_ms: f64,
+    /// Recording time minus device time, s: the device's own stamp of a sample is its `t`
+    /// minus this (the map's latest anchor; a device that restarts re-anchors it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub device_offset_s: Option<f64>,
 }
 
 /// Why and when a run aborted.

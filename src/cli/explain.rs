@@ -6,7 +6,8 @@
 
 use super::procedure;
 use ratecal_engine::explain::{self, AdoptTarget, NominalModel, Options, UserEffect};
-use ratecal_engine::{recording, render};
+use ratecal_engine::fit::{Source, Streamed};
+use ratecal_engine::render;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -117,7 +118,8 @@ fn adopt_target(arg: &Path) -> Option<AdoptTarget> {
 
 /// Runs the subcommand.
 pub fn main(args: Args) -> ExitCode {
-    let rec = match recording::read(&args.run) {
+    // The IMU stream is read a window at a time (`fit::Streamed`), as `analyze` reads it.
+    let rec = match Streamed::open(&args.run) {
         Ok(r) => r,
         Err(e) => {
             eprintln!("{:?}", miette::Report::new(e));
@@ -130,7 +132,9 @@ pub fn main(args: Args) -> ExitCode {
     let nominal = match &args.procedure {
         None => NominalModel::seed(),
         Some(p) => match super::analyze::load_plan(p, args.allow_changed) {
-            Ok((plan, _)) => NominalModel::from_plan(&plan, rec.manifest.station.site.latitude_deg),
+            Ok((plan, _)) => {
+                NominalModel::from_plan(&plan, rec.manifest().station.site.latitude_deg)
+            }
             Err(()) => return ExitCode::from(2),
         },
     };
@@ -140,7 +144,13 @@ pub fn main(args: Args) -> ExitCode {
         without: args.without.clone(),
         ..Options::default()
     };
-    let mut x = explain::explain(&rec, &nominal, &opts);
+    let mut x = match explain::explain_source(&rec, &nominal, &opts) {
+        Ok(x) => x,
+        Err(e) => {
+            eprintln!("{:?}", miette::Report::new(e));
+            return ExitCode::from(2);
+        }
+    };
     // Only the registry's effects can be declared in a procedure.
     let ids: Vec<String> = x
         .findings
@@ -175,7 +185,7 @@ pub fn main(args: Args) -> ExitCode {
             .filter_map(|(effect, svg)| Some((format!("explain-{effect}.svg"), svg?)))
             .collect();
     // Kept in a ratecal run folder (not in another system's recording): its report shows it.
-    let in_run = rec.manifest.run.is_some();
+    let in_run = rec.manifest().run.is_some();
     if in_run {
         let mut files = vec![("explain.json".to_string(), format!("{json}\n"))];
         files.extend(

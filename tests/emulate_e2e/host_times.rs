@@ -111,5 +111,37 @@ pub fn check(scenario: &str, manifest: &str, imu_csv: &str, table_csv: &str) -> 
     };
     let mut wrong = check_stream(scenario, "imu.csv", imu_csv, &imu);
     wrong.extend(check_stream(scenario, "table.csv", table_csv, &table));
+    wrong.extend(device_stamps(imu_csv, &imu));
+    wrong
+}
+
+/// The device's own stamps, `t - device_offset_s`: the emulated IMU stamps its frames on
+/// a clock that starts at zero with the session and ticks at its sample rate, so they are
+/// whole periods from zero (to 10 us: the CSV cells' resolution), the first within seconds of the start.
+fn device_stamps(imu_csv: &str, link: &LinkRecord) -> Vec<String> {
+    let Some(offset) = link.device_offset_s else {
+        return vec!["imu link: no device_offset_s in run.sync".into()];
+    };
+    let Ok(rows) = times("imu.csv", imu_csv) else {
+        return Vec::new(); // reported by check_stream
+    };
+    let device: Vec<f64> = rows.iter().map(|(t, _)| t - offset).collect();
+    let period = {
+        let mut d: Vec<f64> = device.windows(2).map(|w| w[1] - w[0]).collect();
+        d.sort_by(f64::total_cmp);
+        d[d.len() / 2]
+    };
+    let mut wrong = Vec::new();
+    if !(-1e-5..5.0).contains(&device[0]) {
+        wrong.push(format!("imu: first device stamp {} s", device[0]));
+    }
+    if let Some(t) = device
+        .iter()
+        .find(|t| ((*t / period) - (*t / period).round()).abs() * period > 1e-5)
+    {
+        wrong.push(format!(
+            "imu: device stamp {t} s is not a whole number of {period} s periods"
+        ));
+    }
     wrong
 }

@@ -23,6 +23,7 @@ impl ClockMap {
     pub fn arrival(&mut self, newest_s: f64, host_s: f64, samples: u64) {
         if self.offset.is_none() || newest_s < self.newest - 1.0 {
             self.offset = Some(host_s - newest_s);
+            self.stats.device_offset_s = self.offset;
         }
         self.newest = newest_s;
         let latency = host_s - self.map(newest_s);

@@ -1,8 +1,9 @@
 //! The recording accumulated once for every model explain will try: every segment, every
 //! registry effect's columns, and which segments are held out.
 
+use crate::fit::Source;
 use crate::fit::joint::{Layout, SegAcc, excitation};
-use crate::recording::{Recording, SegmentKind};
+use crate::recording::SegmentKind;
 use ratecal_physics::Effect;
 
 /// Accumulated segments and the split between fitted and held-out ones.
@@ -21,10 +22,13 @@ impl Data {
     /// Accumulates every segment (in parallel) over these effects (the registry's and user
     /// effects) and chooses the held-out ones: every third segment of each kind, never the
     /// longest static one.
-    pub(crate) fn with_effects(rec: &Recording, effects: Vec<&'static dyn Effect>) -> Data {
+    pub(crate) fn with_effects<S: Source>(
+        src: &S,
+        effects: Vec<&'static dyn Effect>,
+    ) -> Result<Data, S::Error> {
         let layout = Layout::new(effects);
-        let segs = &rec.manifest.segments;
-        let Ok(accs) = crate::fit::accumulate_all(rec, &layout);
+        let segs = &src.manifest().segments;
+        let accs = crate::fit::accumulate_all(src, &layout)?;
         let longest = accs
             .iter()
             .enumerate()
@@ -46,12 +50,12 @@ impl Data {
         }
         held.sort_unstable();
         let excitation: Vec<Vec<f64>> = accs.iter().map(|a| excitation(&layout, a)).collect();
-        Data {
+        Ok(Data {
             layout,
             accs,
             held,
             excitation,
-        }
+        })
     }
 
     /// The fitted (not held-out) accumulations.

@@ -6,7 +6,7 @@ use super::model::{Terms, fit};
 use super::output::{Located, SegmentRms};
 use super::select::Step;
 use crate::fit::joint::{CHANNELS, seg_rss};
-use crate::recording::Recording;
+use crate::recording::Manifest;
 
 /// Most entries reported per finding.
 const MOST: usize = 8;
@@ -14,8 +14,8 @@ const MOST: usize = 8;
 /// The segments and channels whose residual the effect reduced most, in units of the
 /// channel's noise (a reduction under 9, three standard deviations, is not listed unless
 /// nothing reaches it).
-pub(crate) fn locate(rec: &Recording, data: &Data, step: &Step) -> Vec<Located> {
-    let mut rows: Vec<(f64, Located)> = rows(rec, data, step)
+pub(crate) fn locate(m: &Manifest, data: &Data, step: &Step) -> Vec<Located> {
+    let mut rows: Vec<(f64, Located)> = rows(m, data, step)
         .into_iter()
         .filter(|r| r.0 > 0.0)
         .collect();
@@ -29,8 +29,8 @@ pub(crate) fn locate(rec: &Recording, data: &Data, step: &Step) -> Vec<Located> 
 
 /// Residual RMS before and after the step on every segment and channel with data, in
 /// recording order (the finding's figure).
-pub(crate) fn per_segment(rec: &Recording, data: &Data, step: &Step) -> Vec<SegmentRms> {
-    rows(rec, data, step)
+pub(crate) fn per_segment(m: &Manifest, data: &Data, step: &Step) -> Vec<SegmentRms> {
+    rows(m, data, step)
         .into_iter()
         .map(|(_, l)| SegmentRms {
             segment: l.segment,
@@ -44,7 +44,7 @@ pub(crate) fn per_segment(rec: &Recording, data: &Data, step: &Step) -> Vec<Segm
 
 /// Every segment and channel with data: the residual sum of squares the step removed, in
 /// units of the channel's noise variance, and the entry.
-fn rows(rec: &Recording, data: &Data, step: &Step) -> Vec<(f64, Located)> {
+fn rows(m: &Manifest, data: &Data, step: &Step) -> Vec<(f64, Located)> {
     let fx = data.layout.effects[step.effect];
     let mut rows = Vec::new();
     for (i, acc) in data.accs.iter().enumerate() {
@@ -55,7 +55,7 @@ fn rows(rec: &Recording, data: &Data, step: &Step) -> Vec<(f64, Located)> {
             }
             let before = seg_rss(acc, &data.layout, c, &step.before.theta);
             let after = seg_rss(acc, &data.layout, c, &step.after.theta);
-            let seg = &rec.manifest.segments[acc.seg];
+            let seg = &m.segments[acc.seg];
             rows.push((
                 (before - after) / (sig * sig),
                 Located {

@@ -29,8 +29,9 @@ pub use output::{
 pub use text::render_text;
 pub use user::UserEffect;
 
+use crate::fit::Source;
 use crate::fit::joint::Fit;
-use crate::recording::Recording;
+use crate::recording::{Manifest, Recording};
 use data::Data;
 use model::{Terms, fit, rms, seed_segments};
 use ratecal_physics::{Effect, REGISTRY};
@@ -60,12 +61,24 @@ impl Default for Options {
     }
 }
 
-/// Explains a recording against a nominal model.
+/// Explains a recording held in memory against a nominal model.
 pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Explanation {
+    let Ok(x) = explain_source(rec, nominal, opts);
+    x
+}
+
+/// Explains a recording read from `src` a window of samples at a time; fails only when a
+/// span of the recording cannot be read.
+pub fn explain_source<S: Source>(
+    src: &S,
+    nominal: &NominalModel,
+    opts: &Options,
+) -> Result<Explanation, S::Error> {
     let mut effects: Vec<&'static dyn Effect> = REGISTRY.to_vec();
     effects.extend(opts.user.iter().map(|u| *u as &'static dyn Effect));
     let nonfinite: Vec<usize> = opts.user.iter().map(|u| u.nonfinite()).collect();
-    let data = Data::with_effects(rec, effects);
+    let data = Data::with_effects(src, effects)?;
+    let m = src.manifest();
     let lay = &data.layout;
     let mut warnings = Vec::new();
     for (u, before) in opts.user.iter().zip(nonfinite) {
@@ -94,7 +107,7 @@ pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Expla
         skip: Vec::new(),
     };
     let all: Vec<usize> = (0..data.accs.len()).collect();
-    let (sa, sg) = seed_segments(rec, &data);
+    let (sa, sg) = seed_segments(m, &data);
     if sa.is_empty() || sg.is_empty() {
         warnings.push(
             "the recording lacks static or rate segments: the nominal model is fitted on every segment"
@@ -131,7 +144,7 @@ pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Expla
     let findings: Vec<Finding> = steps
         .iter()
         .map(|step| {
-            let mut f = finding(rec, &data, step, &terms, &whole);
+            let mut f = finding(m, &data, step, &terms, &whole);
             f.defined_in = opts
                 .user
                 .iter()
@@ -160,7 +173,7 @@ pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Expla
         .map(|f| f.effect.as_str())
         .collect();
     let adopt = (!ids.is_empty()).then(|| format!("with {}", ids.join(", ")));
-    Explanation {
+    Ok(Explanation {
         format: FORMAT.into(),
         recording: opts.path.clone(),
         nominal: nominal_out,
@@ -169,7 +182,7 @@ pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Expla
         held_out: data
             .held
             .iter()
-            .map(|&i| rec.manifest.segments[data.accs[i].seg].id.clone())
+            .map(|&i| m.segments[data.accs[i].seg].id.clone())
             .collect(),
         rejected,
         adopt,
@@ -183,13 +196,13 @@ pub fn explain(rec: &Recording, nominal: &NominalModel, opts: &Options) -> Expla
             })
             .collect(),
         warnings,
-    }
+    })
 }
 
 /// One accepted step as a finding, its parameters from the final model fitted on every
 /// segment (`whole`: the fit and its unobservable columns).
 fn finding(
-    rec: &Recording,
+    m: &Manifest,
     data: &Data,
     step: &select::Step,
     terms: &Terms,
@@ -238,8 +251,8 @@ fn finding(
     Finding {
         effect: fx.id().into(),
         explanation: fx.explanation().into(),
-        located: locate::locate(rec, data, step),
-        residuals: locate::per_segment(rec, data, step),
+        located: locate::locate(m, data, step),
+        residuals: locate::per_segment(m, data, step),
         parameters,
         evidence,
         rms_after: rms(data, &step.after, &all),

@@ -5,7 +5,7 @@ use super::data::Data;
 pub(crate) use crate::fit::joint::Terms;
 use crate::fit::joint::{Fit, fit_terms, latitude_of, rss_on};
 use crate::plan::Plan;
-use crate::recording::{Recording, SegmentKind};
+use crate::recording::{Manifest, SegmentKind};
 use ratecal_physics::effects::EarthRate;
 
 /// The model a recording is compared with before anything is added.
@@ -111,8 +111,8 @@ pub(crate) fn rms(data: &Data, fit: &Fit, segs: &[usize]) -> super::Rms {
 
 /// The seed model's segments: static ones for the accelerometers; the longest static one
 /// and the rate segments for the gyros.
-pub(crate) fn seed_segments(rec: &Recording, data: &Data) -> (Vec<usize>, Vec<usize>) {
-    let kind = |i: usize| rec.manifest.segments[data.accs[i].seg].kind;
+pub(crate) fn seed_segments(m: &Manifest, data: &Data) -> (Vec<usize>, Vec<usize>) {
+    let kind = |i: usize| m.segments[data.accs[i].seg].kind;
     let all = 0..data.accs.len();
     let accel: Vec<usize> = all
         .clone()

@@ -390,7 +390,7 @@ impl Window<'_> {
                         .collect()
                 };
                 rayon::join(
-                    || prep::flag_window(|k| resid(k), rule, &core, &mut keep_a),
+                    || prep::flag_window(resid, rule, &core, &mut keep_a),
                     || prep::flag_window(|k| resid(3 + k), rule, &core, &mut keep_g),
                 );
             }

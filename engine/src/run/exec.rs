@@ -117,7 +117,8 @@ pub async fn execute(
     ex.journal(JournalEvent::End {
         status: status.as_str().into(),
     });
-    let sync = super::links::sync_record(ex.table.link_stats(), ex.imu.link_stats());
+    let shift = ex.t0.map_or(0.0, |t0| ex.opts.t_offset - t0);
+    let sync = super::links::sync_record(ex.table.link_stats(), ex.imu.link_stats(), shift);
     if let Some(s) = &sync {
         ex.sink.links(s);
     }
