@@ -115,8 +115,9 @@ pub fn analyze_source<S: Source>(
     let thermal = sel.temp_requested && src.has_temp();
     let design = models::Design::new(&sel, &declared, thermal, &mut out);
     let rate_hz = mean_rate(src);
+    // The temperature the thermal terms refer to: the recording's mean.
     let t_ref_c = if design.uses_temperature() {
-        mean_temperature(src, rate_hz, opts.window_rows)?
+        src.mean_temp()?
     } else {
         0.0
     };
@@ -270,7 +271,7 @@ pub(crate) fn accumulate_all<S: Source>(src: &S, layout: &Layout) -> Result<Vec<
     let geos = prep::geometries(m);
     let rate_hz = mean_rate(src);
     let t_ref_c = if layout.effects.iter().any(|e| e.uses_temperature()) {
-        mean_temperature(src, rate_hz, segment::WINDOW_ROWS)?
+        src.mean_temp()?
     } else {
         0.0
     };
@@ -312,29 +313,6 @@ fn mean_rate<S: Source>(src: &S) -> f64 {
     } else {
         1.0
     }
-}
-
-/// The IMU temperature the thermal terms refer to: the recording's mean, read a window at
-/// a time.
-fn mean_temperature<S: Source>(src: &S, rate_hz: f64, rows: usize) -> Result<f64, S::Error> {
-    let (t0, t1) = src.imu_extent();
-    let span = rows.max(1) as f64 / rate_hz;
-    let k = (((t1 - t0) / span).ceil() as usize).max(1);
-    let (mut sum, mut n) = (0.0, 0usize);
-    for i in 0..k {
-        let at = |i: usize| t0 + (t1 - t0) * i as f64 / k as f64;
-        let (a, b, last) = (at(i), at(i + 1), i + 1 == k);
-        src.rows(a, if last { t1 } else { b }, |v| {
-            let Some(temp) = v.temp else { return };
-            for (t, x) in v.t.iter().zip(temp) {
-                if (last || *t < b) && x.is_finite() {
-                    sum += x;
-                    n += 1;
-                }
-            }
-        })?;
-    }
-    Ok(if n == 0 { 0.0 } else { sum / n as f64 })
 }
 
 /// Residuals on the segments a sensor's fit did not use (the accelerometers on the rate

@@ -345,12 +345,14 @@ impl Window<'_> {
         // Signals at every stamp (one set at rest), with the synchronisation seen.
         let mut sigs: Vec<Signals> = Vec::new();
         let constant = kin.rest;
+        // Synchronisation and mean angles are reported for the prepared segments only.
+        let prepared = self.job.prep.is_some();
         if let Some(&t0) = v.t.first() {
             kin.seek(t0);
         }
         for (i, &t) in v.t.iter().enumerate() {
             let (j, w) = kin.advance(t);
-            if (ca..cb).contains(&i) {
+            if prepared && (ca..cb).contains(&i) {
                 self.see_sync(kin.tab, j, w, t);
             }
             if constant.is_none() {

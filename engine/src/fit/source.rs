@@ -47,6 +47,8 @@ pub trait Source: Sync {
     fn imu_extent(&self) -> (f64, f64);
     /// Whether the IMU stream has the temperature column.
     fn has_temp(&self) -> bool;
+    /// The mean of its finite temperatures over every row, degC (0 without any).
+    fn mean_temp(&self) -> Result<f64, Self::Error>;
     /// Hands `f` the IMU rows with `t0 <= t <= t1`.
     fn rows<R>(&self, t0: f64, t1: f64, f: impl FnOnce(ImuView<'_>) -> R)
     -> Result<R, Self::Error>;
@@ -80,6 +82,17 @@ impl Source for Recording {
 
     fn has_temp(&self) -> bool {
         self.imu.temp.is_some()
+    }
+
+    fn mean_temp(&self) -> Result<f64, Infallible> {
+        let (s, n) = self
+            .imu
+            .temp
+            .iter()
+            .flatten()
+            .filter(|x| x.is_finite())
+            .fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
+        Ok(if n == 0 { 0.0 } else { s / n as f64 })
     }
 
     fn rows<R>(&self, t0: f64, t1: f64, f: impl FnOnce(ImuView<'_>) -> R) -> Result<R, Infallible> {
@@ -132,6 +145,10 @@ impl Source for Streamed {
 
     fn has_temp(&self) -> bool {
         self.open.imu_has_temp()
+    }
+
+    fn mean_temp(&self) -> Result<f64, RecordingError> {
+        Ok(self.open.imu_mean_temp()?.unwrap_or(0.0))
     }
 
     fn rows<R>(

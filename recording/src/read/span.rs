@@ -9,7 +9,7 @@ use super::check;
 use super::check::Extent;
 use super::csvread::read_rows;
 use super::index::{StreamIndex, Times};
-use super::scan::{self, MAX_SLOTS, RowSink};
+use super::scan::{self, Layout, MAX_SLOTS, RowSink, SKIP};
 use super::stream::Stream;
 use super::{io_error, read_manifest, read_stream};
 use crate::error::RecordingError;
@@ -120,6 +120,73 @@ impl OpenRecording {
     /// Whether `imu.csv` has the optional `temp` column.
     pub fn imu_has_temp(&self) -> bool {
         self.imu.optional
+    }
+
+    /// The mean of the IMU's finite `temp` cells over every row (`None` without the
+    /// column or a finite cell): one pass that parses that cell of each line alone.
+    pub fn imu_mean_temp(&self) -> Result<Option<f64>, RecordingError> {
+        if !self.imu.optional {
+            return Ok(None);
+        }
+        let slot = ImuStream::REQUIRED.len();
+        let mut sum = TempSum { slot, s: 0.0, n: 0 };
+        if let Some(full) = &self.imu.fast {
+            let want = full.want.iter();
+            let layout = Layout {
+                want: want.map(|&w| if w == slot { slot } else { SKIP }).collect(),
+                data_start: full.data_start,
+                lazy_tail: true,
+            };
+            // Two halves side by side (a range owns the lines that start in it).
+            let (from, to) = (self.imu.head_end, self.imu.len);
+            let mid = from + (to - from) / 2;
+            let path = &self.imu.path;
+            let mut second = TempSum { slot, s: 0.0, n: 0 };
+            let (a, b) = std::thread::scope(|sc| {
+                let h = sc.spawn(|| scan::scan_range(path, &layout, mid, to, &mut second));
+                let a = scan::scan_range(path, &layout, from, mid, &mut sum);
+                (a, h.join().expect("scan thread"))
+            });
+            if a.is_ok() && b.is_ok() {
+                sum.s += second.s;
+                sum.n += second.n;
+                return Ok(sum.mean());
+            }
+            sum = TempSum { slot, s: 0.0, n: 0 };
+        }
+        // The exact reader, whole (it locates a bad cell).
+        let all = self.read_imu_span(f64::NEG_INFINITY, f64::INFINITY)?;
+        for v in all.temp.iter().flatten() {
+            sum.add(*v);
+        }
+        Ok(sum.mean())
+    }
+}
+
+/// Sums the finite temperatures the range parser hands over.
+struct TempSum {
+    slot: usize,
+    s: f64,
+    n: usize,
+}
+
+impl TempSum {
+    fn add(&mut self, v: f64) {
+        if v.is_finite() {
+            self.s += v;
+            self.n += 1;
+        }
+    }
+
+    fn mean(&self) -> Option<f64> {
+        (self.n > 0).then(|| self.s / self.n as f64)
+    }
+}
+
+impl RowSink for TempSum {
+    #[inline]
+    fn push(&mut self, r: &[f64; MAX_SLOTS]) {
+        self.add(r[self.slot]);
     }
 }
 
