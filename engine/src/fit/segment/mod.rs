@@ -10,14 +10,20 @@
 //! a segment of several windows reads each window with a margin on both sides, so that the
 //! filter's start-up is spent outside the rows it keeps.
 
+mod kin;
+mod stats;
+
+pub(crate) use stats::ChannelStats;
+
 use super::joint::{Accumulator, Layout, SegAcc};
 use super::prep::{self, PrepOptions};
 use super::source::{ImuView, Source};
-use super::stats::{Inflation, median_step};
-use crate::recording::{Segment, SegmentKind, TableStream};
+use super::stats::median_step;
+use crate::recording::{Segment, TableStream};
 use crate::results::SyncReport;
+use kin::Kin;
+use ratecal_physics::Geometry;
 use ratecal_physics::effects::Signals;
-use ratecal_physics::{AxisMotion, DEG, Geometry, Site, TableState};
 use std::borrow::Cow;
 
 /// Rows per window of a static segment by default: 87 minutes at 100 Hz, 8.7 at 1 kHz.
@@ -50,63 +56,6 @@ pub(crate) struct Job<'a> {
     pub window_rows: usize,
 }
 
-/// Means and spread of one output channel against its reference over kept samples.
-#[derive(Debug, Clone, Default)]
-pub(crate) struct ChannelStats {
-    /// Kept samples.
-    pub n: usize,
-    /// Sum of the outputs.
-    pub sum_out: f64,
-    /// Sum of the references.
-    pub sum_ref: f64,
-    /// Mean and sum of squared deviations of `out - ref` (merged by Chan's rule).
-    pub mean_d: f64,
-    /// Sum of squared deviations of `out - ref`.
-    pub m2_d: f64,
-    /// Correlation of `out - ref` (batch means).
-    pub inflation: Inflation,
-}
-
-impl ChannelStats {
-    fn add_window(&mut self, out: &[f64], refs: &[f64], keep: &[bool]) {
-        let d: Vec<f64> = out.iter().zip(refs).map(|(o, r)| o - r).collect();
-        let (mut n, mut so, mut sr, mut sd) = (0usize, 0.0, 0.0, 0.0);
-        for i in 0..d.len() {
-            if keep[i] {
-                n += 1;
-                so += out[i];
-                sr += refs[i];
-                sd += d[i];
-            }
-        }
-        if n == 0 {
-            return;
-        }
-        let m = sd / n as f64;
-        let m2: f64 = (0..d.len())
-            .filter(|&i| keep[i])
-            .map(|i| (d[i] - m).powi(2))
-            .sum();
-        let (na, nb) = (self.n as f64, n as f64);
-        let delta = m - self.mean_d;
-        self.m2_d += m2 + delta * delta * na * nb / (na + nb);
-        self.mean_d += delta * nb / (na + nb);
-        self.n += n;
-        self.sum_out += so;
-        self.sum_ref += sr;
-        self.inflation.add(&d, keep);
-    }
-
-    /// Sample standard deviation of `out - ref`.
-    pub(crate) fn std_d(&self) -> f64 {
-        if self.n < 2 {
-            0.0
-        } else {
-            (self.m2_d / (self.n - 1) as f64).sqrt()
-        }
-    }
-}
-
 /// What is left of a segment once its rows have passed.
 #[derive(Debug, Clone)]
 pub(crate) struct Summary {
@@ -132,114 +81,6 @@ pub(crate) struct Summary {
     pub channels: [ChannelStats; 6],
     /// The kept gyro outputs per axis, in order (the Allan block only).
     pub allan: Option<[Vec<f64>; 3]>,
-}
-
-/// The kinematic signals of one segment at any stamp, the feedback cursor kept between
-/// calls (stamps come in order).
-struct Kin<'a> {
-    tab: &'a TableStream,
-    geo: &'a Geometry,
-    site: Site,
-    /// At rest with known angles: the one set of signals.
-    rest: Option<Signals>,
-    /// At rest without feedback inside: rates and accelerations are zero.
-    still: bool,
-    /// A rate segment's steady rates, rad/s.
-    steady: Option<(f64, f64)>,
-    j: usize,
-}
-
-impl<'a> Kin<'a> {
-    fn new(tab: &'a TableStream, seg: &Segment, geo: &'a Geometry, site: Site) -> Self {
-        let still = seg.kind == SegmentKind::Static;
-        let rest = still
-            .then(|| prep::rest_angles(tab, seg.t_start, seg.t_end))
-            .flatten()
-            .map(|(o, i)| {
-                let at = |angle: f64| AxisMotion {
-                    angle: angle * DEG,
-                    rate: 0.0,
-                    accel: 0.0,
-                };
-                let state = TableState {
-                    outer: at(o),
-                    inner: at(i),
-                };
-                Signals::new(&state.snapshot(geo, &site), &site, 0.0)
-            });
-        let steady = (seg.kind == SegmentKind::Rate).then(|| {
-            let (o, i) = prep::steady_rates(tab, seg.t_start, seg.t_end);
-            (o * DEG, i * DEG)
-        });
-        let mut kin = Kin {
-            tab,
-            geo,
-            site,
-            rest,
-            still,
-            steady,
-            j: 0,
-        };
-        kin.seek(seg.t_start);
-        kin
-    }
-
-    /// Puts the cursor at the feedback step holding `t` (a window's first stamp: a window
-    /// read with a margin starts before where the last one ended).
-    fn seek(&mut self, t: f64) {
-        self.j = self.tab.t.partition_point(|&x| x <= t).saturating_sub(1);
-    }
-
-    /// Moves the cursor to the feedback step holding `t`; the step `j..j + 1` and the
-    /// fraction of it.
-    fn advance(&mut self, t: f64) -> (usize, f64) {
-        let tab = &self.tab.t;
-        let last = tab.len().saturating_sub(2);
-        while self.j < last && tab[self.j + 1] <= t {
-            self.j += 1;
-        }
-        let j = self.j.min(last);
-        let w = ((t - tab[j]) / (tab[j + 1] - tab[j])).clamp(0.0, 1.0);
-        (j, w)
-    }
-
-    /// Signals at step `j`, fraction `w` (temperature offset zero, stamp `t`).
-    fn signals(&self, j: usize, w: f64, t: f64) -> Signals {
-        if let Some(s) = self.rest {
-            return s.at(t);
-        }
-        let tab = self.tab;
-        let (t0, t1) = (tab.t[j], tab.t[j + 1]);
-        let lerp = |x: &[f64]| x[j] + w * (x[j + 1] - x[j]);
-        let angle = |x: &[f64]| x[j] + w * prep::unwrap(x[j + 1] - x[j]);
-        let slope = |x: &[f64]| (x[j + 1] - x[j]) / (t1 - t0);
-        let mut state = TableState {
-            outer: AxisMotion {
-                angle: angle(&tab.outer) * DEG,
-                rate: lerp(&tab.outer_rate) * DEG,
-                accel: slope(&tab.outer_rate) * DEG,
-            },
-            inner: AxisMotion {
-                angle: angle(&tab.inner) * DEG,
-                rate: lerp(&tab.inner_rate) * DEG,
-                accel: slope(&tab.inner_rate) * DEG,
-            },
-        };
-        // At rest or turning steadily, the feedback's rate ripple is the table's
-        // measurement noise, not motion the IMU felt: rates are zero or the steady ones.
-        let fixed = if self.still {
-            Some((0.0, 0.0))
-        } else {
-            self.steady
-        };
-        if let Some((o, i)) = fixed {
-            state.outer.rate = o;
-            state.inner.rate = i;
-            state.outer.accel = 0.0;
-            state.inner.accel = 0.0;
-        }
-        Signals::new(&state.snapshot(self.geo, &self.site), &self.site, 0.0).at(t)
-    }
 }
 
 /// Runs the pass over one segment.

@@ -1,0 +1,60 @@
+//! The sums a verification segment keeps of each output channel against its reference.
+
+use crate::fit::stats::Inflation;
+
+/// Means and spread of one output channel against its reference over kept samples.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct ChannelStats {
+    /// Kept samples.
+    pub n: usize,
+    /// Sum of the outputs.
+    pub sum_out: f64,
+    /// Sum of the references.
+    pub sum_ref: f64,
+    /// Mean and sum of squared deviations of `out - ref` (merged by Chan's rule).
+    pub mean_d: f64,
+    /// Sum of squared deviations of `out - ref`.
+    pub m2_d: f64,
+    /// Correlation of `out - ref` (batch means).
+    pub inflation: Inflation,
+}
+
+impl ChannelStats {
+    pub(super) fn add_window(&mut self, out: &[f64], refs: &[f64], keep: &[bool]) {
+        let d: Vec<f64> = out.iter().zip(refs).map(|(o, r)| o - r).collect();
+        let (mut n, mut so, mut sr, mut sd) = (0usize, 0.0, 0.0, 0.0);
+        for i in 0..d.len() {
+            if keep[i] {
+                n += 1;
+                so += out[i];
+                sr += refs[i];
+                sd += d[i];
+            }
+        }
+        if n == 0 {
+            return;
+        }
+        let m = sd / n as f64;
+        let m2: f64 = (0..d.len())
+            .filter(|&i| keep[i])
+            .map(|i| (d[i] - m).powi(2))
+            .sum();
+        let (na, nb) = (self.n as f64, n as f64);
+        let delta = m - self.mean_d;
+        self.m2_d += m2 + delta * delta * na * nb / (na + nb);
+        self.mean_d += delta * nb / (na + nb);
+        self.n += n;
+        self.sum_out += so;
+        self.sum_ref += sr;
+        self.inflation.add(&d, keep);
+    }
+
+    /// Sample standard deviation of `out - ref`.
+    pub(crate) fn std_d(&self) -> f64 {
+        if self.n < 2 {
+            0.0
+        } else {
+            (self.m2_d / (self.n - 1) as f64).sqrt()
+        }
+    }
+}
