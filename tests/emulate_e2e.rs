@@ -201,6 +201,7 @@ fn station_check_against_the_emulator() {
                 "table_minus_imu_s",
                 "imu link: ",
                 "Table-to-IMU sync",
+                "behind the run clock (device stamp = t - this)",
                 "no lost frames",
                 "host times",
             ],

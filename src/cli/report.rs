@@ -188,10 +188,10 @@ pub fn read_run(dir: &Path) -> miette::Result<ReportInput> {
     };
     // The temperature plot is a nicety: a recording whose streams cannot be read still
     // gets its report, from results.json alone.
-    let temperature = match ratecal_engine::recording::read(dir) {
-        Ok(rec) => TemperatureSeries::from_recording(&rec),
-        Err(_) => TemperatureSeries::default(),
-    };
+    let temperature = ratecal_engine::fit::Streamed::open(dir)
+        .ok()
+        .and_then(|rec| TemperatureSeries::from_source(&rec).ok())
+        .unwrap_or_default();
     // `ratecal explain` keeps its findings beside the run: the report gains a section.
     let explain = std::fs::read_to_string(dir.join("explain.json"))
         .ok()

@@ -24,6 +24,7 @@ mod stats;
 
 pub use allan::overlapping_adev;
 pub use repeat::analyze_runs;
+pub use segment::WINDOW_ROWS;
 pub use source::{ImuView, Source, Streamed};
 
 use crate::plan::{Outliers, Plan};

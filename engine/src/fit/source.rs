@@ -22,6 +22,16 @@ pub struct ImuView<'a> {
 }
 
 impl<'a> ImuView<'a> {
+    /// The first `n` rows of a view.
+    fn of_view(v: &ImuView<'a>, n: usize) -> Self {
+        ImuView {
+            t: &v.t[..n],
+            accel: v.accel.map(|x| &x[..n]),
+            gyro: v.gyro.map(|x| &x[..n]),
+            temp: v.temp.map(|x| &x[..n]),
+        }
+    }
+
     /// Rows `a..b` of a stream.
     pub fn of(s: &'a crate::recording::ImuStream, a: usize, b: usize) -> Self {
         ImuView {
@@ -55,6 +65,32 @@ pub trait Source: Sync {
     /// The whole recording in memory: for the analyses that navigate the raw stream (the
     /// size effect's cycles, from the static blocks before them).
     fn recording(&self) -> Result<Cow<'_, Recording>, Self::Error>;
+
+    /// Hands `f` every IMU row once, in order, a window of about `rows` rows at a time.
+    fn windows(&self, rows: usize, mut f: impl FnMut(ImuView<'_>)) -> Result<(), Self::Error>
+    where
+        Self: Sized,
+    {
+        let (n, (t0, t1)) = (self.imu_rows(), self.imu_extent());
+        if n == 0 {
+            return Ok(());
+        }
+        let k = n.div_ceil(rows.max(1)).max(1);
+        let at = |i: usize| t0 + (t1 - t0) * i as f64 / k as f64;
+        for i in 0..k {
+            let (a, b, last) = (at(i), at(i + 1), i + 1 == k);
+            self.rows(a, if last { t1 } else { b }, |v| {
+                // A window owns the rows before its end (the last one, its end too).
+                let own = if last {
+                    v.t.len()
+                } else {
+                    v.t.partition_point(|&t| t < b)
+                };
+                f(ImuView::of_view(&v, own));
+            })?;
+        }
+        Ok(())
+    }
 }
 
 impl Source for Recording {

@@ -28,6 +28,7 @@ pub use context::CONTEXT_FORMAT;
 pub use error::{RenderError, TemplateError};
 pub use finding::explain_figures;
 
+use crate::fit::Source;
 use crate::plan::Plan;
 use minijinja::{Environment, UndefinedBehavior, Value};
 use std::collections::BTreeMap;
@@ -61,16 +62,14 @@ impl ReportInput {
         results: &crate::results::Results,
         manifest: &crate::recording::Manifest,
         plan: Option<&Plan>,
-        recording: Option<&crate::recording::Recording>,
+        temperature: TemperatureSeries,
         ratecal_version: &str,
     ) -> Self {
         ReportInput {
             results: serde_json::to_value(results).unwrap_or_default(),
             manifest: serde_json::to_value(manifest).ok(),
             plan: plan.cloned(),
-            temperature: recording
-                .map(TemperatureSeries::from_recording)
-                .unwrap_or_default(),
+            temperature,
             ratecal_version: ratecal_version.to_string(),
             explain: None,
             archive_trend: None,
@@ -85,25 +84,39 @@ impl TemperatureSeries {
     /// The IMU `temp` column and the table's `ambient` column, thinned to at most
     /// [`TEMPERATURE_POINTS`] each.
     pub fn from_recording(rec: &crate::recording::Recording) -> Self {
-        let thin = |t: &[f64], v: &[f64]| -> Vec<(f64, f64)> {
-            let n = t.len().min(v.len());
-            let step = n.div_ceil(TEMPERATURE_POINTS).max(1);
-            (0..n).step_by(step).map(|i| (t[i], v[i])).collect()
-        };
-        TemperatureSeries {
-            imu: rec
-                .imu
-                .temp
-                .as_deref()
-                .map(|v| thin(&rec.imu.t, v))
-                .unwrap_or_default(),
-            ambient: rec
-                .table
-                .ambient
-                .as_deref()
-                .map(|v| thin(&rec.table.t, v))
-                .unwrap_or_default(),
+        let Ok(series) = Self::from_source(rec);
+        series
+    }
+
+    /// The same from a recording read a window at a time (every row's `temp` is seen
+    /// once; the kept ones are every n-th of the whole stream, as in memory).
+    pub fn from_source<S: Source>(src: &S) -> Result<Self, S::Error> {
+        let step = |n: usize| n.div_ceil(TEMPERATURE_POINTS).max(1);
+        let every = step(src.imu_rows());
+        let mut imu = Vec::new();
+        let mut row = 0usize;
+        if src.has_temp() {
+            src.windows(crate::fit::WINDOW_ROWS, |v| {
+                if let Some(temp) = v.temp {
+                    for (t, c) in v.t.iter().zip(temp) {
+                        if row.is_multiple_of(every) {
+                            imu.push((*t, *c));
+                        }
+                        row += 1;
+                    }
+                }
+            })?;
         }
+        let tab = src.table();
+        let ambient = tab
+            .ambient
+            .as_deref()
+            .map(|v| {
+                let n = tab.t.len().min(v.len());
+                (0..n).step_by(step(n)).map(|i| (tab.t[i], v[i])).collect()
+            })
+            .unwrap_or_default();
+        Ok(TemperatureSeries { imu, ambient })
     }
 }
 

@@ -1,6 +1,7 @@
-//! A recording read by time span: [`Recording::open`] reads the manifest and indexes both
-//! streams by time; [`OpenRecording::read_span`] parses only the blocks that hold a span,
-//! so a long 1 kHz recording is analysed segment by segment in bounded memory.
+//! A recording read by time span: [`Recording::open`] reads the manifest and the table
+//! feedback, and indexes the IMU stream by time; [`OpenRecording::read_span`] parses only
+//! the blocks that hold a span, so a long 1 kHz recording is analysed segment by segment in
+//! bounded memory.
 
 // A refused recording is built once per read: the error's size costs nothing.
 #![allow(clippy::result_large_err)]

@@ -129,15 +129,19 @@ pub fn journal_warnings(dir: &Path) -> Vec<String> {
 /// Analyses the recording kept (complete or not), writes results.json, plan.json and the
 /// reports; the verdict, or `None` when the recording could not be analysed.
 fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict> {
-    let rec = match ratecal_engine::recording::read(dir) {
-        Ok(r) => r,
-        Err(e) => {
-            errln!("{:?}", Report::new(e));
-            errln!("no analysis: the recording cannot be read back");
-            return None;
-        }
+    use ratecal_engine::fit::{Options, Source, Streamed, analyze_source};
+    // The recording is read back a window at a time, as `ratecal analyze` reads it.
+    let unreadable = |e| {
+        errln!("{:?}", Report::new(e));
+        errln!("no analysis: the recording cannot be read back");
     };
-    let mut results = ratecal_engine::fit::analyze(&rec, Some(plan));
+    let rec = Streamed::open(dir).map_err(unreadable).ok()?;
+    let mut results = analyze_source(&rec, Some(plan), &Options::default())
+        .map_err(unreadable)
+        .ok()?;
+    let temperature = ratecal_engine::render::TemperatureSeries::from_source(&rec)
+        .map_err(unreadable)
+        .ok()?;
     let run_warnings = journal_warnings(dir);
     results.warnings.splice(0..0, run_warnings);
     if let Err(e) = std::fs::write(dir.join("results.json"), results.to_json()) {
@@ -169,9 +173,9 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
     }
     let mut input = ratecal_engine::render::ReportInput::from_run(
         &results,
-        &rec.manifest,
+        rec.manifest(),
         Some(plan),
-        Some(&rec),
+        temperature,
         env!("CARGO_PKG_VERSION"),
     );
     let serial = crate::cli::report::serial_of(&input);

@@ -27,7 +27,7 @@ use ratecal_physics::effects::Signals;
 use std::borrow::Cow;
 
 /// Rows per window of a static segment by default: 87 minutes at 100 Hz, 8.7 at 1 kHz.
-pub(crate) const WINDOW_ROWS: usize = 524_288;
+pub const WINDOW_ROWS: usize = 524_288;
 /// A moving segment's windows are this much shorter (its signals are kept per row).
 const MOVING_DIVISOR: usize = 8;
 /// Margin on each side of a window for a low-pass, in periods of the cutoff.
