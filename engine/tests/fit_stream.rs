@@ -103,3 +103,39 @@ fn outliers_judged_per_window_move_estimates_by_a_fraction_of_u() {
     assert!(a > 0 && b > 0, "{a} {b}");
     assert!(a.abs_diff(b) * 10 < a.max(b), "{a} vs {b} samples removed");
 }
+
+/// `Source::windows` hands every row once, in order, however small the windows; the
+/// report's temperature series read span by span keeps the rows a whole read keeps.
+#[test]
+fn windows_hand_every_row_once_and_the_temperature_plot_is_the_same() {
+    use fit::Source;
+    let mut spec = SimSpec::tactical(24);
+    spec.temp = Some((22.0, 3.0));
+    let tmp = sim(&spec);
+    let rec = recording::read(tmp.path()).unwrap();
+    let streamed = fit::Streamed::open(tmp.path()).unwrap();
+    for rows in [1_000, 7_777, 1 << 20] {
+        let mut seen: Vec<(f64, f64)> = Vec::new();
+        streamed
+            .windows(rows, |v| {
+                seen.extend(v.t.iter().zip(v.gyro[2]).map(|(t, g)| (*t, *g)));
+            })
+            .unwrap();
+        let want: Vec<(f64, f64)> = rec
+            .imu
+            .t
+            .iter()
+            .copied()
+            .zip(rec.imu.gyro[2].iter().copied())
+            .collect();
+        assert_eq!(seen, want, "windows of {rows} rows");
+    }
+    let whole = ratecal_engine::render::TemperatureSeries::from_recording(&rec);
+    let spans = ratecal_engine::render::TemperatureSeries::from_source(&streamed).unwrap();
+    assert_eq!(whole, spans);
+    assert!(
+        whole.imu.len() > 1_000 && whole.imu.len() <= 2_000,
+        "{}",
+        whole.imu.len()
+    );
+}
