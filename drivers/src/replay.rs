@@ -123,16 +123,7 @@ impl ReplayImu {
                 t_host: None,
             })
             .collect();
-        let imu = &station.imu;
-        let info = ImuInfo {
-            model: imu.model.clone(),
-            serial: imu.serial.clone(),
-            grade: imu.grade.clone(),
-            sample_hz: imu.sample_rate.0,
-            accel_range_mps2: imu.accel_range.0,
-            gyro_range_dps: imu.gyro_range.0,
-            simulated: true,
-        };
+        let info = station.imu.info(true);
         Ok(ReplayImu {
             info,
             stream: Replayer {

@@ -10,7 +10,7 @@ pub use spec::{DriverSpec, Settings};
 use crate::link::{Endpoint, FramedImu, LinkTable};
 use crate::sim::{SharedWorld, SimImu, SimTable};
 use crate::station::Station;
-use crate::{DriverError, DriverErrorKind, ImuDriver, ImuInfo, TableDriver, TableInfo};
+use crate::{DriverError, DriverErrorKind, ImuDriver, TableDriver, TableInfo};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 use tokio::time::Instant;
@@ -163,16 +163,7 @@ fn link_table(c: &mut Context<'_>, s: &Settings) -> Result<Box<dyn TableDriver>,
 
 fn framed_imu(c: &mut Context<'_>, s: &Settings) -> Result<Box<dyn ImuDriver>, DriverError> {
     let endpoint = endpoint(s)?;
-    let imu = &c.station.imu;
-    let info = ImuInfo {
-        model: imu.model.clone(),
-        serial: imu.serial.clone(),
-        grade: imu.grade.clone(),
-        sample_hz: imu.sample_rate.0,
-        accel_range_mps2: imu.accel_range.0,
-        gyro_range_dps: imu.gyro_range.0,
-        simulated: false,
-    };
+    let info = c.station.imu.info(false);
     let timeout = Duration::from_secs_f64(s.timeout_s());
     Ok(Box::new(FramedImu::spawn(endpoint, info, timeout, c.start)))
 }

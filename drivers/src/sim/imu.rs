@@ -78,15 +78,7 @@ impl SimImu {
             .collect();
         SimImu {
             world,
-            info: ImuInfo {
-                model: imu.model.clone(),
-                serial: imu.serial.clone(),
-                grade: imu.grade.clone(),
-                sample_hz: fs,
-                accel_range_mps2: imu.accel_range.0,
-                gyro_range_dps: imu.gyro_range.0,
-                simulated: true,
-            },
+            info: imu.info(true),
             geo: station.geometry(),
             site: station.site(),
             tau: model.delay_s(),

@@ -71,6 +71,21 @@ fn default_feedforward() -> f64 {
     0.8
 }
 
+impl ImuSpec {
+    /// The static facts a driver of this IMU reports.
+    pub fn info(&self, simulated: bool) -> crate::ImuInfo {
+        crate::ImuInfo {
+            model: self.model.clone(),
+            serial: self.serial.clone(),
+            grade: self.grade.clone(),
+            sample_hz: self.sample_rate.0,
+            accel_range_mps2: self.accel_range.0,
+            gyro_range_dps: self.gyro_range.0,
+            simulated,
+        }
+    }
+}
+
 impl Default for SettlingSpec {
     fn default() -> Self {
         SettlingSpec {
