@@ -31,7 +31,7 @@ pub fn days_from_iso(s: &str) -> Option<f64> {
 
 /// `YYYY-MM-DD` of a day count.
 pub fn iso_date(days: f64) -> String {
-    let (y, m, d) = civil_from_days(days.floor() as i64);
+    let (y, m, d) = ratecal_engine::recording::civil_from_days(days.floor() as i64);
     format!("{y:04}-{m:02}-{d:02}")
 }
 
@@ -55,7 +55,7 @@ fn split_offset(t: &str) -> Option<(&str, f64)> {
     Some((t, 0.0))
 }
 
-// Howard Hinnant's civil-calendar algorithms.
+// Howard Hinnant's algorithm: the inverse of `recording::civil_from_days`.
 fn days_from_civil(y: i64, m: i64, d: i64) -> i64 {
     let y = if m <= 2 { y - 1 } else { y };
     let era = y.div_euclid(400);
@@ -64,19 +64,6 @@ fn days_from_civil(y: i64, m: i64, d: i64) -> i64 {
     let doy = (153 * mp + 2) / 5 + d - 1;
     let doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
     era * 146097 + doe - 719468
-}
-
-fn civil_from_days(z: i64) -> (i64, i64, i64) {
-    let z = z + 719468;
-    let era = z.div_euclid(146097);
-    let doe = z - era * 146097;
-    let yoe = (doe - doe / 1460 + doe / 36524 - doe / 146096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let d = doy - (153 * mp + 2) / 5 + 1;
-    let m = if mp < 10 { mp + 3 } else { mp - 9 };
-    let y = yoe + era * 400 + i64::from(m <= 2);
-    (y, m, d)
 }
 
 #[cfg(test)]

@@ -51,4 +51,6 @@ pub use manifest::{
     ProcedureRef, ResumeRecord, RunInfo, Segment, SegmentKind, SyncRecord, TableAxes,
 };
 pub use read::{OpenRecording, SpanRows, parse_manifest, read, read_imu, read_table};
-pub use write::{Columns, RecordingWriter, manifest_yaml, push_fixed, rfc3339, sha256_hex};
+pub use write::{
+    Columns, RecordingWriter, civil_from_days, manifest_yaml, push_fixed, rfc3339, sha256_hex,
+};
