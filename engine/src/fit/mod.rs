@@ -107,7 +107,6 @@ pub fn analyze_source<S: Source>(
 ) -> Result<Results, S::Error> {
     let m = src.manifest();
     let sel = select::select(m, plan, opts);
-    let geos = prep::geometries(m);
     let mut out = Out {
         warnings: sel.warnings.clone(),
         ..Default::default()
@@ -115,42 +114,10 @@ pub fn analyze_source<S: Source>(
     let declared = models::declared(plan, &opts.with);
     let thermal = sel.temp_requested && src.has_temp();
     let design = models::Design::new(&sel, &declared, thermal, &mut out);
-    let rate_hz = mean_rate(src);
-    // The temperature the thermal terms refer to: the recording's mean.
-    let t_ref_c = if design.uses_temperature() {
-        src.mean_temp()?
-    } else {
-        0.0
-    };
-    // Segments are independent: passed in parallel, longest first so that the work
-    // stealing balances.
-    let dur = |i: usize| m.segments[i].t_end - m.segments[i].t_start;
-    let mut order: Vec<usize> = (0..m.segments.len()).collect();
-    order.sort_by(|a, b| dur(*b).total_cmp(&dur(*a)));
-    let passed: Vec<(Summary, SegAcc)> = {
-        use rayon::prelude::*;
-        order
-            .par_iter()
-            .map(|&i| {
-                let job = segment::Job {
-                    seg: i,
-                    geo: &geos[i],
-                    layout: &design.layout,
-                    t_ref_c,
-                    prep: sel.prep.iter().find(|p| p.0 == i).map(|p| p.1),
-                    allan: sel.allan == Some(i),
-                    verify: sel.unused.contains(&i),
-                    rate_hz,
-                    window_rows: opts.window_rows,
-                };
-                segment::pass(src, &job)
-            })
-            .collect::<Result<_, _>>()?
-    };
-    let (mut sums, mut accs): (Vec<Summary>, Vec<SegAcc>) = passed.into_iter().unzip();
-    sums.sort_by_key(|s| s.seg);
-    accs.sort_by_key(|a| a.seg);
-    accs.retain(|a| a.n > 0);
+    let (mut sums, accs) = pass_segments(src, &design.layout, opts.window_rows, |i| {
+        let prep = sel.prep.iter().find(|p| p.0 == i).map(|p| p.1);
+        (prep, sel.allan == Some(i), sel.unused.contains(&i))
+    })?;
     let mut sync = SyncReport {
         method: "linear_interpolation".into(),
         table_step_s: stats::median_step(&src.table().t),
@@ -229,10 +196,7 @@ pub fn analyze_source<S: Source>(
         .filter(|s| s.is_finite())
         .collect();
     let imu = (src.imu_rows(), src.imu_extent(), median(steps));
-    let temp_range = sums
-        .iter()
-        .filter_map(|s| s.temp_range)
-        .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)));
+    let temp_range = temp_span(sums.iter());
     let mut res = Results {
         format: results::FORMAT.into(),
         verdict: results::RunVerdict::default(),
@@ -267,6 +231,21 @@ pub fn analyze_source<S: Source>(
 /// Every segment's raw samples (no preprocessing) accumulated over `layout`, in manifest
 /// order, those without samples left out: what explain fits its models from.
 pub(crate) fn accumulate_all<S: Source>(src: &S, layout: &Layout) -> Result<Vec<SegAcc>, S::Error> {
+    let (_, accs) = pass_segments(src, layout, segment::WINDOW_ROWS, |_| (None, false, false))?;
+    Ok(accs)
+}
+
+/// Passes every segment once over `layout` (in parallel, longest first so that the work
+/// stealing balances), the thermal terms referred to the recording's mean temperature;
+/// `what(i)` says how segment `i` is prepared, whether it is the Allan block and whether a
+/// verification segment. Summaries in manifest order; accumulations of the segments with
+/// samples.
+fn pass_segments<S: Source>(
+    src: &S,
+    layout: &Layout,
+    window_rows: usize,
+    what: impl Fn(usize) -> (Option<prep::PrepOptions>, bool, bool) + Sync,
+) -> Result<(Vec<Summary>, Vec<SegAcc>), S::Error> {
     use rayon::prelude::*;
     let m = src.manifest();
     let geos = prep::geometries(m);
@@ -276,25 +255,38 @@ pub(crate) fn accumulate_all<S: Source>(src: &S, layout: &Layout) -> Result<Vec<
     } else {
         0.0
     };
-    let mut accs: Vec<SegAcc> = (0..m.segments.len())
-        .into_par_iter()
-        .map(|i| {
+    let dur = |i: usize| m.segments[i].t_end - m.segments[i].t_start;
+    let mut order: Vec<usize> = (0..m.segments.len()).collect();
+    order.sort_by(|a, b| dur(*b).total_cmp(&dur(*a)));
+    let passed: Vec<(Summary, SegAcc)> = order
+        .par_iter()
+        .map(|&i| {
+            let (prep, allan, verify) = what(i);
             let job = segment::Job {
                 seg: i,
                 geo: &geos[i],
                 layout,
                 t_ref_c,
-                prep: None,
-                allan: false,
-                verify: false,
+                prep,
+                allan,
+                verify,
                 rate_hz,
-                window_rows: segment::WINDOW_ROWS,
+                window_rows,
             };
-            segment::pass(src, &job).map(|p| p.1)
+            segment::pass(src, &job)
         })
         .collect::<Result<_, _>>()?;
+    let (mut sums, mut accs): (Vec<Summary>, Vec<SegAcc>) = passed.into_iter().unzip();
+    sums.sort_by_key(|s| s.seg);
+    accs.sort_by_key(|a| a.seg);
     accs.retain(|a| a.n > 0);
-    Ok(accs)
+    Ok((sums, accs))
+}
+
+/// The lowest and highest IMU temperature over these segments' samples.
+fn temp_span<'a>(sums: impl Iterator<Item = &'a Summary>) -> Option<(f64, f64)> {
+    sums.filter_map(|s| s.temp_range)
+        .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
 }
 
 /// The median of some values (NaN of none).
@@ -358,12 +350,7 @@ fn unfitted_residual_warnings(rs: &[(ResidualStats, bool)], out: &mut Out) {
 /// Whether the IMU temperature varied by at least 1 degC across these segments: a thermal
 /// coefficient needs a temperature span to be determined.
 fn temperature_varies(sums: &[Summary], segs: &[usize]) -> bool {
-    let range = sums
-        .iter()
-        .filter(|s| segs.contains(&s.seg))
-        .filter_map(|s| s.temp_range)
-        .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)));
-    range.is_some_and(|(lo, hi)| hi - lo >= 1.0)
+    temp_span(sums.iter().filter(|s| segs.contains(&s.seg))).is_some_and(|(lo, hi)| hi - lo >= 1.0)
 }
 
 /// The largest mean residual of each sensor's fitted segments (`accel.residual.mean`,

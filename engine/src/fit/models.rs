@@ -146,11 +146,6 @@ impl Design {
             earth_fitted,
         }
     }
-
-    /// Whether a term of the design reads the IMU temperature.
-    pub(crate) fn uses_temperature(&self) -> bool {
-        self.layout.effects.iter().any(|e| e.uses_temperature())
-    }
 }
 
 /// Fits the models from the segments' accumulations (`accs`, those with samples) and

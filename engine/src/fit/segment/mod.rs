@@ -207,7 +207,7 @@ impl Window<'_> {
         // References: specific force and inertial rate (with the Earth's), per channel.
         let refs = match constant {
             Some(s) => Refs::Constant(reference(&s)),
-            None if self.job.prep.is_some() => {
+            None if prepared => {
                 let mut r: [Vec<f64>; 6] = std::array::from_fn(|_| Vec::with_capacity(n));
                 for s in &sigs {
                     for (c, v) in reference(s).into_iter().enumerate() {
@@ -267,7 +267,7 @@ impl Window<'_> {
                 .push(&s, v.t[i], [o(0), o(1), o(2)], [o(3), o(4), o(5)]);
         }
         self.sum.rows += cb - ca;
-        if self.job.prep.is_some() && self.job.verify {
+        if prepared && self.job.verify {
             for c in 0..6 {
                 let keep = if c < 3 { &keep_a } else { &keep_g };
                 let r: Vec<f64> = (ca..cb).map(|i| refs.at(c, i)).collect();
