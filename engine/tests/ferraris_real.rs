@@ -3,22 +3,12 @@
 //! its values agree with an independent full 3x3 fit of the same data (segment means
 //! against the closed-form gravity references, solved here by SVD).
 
+#[path = "../../tests/support/shared.rs"]
+mod shared;
+
 use nalgebra::{DMatrix, DVector};
 use ratecal_engine::explain::{self, NominalModel, Options, ParamOut};
 use ratecal_engine::recording;
-use std::path::{Path, PathBuf};
-
-fn session() -> Option<PathBuf> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let found = ["../../shared", "../../../shared"]
-        .iter()
-        .map(|r| root.join(r).join("examples/real-ferraris-session"))
-        .find(|p| p.exists());
-    if found.is_none() {
-        println!("skipped: ../shared/examples/real-ferraris-session is absent");
-    }
-    found
-}
 
 /// `K` (3x3) of `a = K f + b` from the six segments' mean outputs and references
 /// `f = g [sin th, cos th sin ph, cos th cos ph]` (th, ph: mean outer and inner feedback),
@@ -66,7 +56,9 @@ fn full_fit(rec: &recording::Recording) -> [[(f64, f64); 3]; 3] {
 
 #[test]
 fn explain_names_the_misalignment_a_full_fit_agrees_with() {
-    let Some(dir) = session() else { return };
+    let Some(dir) = shared::shared_example("real-ferraris-session") else {
+        return;
+    };
     let rec = recording::read(&dir).unwrap();
     let x = explain::explain(&rec, &NominalModel::seed(), &Options::default());
     let found: Vec<&str> = x.findings.iter().map(|f| f.effect.as_str()).collect();

@@ -1,24 +1,15 @@
 //! The analysis on the independent example recording, against its truth.json.
 
-use ratecal_engine::{fit, recording};
-use std::path::{Path, PathBuf};
+#[path = "../../tests/support/shared.rs"]
+mod shared;
 
-fn shared() -> Option<PathBuf> {
-    // ../shared next to the repository (CI), or one level up (a worktree under wt/).
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let found = ["../../shared", "../../../shared"]
-        .iter()
-        .map(|r| root.join(r).join("examples/standard-with-lever-arm"))
-        .find(|p| p.exists());
-    if found.is_none() {
-        println!("skipped: ../shared/examples/standard-with-lever-arm is absent");
-    }
-    found
-}
+use ratecal_engine::{fit, recording};
 
 #[test]
 fn example_matches_truth_where_the_standard_model_applies() {
-    let Some(dir) = shared() else { return };
+    let Some(dir) = shared::shared_example("standard-with-lever-arm") else {
+        return;
+    };
     let rec = recording::read(&dir).unwrap();
     let t0 = std::time::Instant::now();
     let res = fit::analyze(&rec, None);

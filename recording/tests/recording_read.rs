@@ -1,25 +1,17 @@
 //! Reading recordings: the independent example folder, and located errors for bad ones.
 
+#[path = "../../tests/support/shared.rs"]
+mod shared;
+
 use miette::{GraphicalReportHandler, GraphicalTheme};
 use ratecal_recording::{self as recording, RecordingError, SegmentKind};
-use std::path::{Path, PathBuf};
-
-fn shared() -> Option<PathBuf> {
-    // ../shared next to the repository (CI), or one level up (a worktree under wt/).
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let found = ["../../shared", "../../../shared"]
-        .iter()
-        .map(|r| root.join(r).join("examples/standard-with-lever-arm"))
-        .find(|p| p.exists());
-    if found.is_none() {
-        println!("skipped: ../shared/examples/standard-with-lever-arm is absent");
-    }
-    found
-}
+use std::path::Path;
 
 #[test]
 fn reads_the_independent_example_exactly() {
-    let Some(dir) = shared() else { return };
+    let Some(dir) = shared::shared_example("standard-with-lever-arm") else {
+        return;
+    };
     let t0 = std::time::Instant::now();
     let rec = recording::read(&dir).expect("example reads");
     eprintln!("read in {:?}", t0.elapsed());

@@ -1,22 +1,12 @@
 //! Reading by time span: a span read equals that slice of a whole read, whatever the line
 //! ends, and a bad cell in a span is located where a whole read locates it.
 
+#[path = "../../tests/support/shared.rs"]
+mod shared;
+
 use miette::{GraphicalReportHandler, GraphicalTheme};
 use ratecal_recording::{self as recording, ImuStream, Recording, RecordingError, TableStream};
-use std::path::{Path, PathBuf};
-
-fn shared_example() -> Option<PathBuf> {
-    // ../shared next to the repository, or one level up (a worktree under wt/).
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let found = ["../../shared", "../../../shared"]
-        .iter()
-        .map(|r| root.join(r).join("examples/standard-with-lever-arm"))
-        .find(|p| p.exists());
-    if found.is_none() {
-        println!("skipped: ../shared/examples/standard-with-lever-arm is absent");
-    }
-    found
-}
+use std::path::Path;
 
 /// A recording of `n` IMU rows at 100 Hz (a few blocks of the index), the table at 50 Hz
 /// with the time column last.
@@ -150,7 +140,9 @@ fn span_reads_are_slices(dir: &Path) {
 
 #[test]
 fn spans_of_the_example_are_slices_of_a_whole_read() {
-    let Some(dir) = shared_example() else { return };
+    let Some(dir) = shared::shared_example("standard-with-lever-arm") else {
+        return;
+    };
     span_reads_are_slices(&dir);
     let files = read_files(&dir);
     for ends in ["\r\n", "\r\r\n"] {

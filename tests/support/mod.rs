@@ -2,6 +2,8 @@
 
 #![allow(dead_code)]
 
+mod shared;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -94,13 +96,5 @@ pub fn mini_run(dir: &Path, out: &str, extra: &[&str]) -> Output {
 /// The shared lever-arm example recording (`../shared/examples/standard-with-lever-arm`),
 /// or `None` with a "skipped" line when this machine lacks it.
 pub fn example() -> Option<PathBuf> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let found = ["../shared", "../../shared"]
-        .iter()
-        .map(|r| root.join(r).join("examples/standard-with-lever-arm"))
-        .find(|p| p.exists());
-    if found.is_none() {
-        println!("skipped: ../shared/examples/standard-with-lever-arm is absent");
-    }
-    found
+    shared::shared_example("standard-with-lever-arm")
 }
