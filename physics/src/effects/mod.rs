@@ -26,7 +26,8 @@ mod thermal;
 mod time_offset;
 
 pub use earth_rate::EarthRate;
-pub use eccentricity::{EncoderError, Eccentricity};
+pub use clock_rate::ClockRate;
+pub use eccentricity::{Eccentricity, EncoderError};
 pub use misalignment::pair as misalignment_pair;
 pub use model::{ImuModel, Term};
 pub use signals::Signals;
