@@ -55,7 +55,7 @@ fn a_folder_of_effect_files_is_tried_like_the_registry() {
         .iter()
         .map(|e| e["effect"].as_str().unwrap())
         .collect();
-    assert_eq!(files, ["accel_k2", "centripetal"]);
+    assert_eq!(files, ["accel_cross_xz", "centripetal"]);
     assert_eq!(v["adopt"], "with earth_rate");
 }
 
