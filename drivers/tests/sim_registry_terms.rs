@@ -3,6 +3,9 @@
 //! eccentricity) as their closed forms, written out here independently of the physics
 //! crate.
 
+// Channel loops index the truth's arrays and the samples' at once.
+#![allow(clippy::needless_range_loop)]
+
 use ratecal_drivers::{ImuSample, Station, TableAxisId, TableCommand, TableSample, build};
 use std::time::Duration;
 
@@ -195,7 +198,12 @@ async fn gyro_asymmetry_and_thermal_scale_follow_the_rate() {
                 let w = w_b[i] + e[i];
                 let scale = tr.sg[i] + (asym[i] * w.signum() + thermal[i] * dt) * 1e-6;
                 let g = (1.0 + scale) * w + tr.bg[i];
-                near(x.gyro[i], g, 1e-9, &format!("{axis:?} {rate} g{i} at {}", x.t));
+                near(
+                    x.gyro[i],
+                    g,
+                    1e-9,
+                    &format!("{axis:?} {rate} g{i} at {}", x.t),
+                );
             }
         }
     }
@@ -302,7 +310,10 @@ async fn encoder_eccentricity_turns_the_imu_by_the_true_angle() {
                 apart = apart.max(((1.0 + tr.sa[i]) * at_enc + tr.ba[i] - x.accel[i]).abs());
             }
         }
-        assert!(apart > 1e-4, "the error shows at ({pitch}, {roll}): {apart}");
+        assert!(
+            apart > 1e-4,
+            "the error shows at ({pitch}, {roll}): {apart}"
+        );
     }
     // Turning about the inner axis: the encoder's rate is steady, the true one is not.
     let rate = 100.0;

@@ -62,7 +62,10 @@ impl Eccentricity {
                 .sqrt()
         };
         if e <= 0.0 {
-            return ((0.0, var([1.0, 0.0]).max(var([0.0, 1.0]))), (phi, f64::INFINITY));
+            return (
+                (0.0, var([1.0, 0.0]).max(var([0.0, 1.0]))),
+                (phi, f64::INFINITY),
+            );
         }
         let u_e = var([s / e, c / e]);
         // d phi / d s = -c / e^2, d phi / d c = s / e^2 (radians).

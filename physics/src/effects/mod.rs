@@ -25,8 +25,8 @@ mod signals;
 mod thermal;
 mod time_offset;
 
-pub use earth_rate::EarthRate;
 pub use clock_rate::ClockRate;
+pub use earth_rate::EarthRate;
 pub use eccentricity::{Eccentricity, EncoderError};
 pub use misalignment::pair as misalignment_pair;
 pub use model::{ImuModel, Term};

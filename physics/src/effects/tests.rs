@@ -229,7 +229,11 @@ fn clock_rate_regressor_is_the_derivative_of_re_timing() {
     let mut out = [Partials::default()];
     e.regressors(&signals(t).at(t), &mut out);
     let (fa, fg) = ((fp - fm) / (2.0 * h), (wp - wm) / (2.0 * h));
-    assert!((out[0].accel - fa).norm() < 1e-9, "{} vs {fa}", out[0].accel);
+    assert!(
+        (out[0].accel - fa).norm() < 1e-9,
+        "{} vs {fa}",
+        out[0].accel
+    );
     assert!((out[0].gyro - fg).norm() < 1e-9, "{} vs {fg}", out[0].gyro);
     // The simulator's delay: exact re-timing, composed with the time offset.
     let mut m = ImuModel::default();
@@ -238,7 +242,10 @@ fn clock_rate_regressor_is_the_derivative_of_re_timing() {
     let t = 1800.0;
     let te = t - m.delay_at_s(t);
     assert!((te - (t / (1.0 + 60e-6) - 2e-3)).abs() < 1e-9, "{te}");
-    assert!((t - te - 0.110).abs() < 1e-3, "60 ppm is about 0.1 s after half an hour");
+    assert!(
+        (t - te - 0.110).abs() < 1e-3,
+        "60 ppm is about 0.1 s after half an hour"
+    );
 }
 
 #[test]
@@ -262,9 +269,7 @@ fn encoder_true_motion_reads_back_as_the_encoder() {
         assert!((tr.angle - en.angle).abs() > 5.0 * arcsec);
     }
     // The true rate and acceleration are the derivatives of the true angle.
-    let d = |f: &dyn Fn(&TableState) -> f64| {
-        (f(&truth(t + h)) - f(&truth(t - h))) / (2.0 * h)
-    };
+    let d = |f: &dyn Fn(&TableState) -> f64| (f(&truth(t + h)) - f(&truth(t - h))) / (2.0 * h);
     let now = truth(t);
     assert!((d(&|s| s.outer.angle) - now.outer.rate).abs() < 1e-8);
     assert!((d(&|s| s.inner.angle) - now.inner.rate).abs() < 1e-8);
@@ -290,8 +295,16 @@ fn eccentricity_regressors_are_the_derivatives_of_the_true_motion() {
             let ((fp, wp), (fm, wm)) = (y(h), y(-h));
             let (fa, fg) = ((fp - fm) / (2.0 * h), (wp - wm) / (2.0 * h));
             assert!(fa.norm() + fg.norm() > 1e-6, "{t} {k}: excited");
-            assert!((out[k].accel - fa).norm() < 1e-10, "{t} {k}: {} vs {fa}", out[k].accel);
-            assert!((out[k].gyro - fg).norm() < 1e-10, "{t} {k}: {} vs {fg}", out[k].gyro);
+            assert!(
+                (out[k].accel - fa).norm() < 1e-10,
+                "{t} {k}: {} vs {fa}",
+                out[k].accel
+            );
+            assert!(
+                (out[k].gyro - fg).norm() < 1e-10,
+                "{t} {k}: {} vs {fg}",
+                out[k].gyro
+            );
         }
     }
 }
