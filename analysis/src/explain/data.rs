@@ -1,10 +1,10 @@
 //! The recording accumulated once for every model explain will try: every segment, every
 //! registry effect's columns, and which segments are held out.
 
-use crate::fit::Source;
-use crate::fit::joint::{Layout, SegAcc, excitation};
 use super::earth::EARTH_HELD;
 use super::probe::{self, Probe};
+use crate::fit::Source;
+use crate::fit::joint::{Layout, SegAcc, excitation};
 use crate::recording::SegmentKind;
 use ratecal_physics::Effect;
 

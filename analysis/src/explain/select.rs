@@ -205,7 +205,10 @@ pub(crate) fn forward(data: &Data, start: &Terms, alpha: f64, without: &[String]
         .filter(|e| {
             !without.iter().any(|w| w == lay.effects[*e].id())
                 && !terms.effects.contains(e)
-                && !terms.fixed.iter().any(|f| lay.effects[f.0].id() == lay.effects[*e].id())
+                && !terms
+                    .fixed
+                    .iter()
+                    .any(|f| lay.effects[f.0].id() == lay.effects[*e].id())
         })
         .collect();
     let n: usize = work.iter().map(|&i| 6 * data.accs[i].n).sum();
