@@ -1,8 +1,8 @@
 //! From the fit's segments to cycles: a cycle is one navigation run, from a static block
-//! (the initial alignment) through the oscillation segments swayed at that block's attitude
-//! under the same mount. The attitude is the IMU's own (the mean specific force in body
-//! axes), so an axis brought up by the table (an inner-axis tilt) and one brought up by a
-//! remount are told apart alike, whatever the manifest's mounts say.
+//! (the initial alignment) through the oscillation segments after it under the same mount,
+//! until a block at rest at another attitude. The attitude is the IMU's own (the mean
+//! specific force in body axes), so an axis brought up by the table (an inner-axis tilt)
+//! and one brought up by a remount are told apart alike, whatever the manifest's mounts say.
 
 use crate::fit::prep::geometries;
 use crate::recording::{Recording, SegmentKind};
@@ -77,38 +77,39 @@ pub(crate) fn plan(rec: &Recording, ix: &[usize]) -> (Vec<Cycle>, Vec<LeftOut>) 
             leave(i, "it has no period (period_s)".into());
             continue;
         }
-        let Some(f) = mean_f(rec, s.t_start, s.t_end) else {
+        if mean_f(rec, s.t_start, s.t_end).is_none() {
             leave(i, "no IMU samples in it".into());
             continue;
+        }
+        // Static blocks are compared with each other only (at rest the specific force is
+        // gravity alone; a sway's mean is not, when its axis is off the vertical).
+        let at_rest_like = |a: usize, b: usize| {
+            let fa = statics.iter().find(|(st, _)| *st == a).map(|x| x.1);
+            let fb = statics.iter().find(|(st, _)| *st == b).map(|x| x.1);
+            same_mount(&geos[a].c_pb, &geos[b].c_pb)
+                && matches!((fa, fb), (Some(fa), Some(fb)) if angle_deg(&fa, &fb) < SAME_ATTITUDE_DEG)
         };
-        let matches = |st: usize, fs: &Vec3| {
-            same_mount(&geos[st].c_pb, &geos[i].c_pb) && angle_deg(fs, &f) < SAME_ATTITUDE_DEG
+        let between = |a: usize| {
+            statics
+                .iter()
+                .map(|(st, _)| *st)
+                .filter(move |&st| segs[st].t_start >= segs[a].t_end && segs[st].t_end <= s.t_start)
         };
-        // The cycle goes on while the mount and the attitude stay those of its alignment.
+        // The cycle goes on while the mount stays and every block at rest since its
+        // alignment is at the alignment's attitude (a tilt or a remount starts another).
         if let Some(c) = cycles.last_mut()
-            && let Some((_, fs)) = statics.iter().find(|(st, _)| *st == c.align)
-            && matches(c.align, fs)
-            && !statics.iter().any(|(st, fs)| {
-                let t = &segs[*st];
-                t.t_start >= segs[c.align].t_end && t.t_end <= s.t_start && !matches(*st, fs)
-            })
+            && same_mount(&geos[c.align].c_pb, &geos[i].c_pb)
+            && between(c.align).all(|st| at_rest_like(st, c.align))
         {
             c.segs.push(i);
             continue;
         }
-        // Otherwise a new run: the last static block before it at its attitude.
+        // Otherwise a new run, from the last static block before it under its mount.
         let align = statics
             .iter()
-            .filter(|(st, fs)| segs[*st].t_end <= s.t_start && matches(*st, fs))
             .map(|(st, _)| *st)
+            .filter(|&st| segs[st].t_end <= s.t_start && same_mount(&geos[st].c_pb, &geos[i].c_pb))
             .max_by(|a, b| segs[*a].t_end.total_cmp(&segs[*b].t_end));
-        // ...with nothing between at another attitude (a remount or a tilt breaks the run).
-        let align = align.filter(|&a| {
-            !statics.iter().any(|(st, fs)| {
-                let t = &segs[*st];
-                t.t_start >= segs[a].t_end && t.t_end <= s.t_start && !matches(*st, fs)
-            })
-        });
         match align {
             Some(align) => cycles.push(Cycle {
                 align,
@@ -116,8 +117,8 @@ pub(crate) fn plan(rec: &Recording, ix: &[usize]) -> (Vec<Cycle>, Vec<LeftOut>) 
             }),
             None => leave(
                 i,
-                "no static segment before it at its attitude and mount to align on (a cycle \
-                 starts with one at rest)"
+                "no static segment before it under its mount to align on (a cycle starts with \
+                 one at rest)"
                     .into(),
             ),
         }

@@ -222,6 +222,21 @@ fn run(rec: &Recording, ci: usize, cycle: &Cycle, out: &mut Runs) -> Result<(), 
             );
             continue;
         }
+        // Gravity's component along the sway axis does not change while swaying about it:
+        // if it is not the alignment's, the IMU was tilted or remounted in between without
+        // the navigation seeing it (the stream jumped).
+        let f_mean = f[k0..k1].iter().sum::<Vec3>() / (k1 - k0).max(1) as f64;
+        let jump = (f_mean.dot(&axis_b) - f0.dot(&axis_b)).abs();
+        if jump > 0.02 * site.gravity_mps2 {
+            leave(
+                out,
+                format!(
+                    "its attitude is not that of {} (gravity along the sway axis differs by {:.3} m/s^2): no alignment at rest at its attitude",
+                    st.id, jump
+                ),
+            );
+            continue;
+        }
         if off > MAX_UP_AXIS_DEG {
             leave(
                 out,

@@ -74,6 +74,11 @@ pub(crate) fn needed_axis(m: usize) -> &'static str {
 
 /// Solves for the coordinates.
 pub(crate) fn solve(drifts: Vec<SegmentDrift>, rests: Vec<RestDrift>, est: &mut SizeEffect) {
+    // Stretches at rest of a cycle none of whose segments could be used say nothing.
+    let rests = rests
+        .into_iter()
+        .filter(|r| drifts.iter().any(|d| d.group == r.group))
+        .collect();
     est.drifts = drifts;
     est.rests = rests;
     let (drifts, rests) = (&est.drifts, &est.rests);
