@@ -96,7 +96,10 @@ fn analyze_recovers_the_independent_sway_within_half_a_millimetre() {
     }
     // Three cycles, Z, X, Y up, each with its two periods' difference accounted for.
     let cycles = r["size_effect"]["cycles"].as_array().unwrap();
-    let ups: Vec<&str> = cycles.iter().map(|c| c["up_axis"].as_str().unwrap()).collect();
+    let ups: Vec<&str> = cycles
+        .iter()
+        .map(|c| c["up_axis"].as_str().unwrap())
+        .collect();
     assert_eq!(ups, ["z", "x", "y"]);
     for c in cycles {
         assert!(c["instrumental_mps2"].is_array(), "{c}");

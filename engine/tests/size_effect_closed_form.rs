@@ -103,7 +103,10 @@ fn write(dir: &std::path::Path, phases: &[Phase], seed: u64) {
         [p[0] + r[4], p[1] + r[5], p[2]],
     ];
     let (b_a, s_a) = ([3e-4, -4e-4, 2.5e-4], [40e-6, -30e-6, 25e-6]);
-    let (b_g, s_g) = ([0.004 / 3600.0, -0.003 / 3600.0, 0.005 / 3600.0], [8e-6, -6e-6, 5e-6]);
+    let (b_g, s_g) = (
+        [0.004 / 3600.0, -0.003 / 3600.0, 0.005 / 3600.0],
+        [8e-6, -6e-6, 5e-6],
+    );
     let mut imu = String::from("t,ax,ay,az,gx,gy,gz\n");
     let mut table = String::from("t,outer,inner,outer_rate,inner_rate\n");
     let mut segs = String::new();
@@ -148,7 +151,7 @@ fn write(dir: &std::path::Path, phases: &[Phase], seed: u64) {
             }
             imu.push_str(&row);
             imu.push('\n');
-            if k_total % 2 == 0 {
+            if k_total.is_multiple_of(2) {
                 writeln!(
                     table,
                     "{t:.5},{:.6},{:.6},0,{:.5}",
@@ -225,7 +228,12 @@ fn check(est: &SizeEffect, tol_mm: f64) {
     for (m, (_, _, name)) in COORDS.iter().enumerate() {
         let (v, u) = est.coords_m[m].unwrap_or_else(|| panic!("{name} unobservable"));
         let err = v * 1e3 - R_MM[m];
-        eprintln!("{name}: {:.3} mm (truth {}, error {err:+.3}, u {:.3})", v * 1e3, R_MM[m], u * 1e3);
+        eprintln!(
+            "{name}: {:.3} mm (truth {}, error {err:+.3}, u {:.3})",
+            v * 1e3,
+            R_MM[m],
+            u * 1e3
+        );
         assert!(err.abs() < tol_mm, "{name}: {} mm vs {}", v * 1e3, R_MM[m]);
     }
 }
@@ -300,7 +308,11 @@ fn unusable_cycles_are_named_and_left_out_without_harm() {
             assert!(why.contains("too short"), "{why}");
         }
     }
-    assert!(est.drifts.iter().all(|d| !d.id.contains("tilted") && !d.id.contains("short")));
+    assert!(
+        est.drifts
+            .iter()
+            .all(|d| !d.id.contains("tilted") && !d.id.contains("short"))
+    );
     check(&est, 0.3);
     // Without the Y cycle, rxz and rzx are not observable and say what they need.
     let no_y: Vec<usize> = sways(&rec)
@@ -310,6 +322,10 @@ fn unusable_cycles_are_named_and_left_out_without_harm() {
     let est = estimate(&rec, &no_y);
     for m in [1, 4] {
         assert!(est.coords_m[m].is_none(), "{}", COORDS[m].2);
-        assert!(est.unobservable[m].contains("Y up"), "{}", est.unobservable[m]);
+        assert!(
+            est.unobservable[m].contains("Y up"),
+            "{}",
+            est.unobservable[m]
+        );
     }
 }

@@ -36,13 +36,15 @@ pub(crate) fn mean_f(rec: &Recording, t0: f64, t1: f64) -> Option<Vec3> {
     let imu = &rec.imu;
     let a = imu.t.partition_point(|&t| t < t0);
     let b = imu.t.partition_point(|&t| t <= t1);
-    (b > a).then(|| {
-        Vec3::from_fn(|c, _| imu.accel[c][a..b].iter().sum::<f64>() / (b - a) as f64)
-    })
+    (b > a).then(|| Vec3::from_fn(|c, _| imu.accel[c][a..b].iter().sum::<f64>() / (b - a) as f64))
 }
 
 fn angle_deg(a: &Vec3, b: &Vec3) -> f64 {
-    a.normalize().dot(&b.normalize()).clamp(-1.0, 1.0).acos().to_degrees()
+    a.normalize()
+        .dot(&b.normalize())
+        .clamp(-1.0, 1.0)
+        .acos()
+        .to_degrees()
 }
 
 /// Sorts the fit's segments into cycles; what cannot join one is left out with the reason.

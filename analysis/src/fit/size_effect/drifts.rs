@@ -324,7 +324,10 @@ fn run(rec: &Recording, ci: usize, cycle: &Cycle, out: &mut Runs) -> Result<(), 
         if hi - lo < MIN_REST_S - 2.0 * REST_TRIM_S {
             continue;
         }
-        let (r0, r1) = (t.partition_point(|&x| x < lo), t.partition_point(|&x| x <= hi));
+        let (r0, r1) = (
+            t.partition_point(|&x| x < lo),
+            t.partition_point(|&x| x <= hi),
+        );
         let n_blocks = (hi - lo).floor() as usize;
         let edges: Vec<f64> = (0..=n_blocks)
             .map(|b| lo + (hi - lo) * b as f64 / n_blocks as f64)

@@ -125,8 +125,7 @@ pub(crate) fn fit(rec: &Recording, ix: &[usize], out: &mut Out) {
                     solve::needed_axis(k)
                 );
                 out.params.insert(key.clone(), Parameter::needs(&needs));
-                out.observability
-                    .insert(key, est.unobservable[k].clone());
+                out.observability.insert(key, est.unobservable[k].clone());
             }
         }
     }

@@ -256,7 +256,11 @@ pub(crate) fn solve(drifts: Vec<SegmentDrift>, rests: Vec<RestDrift>, est: &mut 
             .collect();
         break (x, cov * scale, keep, shifts);
     };
-    let val = |col: usize| keep.iter().position(|&m| m == col).map(|q| (x[q], cov[(q, q)].sqrt()));
+    let val = |col: usize| {
+        keep.iter()
+            .position(|&m| m == col)
+            .map(|q| (x[q], cov[(q, q)].sqrt()))
+    };
     for m in coords.iter().copied() {
         est.coords_m[m] = val(m);
     }
