@@ -127,6 +127,7 @@ impl Data {
             accel: accel.iter().map(|&i| &self.accs[i]).collect(),
             gyro: gyro.iter().map(|&i| &self.accs[i]).collect(),
             merged: None,
+            white_only: false,
         };
         let m = std::sync::Arc::new(crate::fit::joint::merge(&req));
         let mut cache = self.merged.lock().expect("not poisoned");
