@@ -63,6 +63,8 @@ impl Probe {
                 unit: "1",
                 channel: Some((sensor, i)),
                 needs: "",
+                // A probe is a form, not physics: no range.
+                max_abs: f64::INFINITY,
             })
             .collect();
         Box::leak(Box::new(Probe {
