@@ -155,7 +155,7 @@ fn physics_the_registry_lacks_is_found_from_its_file() {
             "{top:?}"
         );
         // Without the file the cross-coupling stays unexplained, on the held-out segments
-        // too (whether a registry effect is named for it: the ignored test below).
+        // too (and no registry effect is named for it: the test below).
         let bare = run(&rec, &[], &[]);
         let (b, w) = (bare.final_.holdout_rms, x.final_.holdout_rms);
         assert!(
@@ -165,12 +165,11 @@ fn physics_the_registry_lacks_is_found_from_its_file() {
     }
 }
 
-/// Issue 27: physics the grown registry lacks must not be named as a registry effect. On
-/// seed 12 explain without the file takes `accel_scale_thermal` (`f_x (T - T_ref)`, which
-/// the rate segments' partial revolutions and the IMU's warm-up make correlate with
-/// `f_x f_z`); seed 11 is clean. Un-ignore when explain reports what it cannot explain.
+/// Issue 27: physics the grown registry lacks is not named as a registry effect (before
+/// explain learnt to say what it cannot explain, seed 12 named `accel_scale_thermal`,
+/// `f_x (T - T_ref)`, which the rate segments' partial revolutions and the IMU's warm-up
+/// make correlate with `f_x f_z`).
 #[test]
-#[ignore = "issue 27 section 2: explain names accel_scale_thermal for a cross-coupling on seed 12"]
 fn physics_the_registry_lacks_is_not_named_as_a_registry_effect() {
     for seed in [11, 12] {
         let mut rec = record("{}", seed);
