@@ -1,6 +1,7 @@
 //! Writing a scenario as a recording folder (spec/recording-format.md) with std formatting,
 //! and its `truth.json` beside.
 
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::fs::{self, File};
 use std::io::{self, BufWriter, Write};
@@ -39,6 +40,10 @@ pub struct Truth {
     pub hidden: Vec<HiddenTruth>,
     /// The end of both streams, s.
     pub duration_s: f64,
+    /// The realised wandering part of the gyro bias, averaged over each segment's IMU
+    /// samples (by time stamp), deg/s: the bias a fit of that segment sees is
+    /// `nominal.gyro_bias_dps` plus this.
+    pub gyro_walk_mean_dps: BTreeMap<String, V3>,
 }
 
 /// The nominal parameters: biases as outputs at zero input, scales as `K_ii - 1`.
@@ -74,7 +79,7 @@ fn off_diagonal(m: &M3) -> M3 {
 }
 
 impl Truth {
-    fn of(s: &Scenario, timeline: &Timeline) -> Truth {
+    fn of(s: &Scenario, timeline: &Timeline, walk: BTreeMap<String, V3>) -> Truth {
         let imu = &s.imu;
         Truth {
             name: s.name.clone(),
@@ -98,6 +103,7 @@ impl Truth {
             },
             hidden: s.hidden.iter().map(|h| h.truth()).collect(),
             duration_s: timeline.duration_s,
+            gyro_walk_mean_dps: walk,
         }
     }
 }
@@ -108,9 +114,9 @@ pub fn write(dir: &Path, scenario: &Scenario) -> io::Result<Truth> {
     fs::create_dir_all(dir)?;
     let timeline = scenario.timeline();
     fs::write(dir.join("manifest.yaml"), manifest(scenario, &timeline))?;
-    write_imu(&dir.join("imu.csv"), scenario, &timeline)?;
+    let walk = write_imu(&dir.join("imu.csv"), scenario, &timeline)?;
     write_table(&dir.join("table.csv"), scenario, &timeline)?;
-    let truth = Truth::of(scenario, &timeline);
+    let truth = Truth::of(scenario, &timeline, walk);
     let json = serde_json::to_string_pretty(&truth).map_err(io::Error::other)?;
     fs::write(dir.join("truth.json"), json + "\n")?;
     Ok(truth)
@@ -168,7 +174,14 @@ fn normal(rng: &mut ChaCha8Rng) -> f64 {
     rng.sample(StandardNormal)
 }
 
-fn write_imu(path: &Path, s: &Scenario, timeline: &Timeline) -> io::Result<()> {
+/// Writes imu.csv; returns the wandering bias's mean over each segment.
+fn write_imu(
+    path: &Path,
+    s: &Scenario,
+    timeline: &Timeline,
+) -> io::Result<BTreeMap<String, V3>> {
+    let segs = &timeline.segments;
+    let mut sums = vec![([0.0f64; 3], 0.0f64); segs.len()];
     let mut f = BufWriter::new(File::create(path)?);
     writeln!(f, "t,ax,ay,az,gx,gy,gz,temp")?;
     let mut rng = ChaCha8Rng::seed_from_u64(s.seed);
@@ -181,6 +194,12 @@ fn write_imu(path: &Path, s: &Scenario, timeline: &Timeline) -> io::Result<()> {
             break;
         }
         let inst = s.instant(timeline, t_stamp);
+        for (seg, (sum, n)) in segs.iter().zip(sums.iter_mut()) {
+            if (seg.t_start..=seg.t_end).contains(&t_stamp) {
+                *sum = std::array::from_fn(|i| sum[i] + walk[i]);
+                *n += 1.0;
+            }
+        }
         let (mut a, mut w) = s.outputs(&inst);
         for i in 0..3 {
             a[i] += s.imu.accel_noise_mps2 * normal(&mut rng);
@@ -193,7 +212,12 @@ fn write_imu(path: &Path, s: &Scenario, timeline: &Timeline) -> io::Result<()> {
             a[0], a[1], a[2], w[0], w[1], w[2], inst.temp_c
         )?;
     }
-    f.flush()
+    f.flush()?;
+    Ok(segs
+        .iter()
+        .zip(sums)
+        .map(|(seg, (sum, n))| (seg.id.clone(), sum.map(|v| v / n.max(1.0))))
+        .collect())
 }
 
 fn write_table(path: &Path, s: &Scenario, timeline: &Timeline) -> io::Result<()> {
