@@ -1,16 +1,15 @@
 //! ratecal's stages, each a function from one data type to the next:
-//! `check` (AST -> Plan), `run` (Plan + drivers -> Recording), `fit` (Recording ->
-//! Results), `render` (Results -> report), `audit` (Plan vs Plan, run folders).
-//! Only `run` awaits; the engine does IO only through what it is handed.
+//! `check` (AST -> Plan), `run` (Plan + drivers -> Recording), `render` (Results -> report),
+//! `audit` (Plan vs Plan, run folders). The plan and the analysis (`fit`, `explain`,
+//! `results`) live in crates of their own (`ratecal-plan`, `ratecal-analysis`) and are
+//! re-exported here under their stage names. Only `run` awaits; the engine does IO only
+//! through what it is handed.
 
 pub mod audit;
 pub mod check;
-pub mod explain;
-pub mod fit;
-pub mod measured;
-pub mod plan;
+pub use ratecal_analysis::{explain, fit, measured, results};
+pub use ratecal_plan as plan;
 /// The recording format lives in its own crate; `crate::recording` names it here.
 pub use ratecal_recording as recording;
 pub mod render;
-pub mod results;
 pub mod run;

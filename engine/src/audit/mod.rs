@@ -16,7 +16,8 @@ mod direction;
 pub mod render;
 pub mod seal;
 pub mod verify;
-pub mod versions;
+/// Procedure folders and `versions.lock` live beside the plan (the analysis reads them too).
+pub use ratecal_plan::versions;
 
 pub use change::{Change, ChangeKind, DiffReport, Side};
 pub use diff::diff;

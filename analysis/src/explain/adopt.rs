@@ -5,9 +5,9 @@
 //! auditor the added effects. Paths are written as given (apply with `patch -p0` or
 //! `git apply -p0`).
 
-use crate::audit::versions::{Version, parse_lock, version_of_file_name};
 use ratecal_grammar::ast::{File, Fit, Item, ProcItem, Stmt, TopItem};
 use ratecal_physics::effects::Sensor;
+use ratecal_plan::versions::{Version, parse_lock, version_of_file_name};
 
 /// The procedure file a diff is made against.
 #[derive(Debug, Clone)]

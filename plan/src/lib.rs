@@ -7,6 +7,8 @@
 //! expansion would exceed a limit); `repeat N` stays a node, so a large count costs
 //! nothing to check.
 
+pub mod versions;
+
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 

@@ -13,18 +13,22 @@
 
 mod adopt;
 pub(crate) mod data;
+mod earth;
 mod locate;
 pub(crate) mod model;
 mod output;
+mod plausible;
+mod probe;
 mod select;
 mod text;
+mod unexplained;
 pub mod user;
 
 pub use adopt::{AdoptTarget, Adoption, adoption, next_version};
 pub use model::NominalModel;
 pub use output::{
-    Evidence, Explanation, FORMAT, Final, Finding, Located, Nominal, ParamOut, Rms, SegmentRms,
-    UserEffectOut,
+    Evidence, Explanation, FORMAT, Final, Finding, Located, Nominal, ParamOut, RefusedOut, Rms,
+    SegmentRms, Signature, Unexplained, UserEffectOut,
 };
 pub use text::render_text;
 pub use user::UserEffect;
@@ -126,7 +130,8 @@ pub fn explain_source<S: Source>(
         rms: rms(&data, &nom, &all),
         holdout_rms: rms(&data, &nom, &data.held),
     };
-    let (steps, rejected) = select::forward(&data, &start, opts.alpha, &opts.without);
+    let sel = select::forward(&data, &start, opts.alpha, &opts.without);
+    let (steps, rejected) = (sel.steps, sel.last_p);
     let work = data.working();
     let last = match steps.last() {
         Some(s) => s.after.clone(),
@@ -140,6 +145,8 @@ pub fn explain_source<S: Source>(
     for step in &steps {
         terms.effects.push(step.effect);
     }
+    let latitude = m.station.site.latitude_deg;
+    let held = earth::hold(&data, &mut terms, latitude);
     let whole = fit(&data, &terms, &all, &all);
     let findings: Vec<Finding> = steps
         .iter()
@@ -150,15 +157,24 @@ pub fn explain_source<S: Source>(
                 .iter()
                 .find(|u| u.id() == f.effect)
                 .map(|u| u.file().to_string());
+            if step.effect == data.earth
+                && let Some(h) = &held
+            {
+                f.parameters = h.parameters(latitude);
+            }
             f
         })
         .collect();
+    let mut unexplained = unexplained::leftover(m, &data, &terms, opts.alpha);
+    if let Some(note) = held.as_ref().and_then(|h| h.mimic(opts.alpha)) {
+        unexplained.insert(0, note);
+    }
     let floor = |cs: std::ops::Range<usize>| {
         let v: Vec<f64> = cs.map(|c| last.noise[c].sigma.powi(2)).collect();
         (v.iter().sum::<f64>() / v.len() as f64).sqrt()
     };
     let final_ = Final {
-        terms: terms.names(&data.layout),
+        terms: earth::names(&data, &terms),
         rms: rms(&data, &last, &all),
         holdout_rms: rms(&data, &last, &data.held),
         noise_floor: Rms {
@@ -185,6 +201,15 @@ pub fn explain_source<S: Source>(
             .map(|&i| m.segments[data.accs[i].seg].id.clone())
             .collect(),
         rejected,
+        refused: sel
+            .refused
+            .into_iter()
+            .map(|r| RefusedOut {
+                effect: r.effect,
+                reason: r.reason,
+            })
+            .collect(),
+        unexplained,
         adopt,
         adopt_diff: None,
         user_effects: opts
@@ -228,7 +253,9 @@ fn finding(
         };
         parameters.insert(p.name.to_string(), out);
     }
-    if let Some((lat, ulat)) = model::latitude(data, last, step.effect) {
+    if step.effect == data.earth {
+        // Replaced by the held Earth's parameters (earth::Held::parameters).
+    } else if let Some((lat, ulat)) = model::latitude(data, last, step.effect) {
         parameters.insert(
             "latitude_deg".into(),
             ParamOut::Estimate {
@@ -257,5 +284,19 @@ fn finding(
         evidence,
         rms_after: rms(data, &step.after, &all),
         defined_in: None,
+        alternatives: step
+            .alternatives
+            .iter()
+            .map(|&e| lay.effects[e].id().to_string())
+            .collect(),
+        separate_by: (!step.alternatives.is_empty()).then(|| {
+            step.alternatives
+                .iter()
+                .filter_map(|&e| lay.effects[e].params().first())
+                .map(|p| p.needs)
+                .chain(fx.params().first().map(|p| p.needs))
+                .collect::<Vec<_>>()
+                .join("; ")
+        }),
     }
 }
