@@ -42,9 +42,18 @@ fn within(params: &Value, name: &str, truth: f64, u_max: f64) {
     let (Some(x), Some(u)) = (x, u) else {
         panic!("{name}: {p}")
     };
-    println!("{name}: {x:.6} ± {u:.6} (truth {truth:.6}, {:.2} u)", (x - truth) / u);
-    assert!((x - truth).abs() < 3.0 * u, "{name}: {x} ± {u}, truth {truth}");
-    assert!(u > 0.0 && u < u_max, "{name}: u = {u} (at most {u_max} expected)");
+    println!(
+        "{name}: {x:.6} ± {u:.6} (truth {truth:.6}, {:.2} u)",
+        (x - truth) / u
+    );
+    assert!(
+        (x - truth).abs() < 3.0 * u,
+        "{name}: {x} ± {u}, truth {truth}"
+    );
+    assert!(
+        u > 0.0 && u < u_max,
+        "{name}: u = {u} (at most {u_max} expected)"
+    );
 }
 
 const AXES: [&str; 3] = ["x", "y", "z"];
@@ -92,7 +101,11 @@ fn full_procedure(dir: &Path) -> String {
             "fit gyro scale (x, y) from gyro_scale/* using gyro_bias",
             "fit gyro full (x, y) from gyro_scale/* using gyro_bias",
         );
-    assert_eq!(full.matches(" full ").count(), 2, "the standard's fits moved");
+    assert_eq!(
+        full.matches(" full ").count(),
+        2,
+        "the standard's fits moved"
+    );
     let proc_file = dir.join("full.rcal");
     std::fs::write(&proc_file, full).unwrap();
     proc_file.to_str().unwrap().to_string()
@@ -150,7 +163,9 @@ fn analyze_is_exact_on_a_noise_free_witness_recording() {
     let truth = write(&dir, &misaligned("quiet", 12).quiet()).unwrap();
     let n = &truth.nominal;
     let near = |p: &Value, name: &str, truth: f64, tol: f64| {
-        let x = p[name]["value"].as_f64().unwrap_or_else(|| panic!("{name}: {p}"));
+        let x = p[name]["value"]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{name}: {p}"));
         println!("{name}: {x:.9} (truth {truth}, off {:.2e})", x - truth);
         assert!((x - truth).abs() < tol, "{name}: {x}, truth {truth}");
     };
@@ -202,8 +217,9 @@ fn effects(v: &Value) -> Vec<String> {
 }
 
 /// The Earth's rate finding is physical: north and up components within 3 u of 15.041 deg/h
-/// projected at the site's latitude (or exact when held).
-fn earth_rate_is_the_earths(v: &Value, lat_deg: f64) {
+/// projected at the site's latitude (or exact when held), and the table's heading, when
+/// fitted, within 3 u of the truth.
+fn earth_rate_is_the_earths(v: &Value, lat_deg: f64, heading_deg: f64) {
     let f = v["findings"]
         .as_array()
         .unwrap()
@@ -216,7 +232,19 @@ fn earth_rate_is_the_earths(v: &Value, lat_deg: f64) {
         let p = &f["parameters"][name];
         let (x, u) = (p["value"].as_f64().unwrap(), p["u"].as_f64().unwrap());
         println!("earth_rate.{name}: {x:.4} ± {u:.4} (truth {truth:.4})");
-        assert!((x - truth).abs() <= (3.0 * u).max(1e-3), "{name}: {x} ± {u}");
+        assert!(
+            (x - truth).abs() <= (3.0 * u).max(1e-3),
+            "{name}: {x} ± {u}"
+        );
+    }
+    let h = &f["parameters"]["heading_deg"];
+    if h.get("value").is_some() {
+        within(&f["parameters"], "heading_deg", heading_deg, 5.0);
+    } else {
+        assert!(
+            heading_deg == 0.0,
+            "a heading of {heading_deg} deg not fitted: {f}"
+        );
     }
 }
 
@@ -227,16 +255,21 @@ fn nothing_unexplained(v: &Value) {
     }
 }
 
-/// A null witness recording: explain names the Earth's rate and nothing else.
+/// A null witness recording: explain names the Earth's rate and nothing else; on a table
+/// turned 25 deg from true north (the manifest does not say so), the same with that heading.
 #[test]
 fn explain_on_a_null_witness_recording_names_only_the_earth_rate() {
     let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("null");
-    write(&dir, &Scenario::standard("null", 21)).unwrap();
-    let v = explain(&dir);
-    assert_eq!(effects(&v), ["earth_rate"], "{v}");
-    earth_rate_is_the_earths(&v, 40.0);
-    nothing_unexplained(&v);
+    for (seed, heading_deg) in [(21, 0.0), (23, 25.0)] {
+        let dir = tmp.path().join(format!("null-{seed}"));
+        let mut s = Scenario::standard("null", seed);
+        s.station.heading_deg = heading_deg;
+        write(&dir, &s).unwrap();
+        let v = explain(&dir);
+        assert_eq!(effects(&v), ["earth_rate"], "{v}");
+        earth_rate_is_the_earths(&v, 40.0, heading_deg);
+        nothing_unexplained(&v);
+    }
 }
 
 /// A witness recording with lever arms: explain names `lever_arm`, every coordinate it
@@ -274,9 +307,12 @@ fn explain_names_the_lever_arm_of_a_witness_recording() {
         }
     }
     for d in ["rxx_mm", "ryy_mm", "rzz_mm"] {
-        assert!(f["parameters"][d].get("value").is_some(), "{d} not reported");
+        assert!(
+            f["parameters"][d].get("value").is_some(),
+            "{d} not reported"
+        );
     }
     assert!(reported >= 3);
-    earth_rate_is_the_earths(&v, 40.0);
+    earth_rate_is_the_earths(&v, 40.0, 0.0);
     nothing_unexplained(&v);
 }

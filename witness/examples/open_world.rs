@@ -12,38 +12,65 @@ use ratecal_witness::{Hidden, Plan, Scenario, write};
 
 /// Each hidden kind at a magnitude a tactical IMU can have, large enough to be seen over
 /// its noise on the standard plan.
-fn kinds() -> Vec<(&'static str, fn() -> Hidden)> {
+fn kinds() -> Vec<(&'static str, Hidden)> {
     vec![
-        ("accel-k2", || Hidden::AccelSecondOrder {
-            k2_ug_per_g2: [150.0, -120.0, 100.0],
-        }),
-        ("accel-cross", || Hidden::AccelCrossCoupling {
-            ug_per_g2: [300.0, -250.0, 0.0],
-        }),
-        ("gyro-g2", || Hidden::GyroG2 {
-            dps_per_g2: [0.006, -0.004, 0.005],
-        }),
-        ("gyro-scale-asym", || Hidden::GyroScaleAsymmetry {
-            ppm: [400.0, -300.0, 0.0],
-        }),
-        ("accel-scale-asym", || Hidden::AccelScaleAsymmetry {
-            ppm: [300.0, -250.0, 200.0],
-        }),
-        ("clock-rate", || Hidden::ClockRate { ppm: 60.0 }),
-        ("accel-bias-step", || Hidden::AccelBiasStep {
-            at_s: 110.0,
-            step_mps2: [0.004, -0.003, 0.0],
-        }),
-        ("gyro-warm-up", || Hidden::GyroWarmUp {
-            amplitude_dps: [0.03, -0.02, 0.025],
-            tau_s: 200.0,
-        }),
-        ("g-sensitivity", || Hidden::GSensitivity {
-            dps_per_g: [[0.01, 0.0, -0.008], [0.0, 0.012, 0.006], [0.0; 3]],
-        }),
-        ("lever-arm", || Hidden::LeverArm {
-            r_mm: [[-4.0, 9.0, -12.0], [3.0, 14.0, -8.0], [-6.0, 2.0, 25.0]],
-        }),
+        (
+            "accel-k2",
+            Hidden::AccelSecondOrder {
+                k2_ug_per_g2: [150.0, -120.0, 100.0],
+            },
+        ),
+        (
+            "accel-cross",
+            Hidden::AccelCrossCoupling {
+                ug_per_g2: [300.0, -250.0, 0.0],
+            },
+        ),
+        (
+            "gyro-g2",
+            Hidden::GyroG2 {
+                dps_per_g2: [0.006, -0.004, 0.005],
+            },
+        ),
+        (
+            "gyro-scale-asym",
+            Hidden::GyroScaleAsymmetry {
+                ppm: [400.0, -300.0, 0.0],
+            },
+        ),
+        (
+            "accel-scale-asym",
+            Hidden::AccelScaleAsymmetry {
+                ppm: [300.0, -250.0, 200.0],
+            },
+        ),
+        ("clock-rate", Hidden::ClockRate { ppm: 60.0 }),
+        (
+            "accel-bias-step",
+            Hidden::AccelBiasStep {
+                at_s: 110.0,
+                step_mps2: [0.004, -0.003, 0.0],
+            },
+        ),
+        (
+            "gyro-warm-up",
+            Hidden::GyroWarmUp {
+                amplitude_dps: [0.03, -0.02, 0.025],
+                tau_s: 200.0,
+            },
+        ),
+        (
+            "g-sensitivity",
+            Hidden::GSensitivity {
+                dps_per_g: [[0.01, 0.0, -0.008], [0.0, 0.012, 0.006], [0.0; 3]],
+            },
+        ),
+        (
+            "lever-arm",
+            Hidden::LeverArm {
+                r_mm: [[-4.0, 9.0, -12.0], [3.0, 14.0, -8.0], [-6.0, 2.0, 25.0]],
+            },
+        ),
     ]
 }
 
@@ -72,9 +99,9 @@ fn main() -> std::io::Result<()> {
         listed.push(serde_json::json!({ "recording": name, "hidden": truth.hidden }));
         Ok(())
     };
-    for (name, make) in kinds() {
-        for seed in 1..=3 {
-            put(format!("{name}-{seed}"), 1000 + seed, Some(make()))?;
+    for seed in 1..=3 {
+        for (name, hidden) in kinds() {
+            put(format!("{name}-{seed}"), 1000 + seed, Some(hidden))?;
         }
     }
     for seed in 1..=nulls {

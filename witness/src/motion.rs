@@ -349,19 +349,15 @@ impl Builder {
             len,
             axes,
         };
-        for i in 0..2 {
-            let [a, w, _] = axes[i].eval(len, len);
-            self.angle[i] = a;
-            self.rate[i] = w;
-        }
-        // A ramp to rest ends at exactly zero rate (cos(pi) leaves ~1e-16 otherwise).
         for (i, piece) in axes.iter().enumerate() {
-            if let Piece::Ramp { w1, .. } | Piece::Spin { w: w1, .. } = piece {
-                self.rate[i] = *w1;
-            }
-            if matches!(piece, Piece::Rest(_) | Piece::Move { .. }) {
-                self.rate[i] = 0.0;
-            }
+            let [a, w, _] = piece.eval(len, len);
+            self.angle[i] = a;
+            // A ramp ends at exactly its rate (cos(pi) leaves ~1e-16 otherwise).
+            self.rate[i] = match piece {
+                Piece::Ramp { w1, .. } | Piece::Spin { w: w1, .. } => *w1,
+                Piece::Rest(_) | Piece::Move { .. } => 0.0,
+            };
+            debug_assert!((self.rate[i] - w).abs() < 1e-9);
         }
         self.phases.push(p);
         self.t += len;
@@ -397,7 +393,9 @@ impl Builder {
 
     /// Cosine move of both (resting) axes to `target` at peak rate `rate`.
     fn move_to(&mut self, target: [f64; 2], rate: f64) {
-        let d = (0..2).map(|i| (target[i] - self.angle[i]).abs()).fold(0.0, f64::max);
+        let d = (0..2)
+            .map(|i| (target[i] - self.angle[i]).abs())
+            .fold(0.0, f64::max);
         if d == 0.0 {
             return;
         }

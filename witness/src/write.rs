@@ -175,11 +175,7 @@ fn normal(rng: &mut ChaCha8Rng) -> f64 {
 }
 
 /// Writes imu.csv; returns the wandering bias's mean over each segment.
-fn write_imu(
-    path: &Path,
-    s: &Scenario,
-    timeline: &Timeline,
-) -> io::Result<BTreeMap<String, V3>> {
+fn write_imu(path: &Path, s: &Scenario, timeline: &Timeline) -> io::Result<BTreeMap<String, V3>> {
     let segs = &timeline.segments;
     let mut sums = vec![([0.0f64; 3], 0.0f64); segs.len()];
     let mut f = BufWriter::new(File::create(path)?);

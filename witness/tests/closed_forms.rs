@@ -150,8 +150,14 @@ fn the_timeline_and_the_kinematics_are_consistent() {
         let [o1, i1] = tl.state(t + h);
         let [o0, i0] = tl.state(t - h);
         for (x, x1, x0) in [(o, o1, o0), (i, i1, i0)] {
-            assert!(((x1[0] - x0[0]) / (2.0 * h) - x[1]).abs() < 1e-4, "rate at {t}");
-            assert!(((x1[1] - x0[1]) / (2.0 * h) - x[2]).abs() < 1e-3, "accel at {t}");
+            assert!(
+                ((x1[0] - x0[0]) / (2.0 * h) - x[1]).abs() < 1e-4,
+                "rate at {t}"
+            );
+            assert!(
+                ((x1[1] - x0[1]) / (2.0 * h) - x[2]).abs() < 1e-3,
+                "accel at {t}"
+            );
         }
         let (a, a1, a0) = (
             s.instant(&tl, t),
