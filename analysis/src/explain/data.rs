@@ -1,10 +1,10 @@
 //! The recording accumulated once for every model explain will try: every segment, every
 //! registry effect's columns, and which segments are held out.
 
-use crate::fit::Source;
-use crate::fit::joint::{Layout, SegAcc, excitation};
 use super::earth::EARTH_HELD;
 use super::probe::{self, Probe};
+use crate::fit::Source;
+use crate::fit::joint::{Layout, SegAcc, excitation};
 use crate::recording::SegmentKind;
 use ratecal_physics::Effect;
 
@@ -127,6 +127,7 @@ impl Data {
             accel: accel.iter().map(|&i| &self.accs[i]).collect(),
             gyro: gyro.iter().map(|&i| &self.accs[i]).collect(),
             merged: None,
+            white_only: false,
         };
         let m = std::sync::Arc::new(crate::fit::joint::merge(&req));
         let mut cache = self.merged.lock().expect("not poisoned");

@@ -10,8 +10,8 @@
 //! model then holds the Earth's rate at its physical value, and what mimics it is left to
 //! the tests for what remains unexplained.
 
-use ratecal_physics::effects::{Effect, EarthRate, Param, Partials, Sensor, Signals};
 use ratecal_physics::DEG;
+use ratecal_physics::effects::{EarthRate, Effect, Param, Partials, Sensor, Signals};
 
 /// The candidate (its id is the registry's `earth_rate`).
 #[derive(Debug)]
@@ -105,7 +105,11 @@ pub(crate) struct Held {
 /// When `terms` holds the candidate, replaces it by the Earth's rate at the manifest's
 /// latitude (the registry's `earth_rate`, fixed) with only the East component free (the
 /// heading), in two passes so that a heading of tens of degrees is exact.
-pub(crate) fn hold(data: &super::data::Data, terms: &mut super::model::Terms, latitude_deg: f64) -> Option<Held> {
+pub(crate) fn hold(
+    data: &super::data::Data,
+    terms: &mut super::model::Terms,
+    latitude_deg: f64,
+) -> Option<Held> {
     let lay = &data.layout;
     if !terms.effects.contains(&data.earth) {
         return None;
@@ -197,7 +201,8 @@ impl Held {
 
 /// The final model's term names, the Earth's rate said once.
 pub(crate) fn names(data: &super::data::Data, terms: &super::model::Terms) -> Vec<String> {
-    let held = terms.effects.contains(&data.earth) && terms.skip.contains(&data.layout.first[data.earth]);
+    let held =
+        terms.effects.contains(&data.earth) && terms.skip.contains(&data.layout.first[data.earth]);
     terms
         .names(&data.layout)
         .into_iter()

@@ -81,7 +81,12 @@ pub fn explain_source<S: Source>(
     let mut effects: Vec<&'static dyn Effect> = REGISTRY.to_vec();
     effects.extend(opts.user.iter().map(|u| *u as &'static dyn Effect));
     let nonfinite: Vec<usize> = opts.user.iter().map(|u| u.nonfinite()).collect();
+    let clock = std::time::Instant::now();
+    let debug = std::env::var_os("RATECAL_EXPLAIN_DEBUG").is_some();
     let data = Data::with_effects(src, effects)?;
+    if debug {
+        eprintln!("accumulated in {:?}", clock.elapsed());
+    }
     let m = src.manifest();
     let lay = &data.layout;
     let mut warnings = Vec::new();
@@ -131,6 +136,9 @@ pub fn explain_source<S: Source>(
         holdout_rms: rms(&data, &nom, &data.held),
     };
     let sel = select::forward(&data, &start, opts.alpha, &opts.without);
+    if debug {
+        eprintln!("selected in {:?}", clock.elapsed());
+    }
     let (steps, rejected) = (sel.steps, sel.last_p);
     let work = data.working();
     let last = match steps.last() {
@@ -166,6 +174,9 @@ pub fn explain_source<S: Source>(
         })
         .collect();
     let mut unexplained = unexplained::leftover(m, &data, &terms, opts.alpha);
+    if debug {
+        eprintln!("leftover tested in {:?}", clock.elapsed());
+    }
     if let Some(note) = held.as_ref().and_then(|h| h.mimic(opts.alpha)) {
         unexplained.insert(0, note);
     }

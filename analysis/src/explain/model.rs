@@ -81,6 +81,17 @@ pub(crate) fn fit(
     accel: &[usize],
     gyro: &[usize],
 ) -> (Fit, Vec<usize>) {
+    fit_with(data, terms, accel, gyro, false)
+}
+
+/// [`fit`] with a white-noise covariance only (`white_only`): to rank many models cheaply.
+pub(crate) fn fit_with(
+    data: &Data,
+    terms: &Terms,
+    accel: &[usize],
+    gyro: &[usize],
+    white_only: bool,
+) -> (Fit, Vec<usize>) {
     let merged = data.merged(accel, gyro);
     fit_terms_merged(
         &data.layout,
@@ -90,6 +101,7 @@ pub(crate) fn fit(
         accel,
         gyro,
         Some(&merged),
+        white_only,
     )
 }
 

@@ -24,14 +24,10 @@ pub(crate) enum Form {
     ForceProduct(usize, usize),
     /// `|f_i|` (accel: m/s^2; gyro: per g).
     ForceAbs,
-    /// `f_i^3` (accel: `/ g^2`; gyro: `/ g^3`).
-    ForceCube,
     /// `|w_ib,i|`, deg/s.
     RateAbs,
     /// `w_ib,i^2` (deg/s)^2: even in the rate.
     RateSquare,
-    /// `w_ib,i^3` (deg/s)^3.
-    RateCube,
     /// `(t - t0) / 3600`: a linear drift per hour.
     Drift { t0: f64 },
     /// `exp(-(t - t0) / tau)`: a decay since the recording began.
@@ -92,11 +88,8 @@ impl Probe {
             Form::ForceProduct(j, k) => format!("f_b.{} * f_b.{} / g", AXES[j], AXES[k]),
             Form::ForceAbs if gyro => format!("abs(f_b.{a}) / g"),
             Form::ForceAbs => format!("abs(f_b.{a})"),
-            Form::ForceCube if gyro => format!("f_b.{a}^3 / g^3"),
-            Form::ForceCube => format!("f_b.{a}^3 / g^2"),
             Form::RateAbs => format!("abs(w_ib.{a} / deg)"),
             Form::RateSquare => format!("(w_ib.{a} / deg)^2"),
-            Form::RateCube => format!("(w_ib.{a} / deg)^3"),
             Form::Drift { t0 } => format!("(t_s - {t0}) / 3600"),
             Form::Decay { t0, tau } => format!("exp(-(t_s - {t0}) / {tau})"),
             Form::Step { at } => format!("(sign(t_s - {at:.1}) + 1) / 2"),
@@ -113,10 +106,8 @@ impl Probe {
             Form::ForceSquare => f[i] * f[i] / if gyro { g * g } else { g },
             Form::ForceProduct(j, k) => f[j] * f[k] / if gyro { g * g } else { g },
             Form::ForceAbs => f[i].abs() / if gyro { g } else { 1.0 },
-            Form::ForceCube => f[i].powi(3) / if gyro { g.powi(3) } else { g * g },
             Form::RateAbs => w[i].abs(),
             Form::RateSquare => w[i] * w[i],
-            Form::RateCube => w[i].powi(3),
             Form::Drift { t0 } => (s.t_s - t0) / 3600.0,
             Form::Decay { t0, tau } => (-(s.t_s - t0).max(0.0) / tau).exp(),
             // Derived from the bias column (add_steps): never evaluated per sample.
@@ -154,10 +145,8 @@ impl Probe {
             Form::ForceAbs => {
                 "the output depends on the sign of the specific force: scale asymmetry (+g and -g differ)"
             }
-            Form::ForceCube => "the output grows with the cube of the specific force: odd-order nonlinearity",
             Form::RateAbs => "the output depends on the sign of the rate: scale asymmetry",
             Form::RateSquare => "the output grows with the square of the rate, whatever its sign",
-            Form::RateCube => "the output grows with the cube of the rate: odd-order scale nonlinearity",
             Form::Drift { .. } => "the bias drifts linearly with time",
             Form::Decay { .. } => "the bias decays with time since the recording began: warm-up",
             Form::Step { .. } => "the bias jumps between two segments: a bias step",
@@ -194,7 +183,7 @@ impl Effect for Probe {
 }
 
 /// Time constants of the decays tried, s.
-const DECAYS_S: [f64; 2] = [120.0, 900.0];
+const DECAYS_S: [f64; 1] = [600.0];
 
 /// The sampled probes for a recording that begins at `t0`.
 pub(crate) fn sampled(t0: f64) -> Vec<&'static Probe> {
@@ -206,11 +195,10 @@ pub(crate) fn sampled(t0: f64) -> Vec<&'static Probe> {
             Form::ForceProduct(0, 2),
             Form::ForceProduct(1, 2),
             Form::ForceAbs,
-            Form::ForceCube,
             Form::Drift { t0 },
         ];
         if sensor == Sensor::Gyro {
-            forms.extend([Form::RateAbs, Form::RateSquare, Form::RateCube]);
+            forms.extend([Form::RateAbs, Form::RateSquare]);
         }
         forms.extend(DECAYS_S.iter().map(|&tau| Form::Decay { t0, tau }));
         out.extend(forms.into_iter().map(|f| Probe::new(sensor, f)));
@@ -303,4 +291,40 @@ pub(crate) fn add_steps(
         }
     }
     added
+}
+
+/// Probes most worth a full test beside `terms` over `segs`: each probe fitted with a
+/// white-noise covariance (cheap), its Wald statistic per sensor, the `keep` strongest of
+/// each sensor kept, strongest first.
+pub(crate) fn screen(
+    data: &super::data::Data,
+    terms: &super::model::Terms,
+    segs: &[usize],
+    keep: usize,
+) -> Vec<usize> {
+    use rayon::prelude::*;
+    let lay = &data.layout;
+    let mut scored: Vec<(usize, Sensor, f64)> = data
+        .probes
+        .par_iter()
+        .map(|&(e, p)| {
+            let mut t = terms.clone();
+            t.effects.push(e);
+            let (f, _) = super::model::fit_with(data, &t, segs, segs, true);
+            let cols: Vec<usize> = lay.columns_of(e).collect();
+            (e, p.sensor, super::select::wald(&f, &cols).0)
+        })
+        .collect();
+    scored.sort_by(|a, b| b.2.total_cmp(&a.2));
+    let mut out = Vec::new();
+    for sensor in [Sensor::Accel, Sensor::Gyro] {
+        out.extend(
+            scored
+                .iter()
+                .filter(|s| s.1 == sensor)
+                .take(keep)
+                .map(|s| s.0),
+        );
+    }
+    out
 }

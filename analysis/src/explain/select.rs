@@ -126,10 +126,11 @@ struct ProbeTry {
 fn try_probes(data: &Data, terms: &Terms, work: &[usize], n: usize) -> Vec<ProbeTry> {
     use rayon::prelude::*;
     let lay = &data.layout;
-    let mut out: Vec<ProbeTry> = data
-        .probes
+    // A white-noise screen first: only the strongest probes get the honest covariance.
+    let short = super::probe::screen(data, terms, work, 4);
+    let mut out: Vec<ProbeTry> = short
         .par_iter()
-        .map(|&(e, _)| {
+        .map(|&e| {
             let mut t = terms.clone();
             t.effects.push(e);
             let (f, _) = fit(data, &t, work, work);
@@ -205,7 +206,10 @@ pub(crate) fn forward(data: &Data, start: &Terms, alpha: f64, without: &[String]
         .filter(|e| {
             !without.iter().any(|w| w == lay.effects[*e].id())
                 && !terms.effects.contains(e)
-                && !terms.fixed.iter().any(|f| lay.effects[f.0].id() == lay.effects[*e].id())
+                && !terms
+                    .fixed
+                    .iter()
+                    .any(|f| lay.effects[f.0].id() == lay.effects[*e].id())
         })
         .collect();
     let n: usize = work.iter().map(|&i| 6 * data.accs[i].n).sum();
@@ -313,7 +317,7 @@ pub(crate) fn forward(data: &Data, start: &Terms, alpha: f64, without: &[String]
         // A probe that explains what the candidate explains, and more, takes precedence:
         // the strongest probes on the candidate's sensors, tried together.
         let probes = try_probes(data, &terms, &work, n);
-        let a_probe = alpha / probes.len().max(1) as f64;
+        let a_probe = alpha / data.probes.len().max(1) as f64;
         let sensors = lay.effects[e].sensors();
         let rivals: Vec<&ProbeTry> = probes
             .iter()

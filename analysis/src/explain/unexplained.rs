@@ -19,6 +19,8 @@ use ratecal_physics::effects::Sensor;
 
 /// Most forms listed in a signature.
 const MOST_FORMS: usize = 5;
+/// Probes per sensor given the honest test after the white-noise screen.
+const SCREEN: usize = 8;
 /// Most segments listed.
 const MOST_SEGMENTS: usize = 8;
 
@@ -49,17 +51,19 @@ pub(crate) fn leftover(m: &Manifest, data: &Data, terms: &Terms, alpha: f64) -> 
     let lay = &data.layout;
     let all: Vec<usize> = (0..data.accs.len()).collect();
     let (base, _) = fit(data, terms, &all, &all);
-    let fits: Vec<Fit> = data
-        .probes
+    // Screened with white noise alone; the strongest of each sensor get the honest
+    // covariance. The correction still counts every probe's every column.
+    let short = super::probe::screen(data, terms, &all, SCREEN);
+    let fits: Vec<Fit> = short
         .par_iter()
-        .map(|&(e, _)| {
+        .map(|&e| {
             let mut t = terms.clone();
             t.effects.push(e);
             fit(data, &t, &all, &all).0
         })
         .collect();
     let mut tests = Vec::new();
-    for (k, &(e, _)) in data.probes.iter().enumerate() {
+    for (k, &e) in short.iter().enumerate() {
         let f = &fits[k];
         for g in lay.columns_of(e) {
             if !f.estimated.contains(&g) {
@@ -81,7 +85,7 @@ pub(crate) fn leftover(m: &Manifest, data: &Data, terms: &Terms, alpha: f64) -> 
             });
         }
     }
-    let m_tests = tests.len().max(1) as f64;
+    let m_tests = (3 * data.probes.len()).max(1) as f64;
     let p_adj = |chi2: f64| (p_value(chi2, 1) * m_tests).min(1.0);
     let mut out = Vec::new();
     for sensor in [Sensor::Accel, Sensor::Gyro] {

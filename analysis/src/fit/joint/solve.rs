@@ -25,6 +25,9 @@ pub(crate) struct FitRequest<'a> {
     /// The channels' factors over exactly these segments, when the caller keeps them
     /// ([`merge`]): many models over the same segments then share one merge.
     pub merged: Option<&'a [DMatrix<f64>]>,
+    /// Whether the covariance may omit the wandering bias (white noise only): a cheap
+    /// screen of many models, never a reported uncertainty.
+    pub white_only: bool,
 }
 
 /// A solved model.
@@ -207,7 +210,7 @@ pub(crate) fn solve(req: &FitRequest) -> Fit {
         let nz = &noise[c];
         let white = nz.sigma * nz.sigma * nz.phi;
         meat += (xl.transpose() * &xl) * (w[c] * w[c] * white);
-        if nz.q > 0.0 {
+        if nz.q > 0.0 && !req.white_only {
             let m = noise::random_walk_gram(req.segs(c), c, &local, p);
             meat += m * (w[c] * w[c] * nz.q);
         }

@@ -64,11 +64,12 @@ pub(crate) fn fit_terms(
     accel: &[usize],
     gyro: &[usize],
 ) -> (Fit, Vec<usize>) {
-    fit_terms_merged(layout, accs, excitation, terms, accel, gyro, None)
+    fit_terms_merged(layout, accs, excitation, terms, accel, gyro, None, false)
 }
 
 /// [`fit_terms`] with the channels' factors over these segments already merged
-/// ([`super::solve::merge`]).
+/// ([`super::solve::merge`]); `white_only` leaves the wandering bias out of the covariance.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn fit_terms_merged(
     layout: &Layout,
     accs: &[SegAcc],
@@ -77,6 +78,7 @@ pub(crate) fn fit_terms_merged(
     accel: &[usize],
     gyro: &[usize],
     merged: Option<&[nalgebra::DMatrix<f64>]>,
+    white_only: bool,
 ) -> (Fit, Vec<usize>) {
     let mut cols = Vec::new();
     let mut weak = Vec::new();
@@ -122,6 +124,7 @@ pub(crate) fn fit_terms_merged(
         accel: accel.iter().map(|&i| &accs[i]).collect(),
         gyro: gyro.iter().map(|&i| &accs[i]).collect(),
         merged,
+        white_only,
     };
     let f = solve(&req);
     let mut unobs = f.unobservable.clone();
