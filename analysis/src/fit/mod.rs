@@ -16,6 +16,7 @@ mod models;
 pub(crate) mod prep;
 mod repeat;
 mod residuals;
+mod sanity;
 mod segment;
 mod select;
 pub mod size_effect;
@@ -186,6 +187,15 @@ pub fn analyze_source<S: Source>(
             }
         }
     }
+    let mut checks = sanity::recording_checks(
+        m,
+        &sums,
+        &src.imu_cadence(),
+        src.imu_extent(),
+        src.table(),
+        &mut out.warnings,
+    );
+    checks.push(sanity::plausible(&out.params));
     out.residuals = fitted.residuals.iter().map(|(r, _)| r.clone()).collect();
     unfitted_residual_warnings(&fitted.residuals, &mut out);
     let (verification, wh) = accept::verify(&sel, &sums, &out, m);
@@ -200,6 +210,7 @@ pub fn analyze_source<S: Source>(
     let mut res = Results {
         format: results::FORMAT.into(),
         verdict: results::RunVerdict::default(),
+        sanity: checks,
         parameters: std::mem::take(&mut out.params),
         acceptance: Vec::new(),
         observability: std::mem::take(&mut out.observability),
