@@ -18,6 +18,11 @@ pub struct Results {
     /// `aborted`, `not_judged`); an older results file without one reads as `incomplete`.
     #[serde(default)]
     pub verdict: RunVerdict,
+    /// Why the verdict is what it is, when the checks alone do not say it: the failed
+    /// sanity checks (`incomplete`: not fit for judgment) or why nothing was judged
+    /// (`not_judged`). The terminal and the report print this sentence.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub verdict_reason: Option<String>,
     /// The sanity checks (what physics guarantees of any recording), one entry per check,
     /// always all of them; a failed one makes the verdict `incomplete`.
     #[serde(default)]
@@ -522,6 +527,31 @@ impl Results {
         } else {
             RunVerdict::Pass
         };
+        self.verdict_reason = self.reason();
+    }
+
+    /// The sentence `verdict_reason` holds for the verdict decided.
+    fn reason(&self) -> Option<String> {
+        let failed: Vec<&str> = self.sanity_failures().map(|c| c.check.as_str()).collect();
+        match self.verdict {
+            RunVerdict::Incomplete if !failed.is_empty() => Some(format!(
+                "the recording is not fit for judgment: sanity check{} {} failed",
+                if failed.len() == 1 { "" } else { "s" },
+                failed.join(", ")
+            )),
+            RunVerdict::NotJudged => Some(match &self.model.procedure {
+                Some(p) if self.acceptance.is_empty() => format!(
+                    "procedure {} {} declares no acceptance check: the results are measurements, not judged against any standard",
+                    p.name, p.version
+                ),
+                Some(p) => format!(
+                    "the checks of procedure {} {} are decided over several runs, none on this one: the results are measurements, not judged",
+                    p.name, p.version
+                ),
+                None => "analysed without a procedure: no acceptance check applies; the results are measurements, not judged against any standard".into(),
+            }),
+            _ => None,
+        }
     }
 
     /// An estimate by name: `(value, u)`.
@@ -605,9 +635,9 @@ mod tests {
                 false,
                 RunVerdict::Fail,
             ),
-            (vec![Verdict::Pass], true, RunVerdict::Aborted),
             (vec![], false, RunVerdict::NotJudged),
             (vec![Verdict::Deferred], false, RunVerdict::NotJudged),
+            (vec![Verdict::Pass], true, RunVerdict::Aborted),
         ];
         for (checks, aborted, want) in cases {
             r.acceptance = checks.iter().copied().map(check).collect();

@@ -193,35 +193,11 @@ pub(crate) fn verdict_lines(r: &Results) -> Vec<String> {
     for w in &r.warnings {
         out.push(format!("  warning: {w}"));
     }
-    let failed: Vec<&str> = r.sanity_failures().map(|c| c.check.as_str()).collect();
-    let why = match r.verdict {
-        _ if !failed.is_empty() && r.verdict != RunVerdict::Aborted => format!(
-            " (not fit for judgment: sanity check {} failed)",
-            failed.join(", ")
-        ),
-        RunVerdict::NotJudged => format!(" ({})", not_judged_reason(r)),
-        _ => String::new(),
-    };
+    let why = r
+        .verdict_reason
+        .as_ref()
+        .map(|w| format!(" ({w})"))
+        .unwrap_or_default();
     out.push(format!("verdict: {}{why}", r.verdict.label()));
     out
-}
-
-/// Why nothing was judged, in the words the report uses.
-pub(crate) fn not_judged_reason(r: &Results) -> String {
-    match &r.model.procedure {
-        Some(p) => {
-            if r.acceptance.is_empty() {
-                format!(
-                    "procedure {} {} declares no acceptance check: the figures are measurements, not judged against any standard",
-                    p.name, p.version
-                )
-            } else {
-                format!(
-                    "procedure {} {}'s checks are decided over several runs: the figures are measurements, not judged on this run",
-                    p.name, p.version
-                )
-            }
-        }
-        _ => "no procedure: no acceptance check applies; the figures are measurements, not judged against any standard".into(),
-    }
 }

@@ -210,6 +210,7 @@ pub fn analyze_source<S: Source>(
     let mut res = Results {
         format: results::FORMAT.into(),
         verdict: results::RunVerdict::default(),
+        verdict_reason: None,
         sanity: checks,
         parameters: std::mem::take(&mut out.params),
         acceptance: Vec::new(),
@@ -347,7 +348,7 @@ fn unfitted_residual_warnings(rs: &[(ResidualStats, bool)], out: &mut Out) {
             && r.mean.abs() > 5.0 * noise
         {
             out.warnings.push(format!(
-                "{sensor} {} residual on segment {}, which the {sensor} fit does not use: mean {:.4} {}, {:.0} times the fit's noise: the model leaves out {physics}; see `ratecal explain`",
+                "{sensor} {} residual on segment {}, which the {sensor} fit does not use: mean {:.4} {}, {:.0} times the fit's noise: the nominal model does not describe that segment ({physics}, or a disturbance during it); `ratecal explain` tests the catalogue's effects against it and says whether one accounts for it",
                 r.channel,
                 r.segment,
                 r.mean,

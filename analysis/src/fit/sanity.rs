@@ -24,6 +24,11 @@ pub const ACCEL_BIAS_MAX: f64 = 1.0;
 pub const GYRO_BIAS_MAX: f64 = 10.0;
 /// Largest plausible misalignment (cross-coupling), mrad (about 6 deg).
 pub const MISALIGNMENT_MAX: f64 = 100.0;
+/// Largest plausible size-effect coordinate (an accelerometer's sensing point from the
+/// IMU's reference centre), mm: inside the case of any IMU.
+pub const SIZE_EFFECT_MAX_MM: f64 = 300.0;
+/// Largest plausible lever arm (a sensing point from the table's axes), mm: on the platform.
+pub const LEVER_ARM_MAX_MM: f64 = 1000.0;
 /// Largest plausible tilt of a static attitude from the one the table reports, deg (a
 /// hand on a bench does better).
 pub const ATTITUDE_MAX_DEG: f64 = 10.0;
@@ -328,8 +333,8 @@ fn verdict(name: &str, worst: Option<(f64, String)>, none: &str, hint: &str) -> 
     }
 }
 
-/// `fitted_values_plausible`: the fitted biases, scale factors and misalignments inside
-/// the ranges an IMU of any grade has (a scale factor of -90 % is a units error, not a
+/// `fitted_values_plausible`: the fitted biases, scale factors, misalignments, lever arms
+/// and size-effect coordinates inside the ranges an IMU of any grade and a table have (a scale factor of -90 % is a units error, not a
 /// calibration).
 pub(crate) fn plausible(params: &BTreeMap<String, Parameter>) -> SanityCheck {
     let name = "fitted_values_plausible";
@@ -340,6 +345,8 @@ pub(crate) fn plausible(params: &BTreeMap<String, Parameter>) -> SanityCheck {
             ("accel", "bias", "m/s^2") => Some(ACCEL_BIAS_MAX),
             ("gyro", "bias", "deg/s") => Some(GYRO_BIAS_MAX),
             ("accel" | "gyro", "misalignment", "mrad") => Some(MISALIGNMENT_MAX),
+            ("size_effect", _, "mm") => Some(SIZE_EFFECT_MAX_MM),
+            ("lever_arm", _, "mm") => Some(LEVER_ARM_MAX_MM),
             _ => None,
         }
     };
@@ -361,7 +368,7 @@ pub(crate) fn plausible(params: &BTreeMap<String, Parameter>) -> SanityCheck {
         return SanityCheck::new(
             name,
             SanityStatus::NotEvaluated,
-            "no bias, scale factor or misalignment was fitted",
+            "no bias, scale factor, misalignment, lever arm or size effect was fitted",
         );
     }
     if out.is_empty() {
@@ -369,7 +376,7 @@ pub(crate) fn plausible(params: &BTreeMap<String, Parameter>) -> SanityCheck {
             name,
             SanityStatus::Pass,
             format!(
-                "{checked} fitted biases, scale factors and misalignments within +-{:.0} % scale, +-{ACCEL_BIAS_MAX} m/s^2 and +-{GYRO_BIAS_MAX} deg/s bias, +-{MISALIGNMENT_MAX} mrad",
+                "{checked} fitted values within +-{:.0} % scale, +-{ACCEL_BIAS_MAX} m/s^2 and +-{GYRO_BIAS_MAX} deg/s bias, +-{MISALIGNMENT_MAX} mrad misalignment, +-{LEVER_ARM_MAX_MM} mm lever arm, +-{SIZE_EFFECT_MAX_MM} mm size effect",
                 SCALE_MAX * 100.0
             ),
         )
