@@ -4,6 +4,8 @@
 
 mod shared;
 
+pub use shared::shared_example;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 

@@ -423,3 +423,41 @@ pub(crate) fn merge(runs: &[&[SanityCheck]]) -> Vec<SanityCheck> {
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_units_error_is_not_a_plausible_calibration() {
+        let mut p = BTreeMap::new();
+        p.insert(
+            "accel.scale.x".to_string(),
+            Parameter::estimate(-650.0, 5.0, "ppm"),
+        );
+        p.insert("gyro.scale.z".to_string(), Parameter::unobservable());
+        assert_eq!(plausible(&p).status, SanityStatus::Pass);
+        // Accelerometers in g: K = 1 / 9.81.
+        p.insert(
+            "accel.scale.y".to_string(),
+            Parameter::estimate(-898_000.0, 5.0, "ppm"),
+        );
+        let c = plausible(&p);
+        assert_eq!(c.status, SanityStatus::Fail);
+        assert!(c.detail.contains("accel.scale.y") && !c.detail.contains("accel.scale.x"));
+        assert_eq!(
+            plausible(&BTreeMap::new()).status,
+            SanityStatus::NotEvaluated
+        );
+    }
+
+    #[test]
+    fn several_runs_fail_a_check_when_one_does() {
+        let ok = [SanityCheck::new("gyro_at_rest", SanityStatus::Pass, "a")];
+        let bad = [SanityCheck::new("gyro_at_rest", SanityStatus::Fail, "b")];
+        let m = merge(&[&ok, &bad]);
+        assert_eq!(m.len(), 1);
+        assert_eq!(m[0].status, SanityStatus::Fail);
+        assert_eq!(m[0].detail, "run 1: a; run 2: b");
+    }
+}
