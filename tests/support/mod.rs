@@ -4,8 +4,6 @@
 
 mod shared;
 
-pub use shared::shared_example;
-
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -93,6 +91,11 @@ pub fn mini_run(dir: &Path, out: &str, extra: &[&str]) -> Output {
     let mut args = vec!["run", "p.rcal", "--dry-run", "--out", out];
     args.extend_from_slice(extra);
     ratecal(&args, dir)
+}
+
+/// `../shared/examples/<name>`, or `None` with a "skipped" line when this machine lacks it.
+pub fn shared_example(name: &str) -> Option<PathBuf> {
+    shared::shared_example(name)
 }
 
 /// The shared lever-arm example recording (`../shared/examples/standard-with-lever-arm`),
