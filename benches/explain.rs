@@ -17,10 +17,42 @@ fn recording() -> PathBuf {
     dir
 }
 
+/// A dry run of `procedures/imu-2d-standard` at 100 Hz (1 h 13 min, 437,000 IMU rows): the
+/// figure issue 27 names.
+fn standard_dry_run() -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/explain-bench-standard");
+    if !dir.join("imu.csv").exists() {
+        let _ = std::fs::remove_dir_all(&dir);
+        let st = Command::new(env!("CARGO_BIN_EXE_ratecal"))
+            .args(["run", "procedures/imu-2d-standard", "--dry-run", "--out"])
+            .arg(&dir)
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .stdout(std::process::Stdio::null())
+            .status()
+            .expect("ratecal runs");
+        assert!(st.code().is_some_and(|c| c == 0 || c == 3), "{st}");
+    }
+    dir
+}
+
 fn bench(c: &mut Criterion) {
     let dir = recording();
+    let standard = standard_dry_run();
     let mut g = c.benchmark_group("explain");
     g.sample_size(10).measurement_time(Duration::from_secs(20));
+    g.bench_function("cli_standard_dry_run", |b| {
+        b.iter(|| {
+            let st = Command::new(env!("CARGO_BIN_EXE_ratecal"))
+                .arg("explain")
+                .arg(&standard)
+                .arg("--format")
+                .arg("json")
+                .stdout(std::process::Stdio::null())
+                .status()
+                .expect("ratecal runs");
+            assert!(st.code().is_some_and(|c| c == 0 || c == 1), "{st}");
+        })
+    });
     g.bench_function("cli", |b| {
         b.iter(|| {
             let st = Command::new(env!("CARGO_BIN_EXE_ratecal"))

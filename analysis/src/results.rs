@@ -85,6 +85,58 @@ pub struct JointFit {
 pub struct SizeEffectDrifts {
     /// One entry per oscillation segment used.
     pub segments: Vec<SegmentDriftReport>,
+    /// One entry per cycle (navigation run): how well its periods cancelled the
+    /// instrumental terms.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub cycles: Vec<SizeEffectCycle>,
+    /// The segments the size effect could not use, and why.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub left_out: Vec<SegmentLeftOut>,
+}
+
+/// A segment of a `fit size_effect` left out of it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SegmentLeftOut {
+    /// Segment id.
+    pub segment: String,
+    /// Why it was left out.
+    pub reason: String,
+}
+
+/// One swaying cycle: its segments, the axis it held up, and the instrumental terms its
+/// periods cancelled.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SizeEffectCycle {
+    /// The static segment it aligned on.
+    pub align: String,
+    /// Its oscillation segments, in time order.
+    pub segments: Vec<String>,
+    /// The body axis nearest the sway axis (`x`, `y`, `z`) and its angle from it, deg.
+    pub up_axis: String,
+    /// Angle of the up axis from the sway axis, deg.
+    pub up_axis_off_deg: f64,
+    /// The shortest and longest period, s.
+    pub periods_s: [f64; 2],
+    /// East and North drift (mean acceleration error) at the shortest period less that at
+    /// the longest, m/s^2: size effect, plus whatever the periods did not cancel.
+    pub difference_mps2: [f64; 2],
+    /// The part of that difference the size-effect coordinates explain, m/s^2.
+    pub size_effect_mps2: [f64; 2],
+    /// The part due to the tilt error growing between the two spans (measured at rest),
+    /// m/s^2; subtracted before the coordinates.
+    pub tilt_change_mps2: [f64; 2],
+    /// What remains, m/s^2: against `u` it says how well the periods cancelled.
+    pub residual_mps2: [f64; 2],
+    /// Standard uncertainty of the difference, m/s^2.
+    pub u_mps2: [f64; 2],
+    /// The period-independent instrumental term while swaying, East and North, m/s^2,
+    /// `[value, u]` each; absent when the cycle swayed at one period (then not cancelled).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub instrumental_mps2: Option<[[f64; 2]; 2]>,
+    /// Growth of the tilt error times g while swaying, East and North, m/s^3.
+    pub tilt_growth_mps3: [f64; 2],
+    /// How many stretches at rest measured the tilt.
+    pub rests: usize,
 }
 
 /// One oscillation segment of the size-effect fit.
@@ -100,6 +152,24 @@ pub struct SegmentDriftReport {
     pub north_mps2: [f64; 2],
     /// Navigation velocity at about 1 Hz: `[t s, East m/s, North m/s]`.
     pub velocity: Vec<[f64; 3]>,
+    /// The cycle it belongs to (index into `cycles`).
+    #[serde(default)]
+    pub cycle: usize,
+    /// The body axis nearest the sway axis: `x`, `y` or `z`.
+    #[serde(default)]
+    pub up_axis: String,
+    /// Angle of the sway axis from the vertical, deg.
+    #[serde(default)]
+    pub sway_axis_tilt_deg: f64,
+    /// Change of the East and North acceleration error over the span, m/s^3, `[value, u]`.
+    #[serde(default)]
+    pub trend_mps3: [[f64; 2]; 2],
+    /// The instrumental part of its drift (constant and tilt), East and North, m/s^2.
+    #[serde(default)]
+    pub instrumental_mps2: [f64; 2],
+    /// The size-effect part of its drift, East and North, m/s^2.
+    #[serde(default)]
+    pub size_effect_mps2: [f64; 2],
 }
 
 /// A parameter estimate, or the statement that the motion did not determine it.

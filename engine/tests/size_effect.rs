@@ -53,7 +53,9 @@ fn two_periods_recover_all_six_coordinates_through_instrumental_errors() {
         // One period per cycle: the instrumental errors stay in the estimate.
         let one = estimate(&rec, &sways(&rec, &[5.0]));
         let worst_one = show(&format!("seed {seed}, 5 s only"), &one);
-        // Worse, and far outside its own uncertainty (the instrumental part is systematic).
+        // Worse, and far outside its own uncertainty (the instrumental part is systematic;
+        // u comes from the per-period accelerations' scatter, honest for the random walk of
+        // velocity that white accelerometer noise makes).
         let sigmas = (0..6)
             .map(|m| errors_mm(&one)[m].abs() / (one.coords_m[m].unwrap().1 * 1e3))
             .fold(0.0, f64::max);
@@ -61,7 +63,7 @@ fn two_periods_recover_all_six_coordinates_through_instrumental_errors() {
             "seed {seed}: worst two periods {worst_two:.3} mm, one period {worst_one:.3} mm ({sigmas:.0} u)"
         );
         assert!(
-            worst_one > worst_two && worst_one > 0.3 && sigmas > 20.0,
+            worst_one > worst_two && worst_one > 0.3 && sigmas > 5.0,
             "seed {seed}: single period {worst_one} mm ({sigmas} u) vs two periods {worst_two} mm"
         );
     }

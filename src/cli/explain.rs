@@ -219,7 +219,7 @@ pub fn main(args: Args) -> ExitCode {
         Format::Text => explain::render_text(&x),
     };
     out!("{out}");
-    if x.findings.is_empty() {
+    if x.findings.is_empty() && x.unexplained.is_empty() {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(1)

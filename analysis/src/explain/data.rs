@@ -1,6 +1,8 @@
 //! The recording accumulated once for every model explain will try: every segment, every
 //! registry effect's columns, and which segments are held out.
 
+use super::earth::EARTH_HELD;
+use super::probe::{self, Probe};
 use crate::fit::Source;
 use crate::fit::joint::{Layout, SegAcc, excitation};
 use crate::recording::SegmentKind;
@@ -16,19 +18,59 @@ pub(crate) struct Data {
     pub held: Vec<usize>,
     /// Column RMS per segment: how much each column varies there.
     pub excitation: Vec<Vec<f64>>,
+    /// Layout indices of the effects forward selection may add (the registry's catalogue
+    /// with the Earth's rate held, and user effects).
+    pub candidates: Vec<usize>,
+    /// Layout indices of the probes, with their forms: what a leftover may follow.
+    pub probes: Vec<(usize, &'static Probe)>,
+    /// Layout index of the Earth's rate as explain tries it ([`super::earth`]).
+    pub earth: usize,
+    /// The channels' factors merged over the segment sets fitted so far: explain fits
+    /// hundreds of models over a handful of sets.
+    pub merged: Merged,
 }
+
+/// Merged factors by (accelerometer segments, gyro segments).
+pub(crate) type Merged = std::sync::Mutex<
+    Vec<(
+        (Vec<usize>, Vec<usize>),
+        std::sync::Arc<Vec<nalgebra::DMatrix<f64>>>,
+    )>,
+>;
 
 impl Data {
     /// Accumulates every segment (in parallel) over these effects (the registry's and user
     /// effects) and chooses the held-out ones: every third segment of each kind, never the
     /// longest static one.
+    ///
+    /// Besides `effects`, the layout holds the Earth's rate as explain tries it (held at
+    /// the manifest's latitude, the heading free) and the probe library.
     pub(crate) fn with_effects<S: Source>(
         src: &S,
-        effects: Vec<&'static dyn Effect>,
+        mut effects: Vec<&'static dyn Effect>,
     ) -> Result<Data, S::Error> {
-        let layout = Layout::new(effects);
         let segs = &src.manifest().segments;
-        let accs = crate::fit::accumulate_all(src, &layout)?;
+        let t0 = segs.iter().map(|s| s.t_start).fold(f64::INFINITY, f64::min);
+        let t0 = if t0.is_finite() { t0.floor() } else { 0.0 };
+        let mut candidates: Vec<usize> = (0..effects.len())
+            .filter(|&e| !effects[e].nominal() && effects[e].id() != "earth_rate")
+            .collect();
+        let earth = effects.len();
+        candidates.push(earth);
+        effects.push(&EARTH_HELD);
+        let sampled = probe::sampled(t0);
+        let mut probes: Vec<(usize, &'static Probe)> = Vec::new();
+        for p in sampled {
+            probes.push((effects.len(), p));
+            effects.push(p);
+        }
+        let mut layout = Layout::new(effects);
+        let mut accs = crate::fit::accumulate_all(src, &layout)?;
+        let spans: Vec<(f64, f64)> = accs
+            .iter()
+            .map(|a| (segs[a.seg].t_start, segs[a.seg].t_end))
+            .collect();
+        probes.extend(probe::add_steps(&mut layout, &mut accs, &spans));
         let longest = accs
             .iter()
             .enumerate()
@@ -55,7 +97,45 @@ impl Data {
             accs,
             held,
             excitation,
+            candidates,
+            probes,
+            earth,
+            merged: Default::default(),
         })
+    }
+
+    /// The channels' factors merged over these segments, kept for the next model.
+    pub(crate) fn merged(
+        &self,
+        accel: &[usize],
+        gyro: &[usize],
+    ) -> std::sync::Arc<Vec<nalgebra::DMatrix<f64>>> {
+        let key = (accel.to_vec(), gyro.to_vec());
+        if let Some(m) = self
+            .merged
+            .lock()
+            .expect("not poisoned")
+            .iter()
+            .find(|e| e.0 == key)
+        {
+            return m.1.clone();
+        }
+        let req = crate::fit::joint::FitRequest {
+            layout: &self.layout,
+            cols: Vec::new(),
+            fixed: Vec::new(),
+            accel: accel.iter().map(|&i| &self.accs[i]).collect(),
+            gyro: gyro.iter().map(|&i| &self.accs[i]).collect(),
+            merged: None,
+            white_only: false,
+        };
+        let m = std::sync::Arc::new(crate::fit::joint::merge(&req));
+        let mut cache = self.merged.lock().expect("not poisoned");
+        if cache.len() >= 16 {
+            cache.remove(0);
+        }
+        cache.push((key, m.clone()));
+        m
     }
 
     /// The fitted (not held-out) accumulations.

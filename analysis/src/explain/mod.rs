@@ -13,18 +13,22 @@
 
 mod adopt;
 pub(crate) mod data;
+mod earth;
 mod locate;
 pub(crate) mod model;
 mod output;
+mod plausible;
+mod probe;
 mod select;
 mod text;
+mod unexplained;
 pub mod user;
 
 pub use adopt::{AdoptTarget, Adoption, adoption, next_version};
 pub use model::NominalModel;
 pub use output::{
-    Evidence, Explanation, FORMAT, Final, Finding, Located, Nominal, ParamOut, Rms, SegmentRms,
-    UserEffectOut,
+    Evidence, Explanation, FORMAT, Final, Finding, Located, Nominal, ParamOut, RefusedOut, Rms,
+    SegmentRms, Signature, Unexplained, UserEffectOut,
 };
 pub use text::render_text;
 pub use user::UserEffect;
@@ -77,7 +81,12 @@ pub fn explain_source<S: Source>(
     let mut effects: Vec<&'static dyn Effect> = REGISTRY.to_vec();
     effects.extend(opts.user.iter().map(|u| *u as &'static dyn Effect));
     let nonfinite: Vec<usize> = opts.user.iter().map(|u| u.nonfinite()).collect();
+    let clock = std::time::Instant::now();
+    let debug = std::env::var_os("RATECAL_EXPLAIN_DEBUG").is_some();
     let data = Data::with_effects(src, effects)?;
+    if debug {
+        eprintln!("accumulated in {:?}", clock.elapsed());
+    }
     let m = src.manifest();
     let lay = &data.layout;
     let mut warnings = Vec::new();
@@ -126,7 +135,11 @@ pub fn explain_source<S: Source>(
         rms: rms(&data, &nom, &all),
         holdout_rms: rms(&data, &nom, &data.held),
     };
-    let (steps, rejected) = select::forward(&data, &start, opts.alpha, &opts.without);
+    let sel = select::forward(&data, &start, opts.alpha, &opts.without);
+    if debug {
+        eprintln!("selected in {:?}", clock.elapsed());
+    }
+    let (steps, rejected) = (sel.steps, sel.last_p);
     let work = data.working();
     let last = match steps.last() {
         Some(s) => s.after.clone(),
@@ -140,6 +153,8 @@ pub fn explain_source<S: Source>(
     for step in &steps {
         terms.effects.push(step.effect);
     }
+    let latitude = m.station.site.latitude_deg;
+    let held = earth::hold(&data, &mut terms, latitude);
     let whole = fit(&data, &terms, &all, &all);
     let findings: Vec<Finding> = steps
         .iter()
@@ -150,15 +165,27 @@ pub fn explain_source<S: Source>(
                 .iter()
                 .find(|u| u.id() == f.effect)
                 .map(|u| u.file().to_string());
+            if step.effect == data.earth
+                && let Some(h) = &held
+            {
+                f.parameters = h.parameters(latitude);
+            }
             f
         })
         .collect();
+    let mut unexplained = unexplained::leftover(m, &data, &terms, opts.alpha);
+    if debug {
+        eprintln!("leftover tested in {:?}", clock.elapsed());
+    }
+    if let Some(note) = held.as_ref().and_then(|h| h.mimic(opts.alpha)) {
+        unexplained.insert(0, note);
+    }
     let floor = |cs: std::ops::Range<usize>| {
         let v: Vec<f64> = cs.map(|c| last.noise[c].sigma.powi(2)).collect();
         (v.iter().sum::<f64>() / v.len() as f64).sqrt()
     };
     let final_ = Final {
-        terms: terms.names(&data.layout),
+        terms: earth::names(&data, &terms),
         rms: rms(&data, &last, &all),
         holdout_rms: rms(&data, &last, &data.held),
         noise_floor: Rms {
@@ -185,6 +212,15 @@ pub fn explain_source<S: Source>(
             .map(|&i| m.segments[data.accs[i].seg].id.clone())
             .collect(),
         rejected,
+        refused: sel
+            .refused
+            .into_iter()
+            .map(|r| RefusedOut {
+                effect: r.effect,
+                reason: r.reason,
+            })
+            .collect(),
+        unexplained,
         adopt,
         adopt_diff: None,
         user_effects: opts
@@ -228,7 +264,9 @@ fn finding(
         };
         parameters.insert(p.name.to_string(), out);
     }
-    if let Some((lat, ulat)) = model::latitude(data, last, step.effect) {
+    if step.effect == data.earth {
+        // Replaced by the held Earth's parameters (earth::Held::parameters).
+    } else if let Some((lat, ulat)) = model::latitude(data, last, step.effect) {
         parameters.insert(
             "latitude_deg".into(),
             ParamOut::Estimate {
@@ -257,5 +295,19 @@ fn finding(
         evidence,
         rms_after: rms(data, &step.after, &all),
         defined_in: None,
+        alternatives: step
+            .alternatives
+            .iter()
+            .map(|&e| lay.effects[e].id().to_string())
+            .collect(),
+        separate_by: (!step.alternatives.is_empty()).then(|| {
+            step.alternatives
+                .iter()
+                .filter_map(|&e| lay.effects[e].params().first())
+                .map(|p| p.needs)
+                .chain(fx.params().first().map(|p| p.needs))
+                .collect::<Vec<_>>()
+                .join("; ")
+        }),
     }
 }

@@ -3,7 +3,7 @@
 
 use super::data::Data;
 pub(crate) use crate::fit::joint::Terms;
-use crate::fit::joint::{Fit, fit_terms, latitude_of, rss_on};
+use crate::fit::joint::{Fit, fit_terms_merged, latitude_of, rss_on};
 use crate::plan::Plan;
 use crate::recording::{Manifest, SegmentKind};
 use ratecal_physics::effects::EarthRate;
@@ -74,20 +74,34 @@ impl NominalModel {
 }
 
 /// Fits terms over segments (indices into `data.accs`) for each sensor (see
-/// [`fit_terms`]).
+/// [`crate::fit::joint::fit_terms`]).
 pub(crate) fn fit(
     data: &Data,
     terms: &Terms,
     accel: &[usize],
     gyro: &[usize],
 ) -> (Fit, Vec<usize>) {
-    fit_terms(
+    fit_with(data, terms, accel, gyro, false)
+}
+
+/// [`fit`] with a white-noise covariance only (`white_only`): to rank many models cheaply.
+pub(crate) fn fit_with(
+    data: &Data,
+    terms: &Terms,
+    accel: &[usize],
+    gyro: &[usize],
+    white_only: bool,
+) -> (Fit, Vec<usize>) {
+    let merged = data.merged(accel, gyro);
+    fit_terms_merged(
         &data.layout,
         &data.accs,
         &data.excitation,
         terms,
         accel,
         gyro,
+        Some(&merged),
+        white_only,
     )
 }
 

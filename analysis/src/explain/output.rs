@@ -127,6 +127,58 @@ pub struct Finding {
     /// Residual RMS before and after, every segment and channel, in recording order.
     #[serde(default)]
     pub residuals: Vec<SegmentRms>,
+    /// Effects that explain this recording as well (a tie by the selection criterion):
+    /// the data cannot say which it is.
+    #[serde(default)]
+    pub alternatives: Vec<String>,
+    /// With alternatives: the motion that would separate them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub separate_by: Option<String>,
+}
+
+/// One form a leftover follows.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Signature {
+    /// The form, in the user-effect expression language (docs/user-effects.md).
+    pub expression: String,
+    /// Fraction of the channel's leftover it explains (0..1).
+    pub share: f64,
+    /// The channel it was measured on.
+    pub channel: String,
+    /// What a term of this form usually is, in an engineer's words.
+    pub reading: String,
+    /// Whether the form is a function of time (a drift, decay or step).
+    pub in_time: bool,
+}
+
+/// A residual the final model leaves that is larger than the noise allows.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Unexplained {
+    /// `accel` or `gyro`.
+    pub sensor: String,
+    /// The channels, `ax` ... `gz`.
+    pub channels: Vec<String>,
+    /// Where it shows most (segment ids).
+    pub segments: Vec<String>,
+    /// The smallest p-value of its tests, corrected for the multiplicity (Bonferroni over
+    /// every test of the library, docs/explain.md).
+    pub p_value: f64,
+    /// Its size: the largest test statistic, in standard errors.
+    pub standard_errors: f64,
+    /// The forms it follows, best first.
+    pub signature: Vec<Signature>,
+    /// What it means, when explain knows more than the signature says.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+}
+
+/// A candidate that was significant but not reported as a finding, and why.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RefusedOut {
+    /// Its id.
+    pub effect: String,
+    /// Why.
+    pub reason: String,
 }
 
 /// A user effect explain tried, and its file.
@@ -169,6 +221,14 @@ pub struct Explanation {
     pub held_out: Vec<String>,
     /// Candidates tried and not reported, with their last p-value.
     pub rejected: BTreeMap<String, f64>,
+    /// Significant candidates not reported: outside the plausible range, or a form
+    /// outside the registry explains their residual better.
+    #[serde(default)]
+    pub refused: Vec<RefusedOut>,
+    /// What the final model leaves unexplained (empty when the recording is explained to
+    /// its noise).
+    #[serde(default)]
+    pub unexplained: Vec<Unexplained>,
     /// How to adopt the findings: the registry effects to add to the procedure's fits.
     pub adopt: Option<String>,
     /// With a procedure: the unified diff that adds them to its fit statements.

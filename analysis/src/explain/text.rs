@@ -22,7 +22,7 @@ pub fn render_text(x: &Explanation) -> String {
         x.nominal.terms.join(", "),
         rms(&x.nominal.rms)
     );
-    if x.findings.is_empty() {
+    if x.findings.is_empty() && x.unexplained.is_empty() {
         let _ = writeln!(
             s,
             "\nnothing found: the nominal model explains the recording to its noise"
@@ -76,7 +76,50 @@ pub fn render_text(x: &Explanation) -> String {
                 }
             }
         }
+        if !f.alternatives.is_empty() {
+            let _ = writeln!(
+                s,
+                "   explains it as well (the data cannot say which): {}; to separate them: {}",
+                f.alternatives.join(", "),
+                f.separate_by.as_deref().unwrap_or("more varied motion")
+            );
+        }
         let _ = writeln!(s, "   residual RMS after: {}", rms(&f.rms_after));
+    }
+    for u in &x.unexplained {
+        let sensor = if u.sensor == "accel" {
+            "accelerometer"
+        } else {
+            "gyro"
+        };
+        let _ = writeln!(
+            s,
+            "\nnot explained: the {sensor} residual ({}){}: {:.0} standard errors, p = {:.1e} after the multiplicity correction",
+            u.channels.join(", "),
+            if u.segments.is_empty() {
+                String::new()
+            } else {
+                format!(" on {}", u.segments.join(", "))
+            },
+            u.standard_errors,
+            u.p_value
+        );
+        if let Some(note) = &u.note {
+            let _ = writeln!(s, "   {note}");
+        }
+        for f in &u.signature {
+            let _ = writeln!(
+                s,
+                "   it follows {} on {} ({:.0} % of the leftover): {}",
+                f.expression,
+                f.channel,
+                100.0 * f.share,
+                f.reading
+            );
+        }
+    }
+    for r in &x.refused {
+        let _ = writeln!(s, "\nnot reported: {}: {}", r.effect, r.reason);
     }
     let _ = writeln!(
         s,

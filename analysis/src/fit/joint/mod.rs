@@ -14,8 +14,8 @@ mod terms;
 mod tri;
 
 pub(crate) use accumulate::{Accumulator, SegAcc, seg_rss};
-pub(crate) use solve::{Fit, FitRequest, rss_on, solve};
-pub(crate) use terms::{Terms, excitation, excites, fit_terms, latitude_of};
+pub(crate) use solve::{Fit, FitRequest, merge, rss_on, solve};
+pub(crate) use terms::{Terms, excitation, excites, fit_terms, fit_terms_merged, latitude_of};
 
 use ratecal_physics::effects::{Effect, Param, Sensor};
 

@@ -22,6 +22,12 @@ pub(crate) struct FitRequest<'a> {
     pub accel: Vec<&'a SegAcc>,
     /// Segments fitted for the gyros.
     pub gyro: Vec<&'a SegAcc>,
+    /// The channels' factors over exactly these segments, when the caller keeps them
+    /// ([`merge`]): many models over the same segments then share one merge.
+    pub merged: Option<&'a [DMatrix<f64>]>,
+    /// Whether the covariance may omit the wandering bias (white noise only): a cheap
+    /// screen of many models, never a reported uncertainty.
+    pub white_only: bool,
 }
 
 /// A solved model.
@@ -61,6 +67,13 @@ impl FitRequest<'_> {
     }
 }
 
+/// Every channel's factor over the request's segments, for [`FitRequest::merged`].
+pub(crate) fn merge(req: &FitRequest) -> Vec<DMatrix<f64>> {
+    (0..6)
+        .map(|c| merged(req.segs(c), c, req.layout.by_channel[c].len() + 1))
+        .collect()
+}
+
 /// The channel's factor over a set of segments.
 fn merged(segs: &[&SegAcc], c: usize, width: usize) -> DMatrix<f64> {
     if segs.len() == 1 {
@@ -90,7 +103,10 @@ pub(crate) fn solve(req: &FitRequest) -> Fit {
     let facs: Vec<DMatrix<f64>> = (0..6)
         .map(|c| {
             let w = lay.by_channel[c].len() + 1;
-            let mut f = merged(req.segs(c), c, w);
+            let mut f = match req.merged {
+                Some(m) => m[c].clone(),
+                None => merged(req.segs(c), c, w),
+            };
             for (k, &g) in lay.by_channel[c].iter().enumerate() {
                 if theta[g] != 0.0 {
                     let col = f.column(k) * theta[g];
@@ -194,7 +210,7 @@ pub(crate) fn solve(req: &FitRequest) -> Fit {
         let nz = &noise[c];
         let white = nz.sigma * nz.sigma * nz.phi;
         meat += (xl.transpose() * &xl) * (w[c] * w[c] * white);
-        if nz.q > 0.0 {
+        if nz.q > 0.0 && !req.white_only {
             let m = noise::random_walk_gram(req.segs(c), c, &local, p);
             meat += m * (w[c] * w[c] * nz.q);
         }

@@ -64,6 +64,22 @@ pub(crate) fn fit_terms(
     accel: &[usize],
     gyro: &[usize],
 ) -> (Fit, Vec<usize>) {
+    fit_terms_merged(layout, accs, excitation, terms, accel, gyro, None, false)
+}
+
+/// [`fit_terms`] with the channels' factors over these segments already merged
+/// ([`super::solve::merge`]); `white_only` leaves the wandering bias out of the covariance.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn fit_terms_merged(
+    layout: &Layout,
+    accs: &[SegAcc],
+    excitation: &[Vec<f64>],
+    terms: &Terms,
+    accel: &[usize],
+    gyro: &[usize],
+    merged: Option<&[nalgebra::DMatrix<f64>]>,
+    white_only: bool,
+) -> (Fit, Vec<usize>) {
     let mut cols = Vec::new();
     let mut weak = Vec::new();
     for &e in &terms.effects {
@@ -107,6 +123,8 @@ pub(crate) fn fit_terms(
         fixed,
         accel: accel.iter().map(|&i| &accs[i]).collect(),
         gyro: gyro.iter().map(|&i| &accs[i]).collect(),
+        merged,
+        white_only,
     };
     let f = solve(&req);
     let mut unobs = f.unobservable.clone();

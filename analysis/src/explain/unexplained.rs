@@ -1,0 +1,176 @@
+//! What remains unexplained once selection stops: the final model's residuals tested
+//! against the honest noise model (white noise plus the wandering bias) for structure that
+//! the probe library's forms pick up (specific-force and rate forms within and across
+//! segments, drifts, decays and steps in time).
+//!
+//! Each probe is added alone to the final model, fitted on every segment, and each of its
+//! columns (one per channel) is judged by a Wald test with the honest covariance. The
+//! p-values are corrected for the number of tests by Bonferroni (docs/explain.md); a
+//! sensor with any test under the threshold gets one entry, its signature the forms it
+//! follows, each with the share of the leftover it explains.
+
+use super::data::Data;
+use super::model::{Terms, fit};
+use super::output::{Signature, Unexplained};
+use super::select::p_value;
+use crate::fit::joint::{CHANNELS, Fit, seg_rss};
+use crate::recording::Manifest;
+use ratecal_physics::effects::Sensor;
+
+/// Most forms listed in a signature.
+const MOST_FORMS: usize = 5;
+/// Probes per sensor given the honest test after the white-noise screen.
+const SCREEN: usize = 8;
+/// Most segments listed.
+const MOST_SEGMENTS: usize = 8;
+
+/// One probe column's test.
+struct Test {
+    /// Probe layout index.
+    probe: usize,
+    /// Channel.
+    c: usize,
+    /// Wald statistic, 1 dof.
+    chi2: f64,
+    /// Fit with the probe.
+    fit: usize,
+}
+
+/// Weighted residual sum of squares of channel `c` over `segs` under `fit`.
+fn wrss(data: &Data, fit: &Fit, c: usize, segs: &[usize], sigma: f64) -> f64 {
+    segs.iter()
+        .map(|&i| seg_rss(&data.accs[i], &data.layout, c, &fit.theta))
+        .sum::<f64>()
+        / (sigma * sigma)
+}
+
+/// Tests the final model `terms` for leftover structure; `alpha` is the family-wise
+/// threshold over every test.
+pub(crate) fn leftover(m: &Manifest, data: &Data, terms: &Terms, alpha: f64) -> Vec<Unexplained> {
+    use rayon::prelude::*;
+    let lay = &data.layout;
+    let all: Vec<usize> = (0..data.accs.len()).collect();
+    let (base, _) = fit(data, terms, &all, &all);
+    // Screened with white noise alone; the strongest of each sensor get the honest
+    // covariance. The correction still counts every probe's every column.
+    let short = super::probe::screen(data, terms, &all, SCREEN);
+    let fits: Vec<Fit> = short
+        .par_iter()
+        .map(|&e| {
+            let mut t = terms.clone();
+            t.effects.push(e);
+            fit(data, &t, &all, &all).0
+        })
+        .collect();
+    let mut tests = Vec::new();
+    for (k, &e) in short.iter().enumerate() {
+        let f = &fits[k];
+        for g in lay.columns_of(e) {
+            if !f.estimated.contains(&g) {
+                continue;
+            }
+            let var = f.cov[(g, g)];
+            if var <= 0.0 {
+                continue;
+            }
+            let Some((s, ax)) = lay.param(g).channel else {
+                continue;
+            };
+            let c = if s == Sensor::Accel { ax } else { 3 + ax };
+            tests.push(Test {
+                probe: e,
+                c,
+                chi2: f.theta[g] * f.theta[g] / var,
+                fit: k,
+            });
+        }
+    }
+    let m_tests = (3 * data.probes.len()).max(1) as f64;
+    let p_adj = |chi2: f64| (p_value(chi2, 1) * m_tests).min(1.0);
+    let mut out = Vec::new();
+    for sensor in [Sensor::Accel, Sensor::Gyro] {
+        let range = if sensor == Sensor::Accel { 0..3 } else { 3..6 };
+        let sig: Vec<&Test> = tests
+            .iter()
+            .filter(|t| range.contains(&t.c) && p_adj(t.chi2) < alpha)
+            .collect();
+        if sig.is_empty() {
+            continue;
+        }
+        let mut channels: Vec<usize> = sig.iter().map(|t| t.c).collect();
+        channels.sort_unstable();
+        channels.dedup();
+        let p_min = sig.iter().map(|t| p_adj(t.chi2)).fold(1.0, f64::min);
+        // The leftover of a channel: what its best probe removes. Each form's share is
+        // what it removes of that.
+        let mut forms: Vec<(f64, f64, Signature)> = Vec::new();
+        for &c in &channels {
+            let sigma = base.noise[c].sigma.max(1e-300);
+            let before = wrss(data, &base, c, &all, sigma);
+            let drops: Vec<(&Test, f64)> = tests
+                .iter()
+                .filter(|t| t.c == c)
+                .map(|t| (t, before - wrss(data, &fits[t.fit], c, &all, sigma)))
+                .collect();
+            let top = drops.iter().map(|d| d.1).fold(0.0, f64::max);
+            if top <= 0.0 {
+                continue;
+            }
+            for (t, d) in drops {
+                let probe = data.probes.iter().find(|q| q.0 == t.probe).map(|q| q.1);
+                let Some(probe) = probe else { continue };
+                let share = (d / top).clamp(0.0, 1.0);
+                if share < 0.05 {
+                    continue;
+                }
+                let (_, ax) = crate::fit::joint::channel(c);
+                forms.push((
+                    share,
+                    t.chi2,
+                    Signature {
+                        expression: probe.expression(ax),
+                        share,
+                        channel: CHANNELS[c].into(),
+                        reading: probe.reading().into(),
+                        in_time: probe.in_time(),
+                    },
+                ));
+            }
+        }
+        forms.sort_by(|a, b| b.0.total_cmp(&a.0).then(b.1.total_cmp(&a.1)));
+        forms.truncate(MOST_FORMS);
+        // Where it shows: the segments whose residual the strongest test's probe removes
+        // most, in units of the channel's noise.
+        let best = sig
+            .iter()
+            .max_by(|a, b| a.chi2.total_cmp(&b.chi2))
+            .expect("non-empty");
+        let bf = &fits[best.fit];
+        let mut segs: Vec<(f64, String)> = Vec::new();
+        for (i, acc) in data.accs.iter().enumerate() {
+            let mut d = 0.0;
+            for &c in &channels {
+                let sigma = base.noise[c].sigma.max(1e-300);
+                d += (seg_rss(acc, lay, c, &base.theta) - seg_rss(acc, lay, c, &bf.theta))
+                    / (sigma * sigma);
+            }
+            if d >= 9.0 {
+                let _ = i;
+                segs.push((d, m.segments[acc.seg].id.clone()));
+            }
+        }
+        segs.sort_by(|a, b| b.0.total_cmp(&a.0));
+        segs.truncate(MOST_SEGMENTS);
+        let z = sig.iter().map(|t| t.chi2.sqrt()).fold(0.0, f64::max);
+        out.push(Unexplained {
+            sensor: sensor.name().into(),
+            channels: channels.iter().map(|&c| CHANNELS[c].to_string()).collect(),
+            segments: segs.into_iter().map(|s| s.1).collect(),
+            p_value: p_min,
+            standard_errors: z,
+            signature: forms.into_iter().map(|f| f.2).collect(),
+            note: None,
+        });
+    }
+    out
+}
