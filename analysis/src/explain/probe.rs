@@ -145,14 +145,8 @@ impl Probe {
             Form::ForceAbs => {
                 "the output depends on the sign of the specific force: scale asymmetry (+g and -g differ)"
             }
-            Form::ForceCube => {
-                "the output grows with the cube of the specific force: odd-order nonlinearity"
-            }
             Form::RateAbs => "the output depends on the sign of the rate: scale asymmetry",
             Form::RateSquare => "the output grows with the square of the rate, whatever its sign",
-            Form::RateCube => {
-                "the output grows with the cube of the rate: odd-order scale nonlinearity"
-            }
             Form::Drift { .. } => "the bias drifts linearly with time",
             Form::Decay { .. } => "the bias decays with time since the recording began: warm-up",
             Form::Step { .. } => "the bias jumps between two segments: a bias step",
