@@ -67,9 +67,15 @@ fn not_fit(code: i32, v: &Value, err: &str, check: &str) {
     assert_eq!(v["verdict"], "incomplete", "{err}");
     assert_eq!(entry(v, check)["status"], "fail", "{}", v["sanity"]);
     let reason = v["verdict_reason"].as_str().unwrap();
-    assert!(reason.contains("not fit for judgment") && reason.contains(check), "{reason}");
+    assert!(
+        reason.contains("not fit for judgment") && reason.contains(check),
+        "{reason}"
+    );
     assert!(err.contains(&format!("[FAIL] {check}:")), "{err}");
-    assert!(err.contains("verdict: INCOMPLETE (the recording is not fit"), "{err}");
+    assert!(
+        err.contains("verdict: INCOMPLETE (the recording is not fit"),
+        "{err}"
+    );
 }
 
 const NAMES: [&str; 8] = [
@@ -98,7 +104,12 @@ fn accelerometers_in_g_are_not_fit_for_judgment() {
     let tmp = tempfile::tempdir().unwrap();
     let run = mini(tmp.path());
     let g = tmp.path().join("g");
-    altered(&run, &g, |r| r[1..4].iter_mut().for_each(|a| *a /= 9.80665), |m| m);
+    altered(
+        &run,
+        &g,
+        |r| r[1..4].iter_mut().for_each(|a| *a /= 9.80665),
+        |m| m,
+    );
     let (c, v, err) = analyze(&g, tmp.path(), &[]);
     not_fit(c, &v, &err, "gravity_magnitude_at_rest");
     // The fit itself turns the units error into a scale factor of about -90 %.
@@ -116,7 +127,12 @@ fn the_real_session_in_g_is_not_passed() {
     };
     let tmp = tempfile::tempdir().unwrap();
     let g = tmp.path().join("g");
-    altered(&ex, &g, |r| r[1..4].iter_mut().for_each(|a| *a /= 9.80665), |m| m);
+    altered(
+        &ex,
+        &g,
+        |r| r[1..4].iter_mut().for_each(|a| *a /= 9.80665),
+        |m| m,
+    );
     let consumer = procedures("imu-2d-consumer");
     let (c, v, err) = analyze(&g, tmp.path(), &["--procedure", &consumer]);
     not_fit(c, &v, &err, "gravity_magnitude_at_rest");
@@ -274,7 +290,10 @@ fn analyze_without_a_procedure_is_not_judged() {
             .unwrap()
             .contains("without a procedure")
     );
-    assert!(err.contains("verdict: NOT JUDGED (analysed without a procedure"), "{err}");
+    assert!(
+        err.contains("verdict: NOT JUDGED (analysed without a procedure"),
+        "{err}"
+    );
     assert!(!err.contains("PASS"), "{err}");
 }
 
@@ -287,7 +306,12 @@ fn a_station_check_run_is_not_judged() {
     let o = ratecal(&["run", &sc, "--dry-run", "--out", "sc"], tmp.path());
     assert_eq!(code(&o), 0, "{}", text(&o));
     let out = String::from_utf8_lossy(&o.stdout);
-    assert!(out.contains("verdict: NOT JUDGED (procedure station-check 1.0.0 declares no acceptance check"), "{out}");
+    assert!(
+        out.contains(
+            "verdict: NOT JUDGED (procedure station-check 1.0.0 declares no acceptance check"
+        ),
+        "{out}"
+    );
     assert!(!out.contains("PASS"), "{out}");
     let dir = tmp.path().join("sc");
     let results = json(&dir.join("results.json"));

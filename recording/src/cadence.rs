@@ -64,7 +64,8 @@ impl Cadence {
             return;
         };
         let step = t - prev;
-        if !(step > 0.0) {
+        // NaN steps cannot come from a read stream; they count as not increasing.
+        if step.is_nan() || step <= 0.0 {
             self.report.backwards.get_or_insert((prev, t));
             return;
         }

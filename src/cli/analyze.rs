@@ -187,7 +187,12 @@ pub(crate) fn verdict_lines(r: &Results) -> Vec<String> {
         r.sanity.len()
     ));
     for c in r.sanity.iter().filter(|c| c.status != SanityStatus::Pass) {
-        out.push(format!("  [{}] {}: {}", c.status.label(), c.check, c.detail));
+        out.push(format!(
+            "  [{}] {}: {}",
+            c.status.label(),
+            c.check,
+            c.detail
+        ));
     }
     out.push(format!("warnings: {}", r.warnings.len()));
     for w in &r.warnings {

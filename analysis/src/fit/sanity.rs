@@ -325,11 +325,7 @@ fn verdict(name: &str, worst: Option<(f64, String)>, none: &str, hint: &str) -> 
         Some((excess, detail)) if excess > 0.0 || excess.is_nan() => {
             SanityCheck::new(name, SanityStatus::Fail, format!("{detail}{hint}"))
         }
-        Some((_, detail)) => SanityCheck::new(
-            name,
-            SanityStatus::Pass,
-            format!("worst {detail}"),
-        ),
+        Some((_, detail)) => SanityCheck::new(name, SanityStatus::Pass, format!("worst {detail}")),
     }
 }
 
@@ -360,8 +356,10 @@ pub(crate) fn plausible(params: &BTreeMap<String, Parameter>) -> SanityCheck {
             continue;
         };
         checked += 1;
-        if !(value.abs() <= limit) {
-            out.push(format!("{n} = {value:.6} {unit} (plausible within +-{limit} {unit})"));
+        if value.is_nan() || value.abs() > limit {
+            out.push(format!(
+                "{n} = {value:.6} {unit} (plausible within +-{limit} {unit})"
+            ));
         }
     }
     if checked == 0 {

@@ -252,7 +252,13 @@ impl Window<'_> {
         }
         // The raw rows against their references, for the sanity checks.
         for i in ca..cb {
-            let out = [0, 1, 2, 3, 4, 5].map(|c| if c < 3 { v.accel[c][i] } else { v.gyro[c - 3][i] });
+            let out = [0, 1, 2, 3, 4, 5].map(|c| {
+                if c < 3 {
+                    v.accel[c][i]
+                } else {
+                    v.gyro[c - 3][i]
+                }
+            });
             self.sum.raw.add(out, reference(&sig_at(i)));
         }
         // The window's own rows, into the fit and the sums.
