@@ -84,8 +84,8 @@ pub(crate) fn confusions(data: &Data, terms: &Terms, effect: usize) -> Vec<Strin
     without.effects.retain(|e| *e != effect);
     let mine: Vec<usize> = lay.columns_of(effect).collect();
     let mut out = Vec::new();
-    for e in 0..lay.effects.len() {
-        if lay.effects[e].nominal() || terms.effects.contains(&e) {
+    for &e in &data.candidates {
+        if terms.effects.contains(&e) {
             continue;
         }
         let theirs: Vec<usize> = lay.columns_of(e).collect();
