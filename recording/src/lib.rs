@@ -38,12 +38,14 @@
 //! # }
 //! ```
 
+pub mod cadence;
 mod data;
 mod error;
 mod manifest;
 mod read;
 mod write;
 
+pub use cadence::{Cadence, CadenceReport};
 pub use data::{ImuSample, ImuStream, Recording, TableSample, TableStream};
 pub use error::{RecordingError, yaml_offset};
 pub use manifest::{

@@ -252,7 +252,8 @@ pub(crate) fn add_steps(
         let t = starts[i].0;
         for c in 0..6 {
             let sensor = if c < 3 { Sensor::Accel } else { Sensor::Gyro };
-            let base = if c < 3 { ba } else { bg };
+            // The bias column of this channel's own axis.
+            let base = if c < 3 { ba + c } else { bg + c - 3 };
             let k_old = old.by_channel[c].len();
             let local_bias = old.by_channel[c].iter().position(|&g| g == base);
             let k_new = layout.by_channel[c].len();
