@@ -161,6 +161,20 @@ fn registry_terms_are_named_or_left_unexplained_never_mislabelled() {
             "gyro",
         ),
         (
+            "accel-asym",
+            Hidden::AccelScaleAsymmetry {
+                ppm: [300.0, -250.0, 200.0],
+            },
+            &["accel_scale_asymmetry"],
+            "accel",
+        ),
+        (
+            "clock",
+            Hidden::ClockRate { ppm: 60.0 },
+            &["clock_rate"],
+            "gyro",
+        ),
+        (
             "g-sens",
             Hidden::GSensitivity {
                 dps_per_g: [[0.01, 0.0, -0.008], [0.0, 0.012, 0.006], [0.0; 3]],

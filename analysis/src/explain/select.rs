@@ -91,7 +91,7 @@ fn plausible(data: &Data, fit: &Fit, e: usize) -> Result<(), String> {
             continue;
         }
         let p = lay.param(g);
-        let max = super::plausible::max_abs(lay.effects[e].id(), p);
+        let max = super::plausible::max_abs(p);
         if let Some(max) = max
             && fit.theta[g].abs() > max
         {
