@@ -35,37 +35,28 @@ fn standard_dry_run() -> PathBuf {
     dir
 }
 
+/// One `ratecal explain DIR --format json`, the whole process.
+fn explain_cli(dir: &std::path::Path) {
+    let st = Command::new(env!("CARGO_BIN_EXE_ratecal"))
+        .arg("explain")
+        .arg(dir)
+        .arg("--format")
+        .arg("json")
+        .stdout(std::process::Stdio::null())
+        .status()
+        .expect("ratecal runs");
+    assert!(st.code().is_some_and(|c| c == 0 || c == 1), "{st}");
+}
+
 fn bench(c: &mut Criterion) {
     let dir = recording();
     let standard = standard_dry_run();
     let mut g = c.benchmark_group("explain");
     g.sample_size(10).measurement_time(Duration::from_secs(20));
     g.bench_function("cli_standard_dry_run", |b| {
-        b.iter(|| {
-            let st = Command::new(env!("CARGO_BIN_EXE_ratecal"))
-                .arg("explain")
-                .arg(&standard)
-                .arg("--format")
-                .arg("json")
-                .stdout(std::process::Stdio::null())
-                .status()
-                .expect("ratecal runs");
-            assert!(st.code().is_some_and(|c| c == 0 || c == 1), "{st}");
-        })
+        b.iter(|| explain_cli(&standard))
     });
-    g.bench_function("cli", |b| {
-        b.iter(|| {
-            let st = Command::new(env!("CARGO_BIN_EXE_ratecal"))
-                .arg("explain")
-                .arg(&dir)
-                .arg("--format")
-                .arg("json")
-                .stdout(std::process::Stdio::null())
-                .status()
-                .expect("ratecal runs");
-            assert!(st.code().is_some_and(|c| c == 0 || c == 1), "{st}");
-        })
-    });
+    g.bench_function("cli", |b| b.iter(|| explain_cli(&dir)));
     g.finish();
 }
 
