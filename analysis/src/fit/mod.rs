@@ -242,10 +242,76 @@ pub fn analyze_source<S: Source>(
 
 /// Every segment's raw samples (no preprocessing) accumulated over `layout`, in manifest
 /// order, those without samples left out: what explain fits its models from.
+///
+/// A long segment (the standard's hour at rest is four fifths of its samples) is passed in
+/// pieces of about [`PIECE_ROWS`] rows side by side, their factors merged: the factor of
+/// stacked rows is the factor of the stacked factors.
 pub(crate) fn accumulate_all<S: Source>(src: &S, layout: &Layout) -> Result<Vec<SegAcc>, S::Error> {
-    let (_, accs) = pass_segments(src, layout, segment::WINDOW_ROWS, |_| (None, false, false))?;
+    use rayon::prelude::*;
+    let m = src.manifest();
+    let geos = prep::geometries(m);
+    let rate_hz = mean_rate(src);
+    let t_ref_c = if layout.effects.iter().any(|e| e.uses_temperature()) {
+        src.mean_temp()?
+    } else {
+        0.0
+    };
+    let mut jobs = Vec::new();
+    for (i, seg) in m.segments.iter().enumerate() {
+        let rows = (seg.t_end - seg.t_start) * rate_hz;
+        let pieces = ((rows / PIECE_ROWS as f64).floor() as usize).max(1);
+        for p in 0..pieces {
+            let at = |p: usize| seg.t_start + (seg.t_end - seg.t_start) * p as f64 / pieces as f64;
+            let span = (pieces > 1).then(|| {
+                (
+                    at(p),
+                    if p + 1 == pieces {
+                        seg.t_end
+                    } else {
+                        at(p + 1)
+                    },
+                )
+            });
+            jobs.push(segment::Job {
+                seg: i,
+                geo: &geos[i],
+                layout,
+                t_ref_c,
+                prep: None,
+                allan: false,
+                verify: false,
+                rate_hz,
+                window_rows: segment::WINDOW_ROWS,
+                span,
+            });
+        }
+    }
+    let dur = |j: &segment::Job| match j.span {
+        Some((a, b)) => b - a,
+        None => m.segments[j.seg].t_end - m.segments[j.seg].t_start,
+    };
+    jobs.sort_by(|a, b| dur(b).total_cmp(&dur(a)));
+    let mut passed: Vec<(f64, SegAcc)> = jobs
+        .par_iter()
+        .map(|job| {
+            let t0 = job.span.map_or(m.segments[job.seg].t_start, |s| s.0);
+            segment::pass(src, job).map(|(_, acc)| (t0, acc))
+        })
+        .collect::<Result<_, _>>()?;
+    passed.sort_by(|a, b| a.1.seg.cmp(&b.1.seg).then(a.0.total_cmp(&b.0)));
+    let mut accs: Vec<SegAcc> = Vec::new();
+    for (_, acc) in passed {
+        match accs.last_mut() {
+            Some(last) if last.seg == acc.seg => last.merge(acc),
+            _ => accs.push(acc),
+        }
+    }
+    accs.retain(|a| a.n > 0);
     Ok(accs)
 }
+
+/// Rows of one piece of a long segment in [`accumulate_all`].
+const PIECE_ROWS: usize = 65_536;
 
 /// Passes every segment once over `layout` (in parallel, longest first so that the work
 /// stealing balances), the thermal terms referred to the recording's mean temperature;
@@ -284,6 +350,7 @@ fn pass_segments<S: Source>(
                 verify,
                 rate_hz,
                 window_rows,
+                span: None,
             };
             segment::pass(src, &job)
         })

@@ -36,6 +36,22 @@ pub(crate) struct SegAcc {
     pub n: usize,
 }
 
+impl SegAcc {
+    /// Adds the accumulation of a later piece of the same segment: the factors stacked and
+    /// triangulated again, the blocks and counts joined.
+    pub(crate) fn merge(&mut self, later: SegAcc) {
+        for (c, r) in later.r.into_iter().enumerate() {
+            let w = r.ncols();
+            let mut m = DMatrix::zeros(self.r[c].nrows() + r.nrows(), w);
+            m.view_mut((0, 0), self.r[c].shape()).copy_from(&self.r[c]);
+            m.view_mut((self.r[c].nrows(), 0), r.shape()).copy_from(&r);
+            self.r[c] = super::tri::triangle(m, w);
+        }
+        self.blocks.extend(later.blocks);
+        self.n += later.n;
+    }
+}
+
 /// Folds one segment's samples into the factors and block sums of every channel, a sample
 /// at a time, so a segment of any length streams through.
 pub(crate) struct Accumulator<'l> {

@@ -54,6 +54,8 @@ pub(crate) struct Job<'a> {
     pub rate_hz: f64,
     /// Rows per window of a static segment.
     pub window_rows: usize,
+    /// Only this part of the segment (s), when one segment is passed in pieces.
+    pub span: Option<(f64, f64)>,
 }
 
 /// What is left of a segment once its rows have passed.
@@ -97,7 +99,8 @@ pub(crate) fn pass<S: Source>(src: &S, job: &Job) -> Result<(Summary, SegAcc), S
         job.window_rows
     }
     .max(1) as f64;
-    let dur = seg.t_end - seg.t_start;
+    let (s0, s1) = job.span.unwrap_or((seg.t_start, seg.t_end));
+    let dur = s1 - s0;
     let k = ((dur * job.rate_hz / per).ceil() as usize).max(1);
     let margin = match job.prep.and_then(|p| p.lowpass) {
         Some((_, fc)) if k > 1 && fc > 0.0 => MARGIN_PERIODS / fc,
@@ -106,7 +109,7 @@ pub(crate) fn pass<S: Source>(src: &S, job: &Job) -> Result<(Summary, SegAcc), S
     let mut w = Window {
         job,
         seg,
-        acc: Accumulator::new(job.seg, seg.t_start, job.layout),
+        acc: Accumulator::new(job.seg, s0, job.layout),
         sum: Summary {
             seg: job.seg,
             rows: 0,
@@ -126,10 +129,12 @@ pub(crate) fn pass<S: Source>(src: &S, job: &Job) -> Result<(Summary, SegAcc), S
     // Without two feedback samples there is no reference to fit against.
     let k = if src.table().t.len() < 2 { 0 } else { k };
     for i in 0..k {
-        let at = |i: usize| seg.t_start + dur * i as f64 / k as f64;
-        let (c0, c1) = (at(i), if i + 1 == k { seg.t_end } else { at(i + 1) });
+        let at = |i: usize| s0 + dur * i as f64 / k as f64;
+        let (c0, c1) = (at(i), if i + 1 == k { s1 } else { at(i + 1) });
         let (r0, r1) = ((c0 - margin).max(seg.t_start), (c1 + margin).min(seg.t_end));
-        src.rows(r0, r1, |v| w.window(&mut kin, v, c0, c1, i + 1 == k))?;
+        // Only the segment's own end is inclusive: a piece ends where the next begins.
+        let last = i + 1 == k && s1 >= seg.t_end;
+        src.rows(r0, r1, |v| w.window(&mut kin, v, c0, c1, last))?;
     }
     let Window {
         acc,
