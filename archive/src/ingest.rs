@@ -130,6 +130,10 @@ fn walk(root: &Path, dir: &Path, out: &mut Vec<(String, String, u64)>) -> Result
     for entry in rd.flatten() {
         let path = entry.path();
         let ft = entry.file_type().map_err(|e| ArchiveError::io(&path, e))?;
+        // The run folder's lock file says who writes it now, nothing about the run.
+        if dir == root && entry.file_name() == ratecal_engine::audit::seal::LOCK_FILE {
+            continue;
+        }
         if ft.is_dir() {
             walk(root, &path, out)?;
         } else if ft.is_file() {

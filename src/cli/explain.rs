@@ -126,6 +126,19 @@ pub fn main(args: Args) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    // A ratecal run folder gains explain.json: its lock first, so a second writer is
+    // refused at once (exit 2, an error as spec/cli.md has it for explain).
+    let _lock = if rec.manifest().run.is_some() {
+        match super::lock::acquire(&args.run, &super::seal::command_line()) {
+            Ok(l) => Some(l),
+            Err(e) => {
+                eprintln!("{e:?}");
+                return ExitCode::from(2);
+            }
+        }
+    } else {
+        None
+    };
     let Ok(user) = load_effects(&args.effects) else {
         return ExitCode::from(2);
     };

@@ -79,6 +79,11 @@ pub fn main(args: Args) -> ExitCode {
 }
 
 fn report(args: &Args) -> miette::Result<()> {
+    // Writing into a run folder: its lock first, so a second writer is refused at once.
+    let _lock = match &args.out {
+        Some(out) => super::lock::for_file(out, &super::seal::command_line())?,
+        None => None,
+    };
     let mut input = read_run(&args.run_dir)?;
     let serial = serial_of(&input);
     input.archive_trend = super::archive::trend_json(args.archive.as_deref(), serial.as_deref());

@@ -4,12 +4,12 @@
 use ed25519_dalek::pkcs8::{DecodePrivateKey, DecodePublicKey};
 use ed25519_dalek::{SigningKey, VerifyingKey};
 use miette::{Report, miette};
-use ratecal_engine::audit::seal::{SEAL_FILE, SEAL_HASH_FILE, Seal, is_seal_file};
+use ratecal_engine::audit::seal::{SEAL_FILE, SEAL_HASH_FILE, Seal, is_unsealed_file};
 use ratecal_engine::recording::rfc3339;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// Every file under `dir` but the seal's own, by `/`-separated relative path, with its bytes.
+/// Every file under `dir` but the seal's own and the lock file, by `/`-separated relative path, with its bytes.
 pub fn folder_files(dir: &Path) -> std::io::Result<BTreeMap<String, Vec<u8>>> {
     let mut out = BTreeMap::new();
     let mut stack: Vec<PathBuf> = vec![dir.to_path_buf()];
@@ -26,7 +26,7 @@ pub fn folder_files(dir: &Path) -> std::io::Result<BTreeMap<String, Vec<u8>>> {
                 .map(|c| c.as_os_str().to_string_lossy().into_owned())
                 .collect::<Vec<_>>()
                 .join("/");
-            if !is_seal_file(&name) {
+            if !is_unsealed_file(&name) {
                 out.insert(name, std::fs::read(&path)?);
             }
         }

@@ -54,9 +54,18 @@ pub struct Addition {
     pub files: BTreeMap<String, String>,
 }
 
+/// The run folder's lock file: who writes the folder now. Never sealed, archived or
+/// exported: it says nothing about the run.
+pub const LOCK_FILE: &str = ".ratecal.lock";
+
 /// Whether a path names the seal itself (never listed in it).
 pub fn is_seal_file(path: &str) -> bool {
     path == SEAL_FILE || path == SEAL_HASH_FILE
+}
+
+/// Whether a path is outside what a seal covers: the seal's own files and the lock file.
+pub fn is_unsealed_file(path: &str) -> bool {
+    is_seal_file(path) || path == LOCK_FILE
 }
 
 impl Seal {
