@@ -40,12 +40,16 @@
 
 mod data;
 mod error;
+mod excerpt;
+mod files;
 mod manifest;
 mod read;
 mod write;
 
 pub use data::{ImuSample, ImuStream, Recording, TableSample, TableStream};
 pub use error::{RecordingError, yaml_offset};
+pub use excerpt::Excerpt;
+pub use files::{FileState, hash_folder, regular, sha256_file};
 pub use manifest::{
     AbortRecord, EnvironmentRecord, FORMAT, LinkRecord, Manifest, ManifestStation, Mount,
     ProcedureRef, ResumeRecord, RunInfo, Segment, SegmentKind, SyncRecord, TableAxes,

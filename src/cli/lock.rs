@@ -1,8 +1,9 @@
 //! One writer per run folder: every command that writes a run folder holds an advisory lock
 //! on its `.ratecal.lock` (flock on Unix, LockFileEx on Windows, through `std::fs::File`'s
-//! own locking, so no crate is needed). The kernel releases it when the process ends,
-//! however it ends: a `kill -9` leaves no stale lock. The file also says who holds it, so a
-//! second writer is refused at once naming the holder. It is never sealed or archived.
+//! own locking, stable since Rust 1.89, so no crate is needed). The kernel releases it when
+//! the process ends, however it ends: a `kill -9` leaves no stale lock. The file also says
+//! who holds it, so a second writer is refused at once naming the holder. It is never
+//! sealed, verified or archived.
 
 use miette::{Report, miette};
 use ratecal_engine::audit::seal::{LOCK_FILE, SEAL_FILE};
@@ -11,10 +12,40 @@ use std::fs::{File, OpenOptions, TryLockError};
 use std::io::{Read, Seek, Write};
 use std::path::Path;
 
-/// A held lock on a run folder; released when dropped (or when the process dies).
+/// A held lock on a run folder; released when dropped (or when the process dies). A clean
+/// release removes the lock file; one a killed process leaves is harmless (never sealed,
+/// verified or archived) and taken over by the next writer.
 #[derive(Debug)]
 pub struct FolderLock {
-    _file: File,
+    file: Option<File>,
+    path: std::path::PathBuf,
+}
+
+impl Drop for FolderLock {
+    fn drop(&mut self) {
+        // Removed while still held: a writer that opened the old file then finds it is no
+        // longer the one at this path, and tries again (`same_file`).
+        #[cfg(unix)]
+        let _ = std::fs::remove_file(&self.path);
+        drop(self.file.take());
+    }
+}
+
+/// Whether `file` is still the file at `path` (not removed by a writer that let go).
+fn same_file(file: &File, path: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        match (file.metadata(), std::fs::metadata(path)) {
+            (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+            _ => false,
+        }
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = (file, path);
+        true
+    }
 }
 
 /// Takes the lock of run folder `dir` (created if need be) for `command`, or refuses at
@@ -29,18 +60,22 @@ pub fn acquire(dir: &Path, command: &str) -> Result<FolderLock, Report> {
             dir.display()
         )
     };
-    let mut file = OpenOptions::new()
-        .read(true)
-        .write(true)
-        .create(true)
-        .truncate(false)
-        .open(&path)
-        .map_err(cannot)?;
-    match file.try_lock() {
-        Ok(()) => {}
-        Err(TryLockError::WouldBlock) => return Err(in_use(dir, &mut file)),
-        Err(TryLockError::Error(e)) => return Err(cannot(e)),
-    }
+    let mut file = loop {
+        let mut file = OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .open(&path)
+            .map_err(cannot)?;
+        match file.try_lock() {
+            Ok(()) if same_file(&file, &path) => break file,
+            // The holder let go and removed it meanwhile: open the new one.
+            Ok(()) => continue,
+            Err(TryLockError::WouldBlock) => return Err(in_use(dir, &mut file)),
+            Err(TryLockError::Error(e)) => return Err(cannot(e)),
+        }
+    };
     // Who holds it, for the writer refused next.
     let holder = format!(
         "pid {}\nsince {}\ncommand {command}\n",
@@ -53,7 +88,10 @@ pub fn acquire(dir: &Path, command: &str) -> Result<FolderLock, Report> {
         .and_then(|()| file.flush())
         .map_err(cannot)?;
     hold_for_tests();
-    Ok(FolderLock { _file: file })
+    Ok(FolderLock {
+        file: Some(file),
+        path,
+    })
 }
 
 /// The lock of the run folder `file` is written into, when it lies in one (a folder holding

@@ -5,12 +5,12 @@
 // A refused recording is built once per read: the error's size costs nothing.
 #![allow(clippy::result_large_err)]
 
-use super::csvread::{cell_offset, lossy_span, row_start};
+use super::csvread::{cell_offset, row_start};
 use super::io_error;
 use super::manifest::find_segment;
 use crate::Manifest;
 use crate::error::{RecordingError, empty_stream, line_col, line_col_bytes};
-use miette::NamedSource;
+use crate::excerpt::Excerpt;
 use std::path::Path;
 
 /// Time strictly increasing, at least two rows; a problem is located by reading the file
@@ -62,8 +62,8 @@ pub(super) fn time_error(path: &Path, row: usize, prev: f64, t: f64) -> Recordin
         column,
         t,
         prev,
-        src: NamedSource::new(file, String::from_utf8_lossy(&bytes).into_owned()),
-        span: lossy_span(&bytes, offset, offset + len),
+        src: Excerpt::around(&file, &bytes, offset, offset + len).0,
+        span: Excerpt::around(&file, &bytes, offset, offset + len).1,
     }
 }
 
@@ -126,8 +126,8 @@ pub(super) fn check_segments(
             t_end: seg.t_end,
             problem,
             help,
-            src: NamedSource::new(file, text.to_string()),
-            span: (offset, len).into(),
+            src: Excerpt::around(file, text.as_bytes(), offset, offset + len).0,
+            span: Excerpt::around(file, text.as_bytes(), offset, offset + len).1,
         };
         if !(seg.t_start.is_finite() && seg.t_end.is_finite()) || seg.t_end <= seg.t_start {
             return Err(outside(
@@ -149,8 +149,8 @@ pub(super) fn check_segments(
                 id: seg.id.clone(),
                 t_start: seg.t_start,
                 t_end: seg.t_end,
-                src: NamedSource::new(file, text.to_string()),
-                span: (offset, len).into(),
+                src: Excerpt::around(file, text.as_bytes(), offset, offset + len).0,
+                span: Excerpt::around(file, text.as_bytes(), offset, offset + len).1,
             });
         }
     }

@@ -6,7 +6,7 @@
 use super::{Prepared, imports, setup};
 use crate::cli::lock::FolderLock;
 use miette::{Report, miette};
-use ratecal_engine::audit::seal::{SEAL_FILE, SEAL_HASH_FILE, verify_seal};
+use ratecal_engine::audit::seal::{SEAL_FILE, SEAL_HASH_FILE, verify_hashes};
 use ratecal_engine::recording::{
     Manifest, RecordingWriter, ResumeRecord, parse_manifest, rfc3339, sha256_hex,
 };
@@ -114,7 +114,7 @@ fn unaltered(dir: &Path) -> Result<(), Report> {
     let hash = std::fs::read_to_string(dir.join(SEAL_HASH_FILE)).ok();
     let files = crate::cli::seal::folder_files(dir)
         .map_err(|e| miette!("cannot read {}: {e}", dir.display()))?;
-    let report = verify_seal(Some(&seal), hash.as_deref(), &files, None);
+    let report = verify_hashes(Some(&seal), hash.as_deref(), &files, None);
     if report.intact() {
         return Ok(());
     }
