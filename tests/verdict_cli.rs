@@ -48,7 +48,11 @@ fn a_run_analysed_with_the_wrong_procedure_is_incomplete() {
     let tmp = tempfile::tempdir().unwrap();
     let o = mini_run(tmp.path(), "r", &[]);
     assert_eq!(code(&o), 0, "{}", text(&o));
-    assert_eq!(json(&tmp.path().join("r/results.json"))["verdict"], "pass");
+    // MINI declares no acceptance check: nothing is judged (exit 0, never a pass).
+    assert_eq!(
+        json(&tmp.path().join("r/results.json"))["verdict"],
+        "not_judged"
+    );
     let std = procedures("imu-2d-standard");
     let o = ratecal(&["analyze", "r", "--procedure", &std], tmp.path());
     assert_eq!(code(&o), 3, "{}", text(&o));

@@ -15,9 +15,18 @@ pub struct Results {
     /// `ratecal-results/1`.
     pub format: String,
     /// The run's verdict over every check it can decide (`pass`, `fail`, `incomplete`,
-    /// `aborted`); an older results file without one reads as `incomplete`.
+    /// `aborted`, `not_judged`); an older results file without one reads as `incomplete`.
     #[serde(default)]
     pub verdict: RunVerdict,
+    /// Why the verdict is what it is, when the checks alone do not say it: the failed
+    /// sanity checks (`incomplete`: not fit for judgment) or why nothing was judged
+    /// (`not_judged`). The terminal and the report print this sentence.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub verdict_reason: Option<String>,
+    /// The sanity checks (what physics guarantees of any recording), one entry per check,
+    /// always all of them; a failed one makes the verdict `incomplete`.
+    #[serde(default)]
+    pub sanity: Vec<SanityCheck>,
     /// Parameters by dotted name (`accel.bias.x`, `gyro.scale.z`, `accel.misalignment.xy`...).
     pub parameters: BTreeMap<String, Parameter>,
     /// Every acceptance threshold of the procedure, evaluated (or not evaluated, with why).
@@ -258,6 +267,53 @@ impl Verdict {
     }
 }
 
+/// One sanity check: what physics guarantees of any recording (gravity at rest, the gyro
+/// following the table, one clock, plausible fitted values), checked before the numbers
+/// become a verdict. Names are stable (docs/results.md).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SanityCheck {
+    /// The check's name (`gravity_magnitude_at_rest`, ...).
+    pub check: String,
+    /// Outcome.
+    pub status: SanityStatus,
+    /// What was found, where, against what tolerance, in plain words.
+    pub detail: String,
+}
+
+impl SanityCheck {
+    /// An entry.
+    pub fn new(check: &str, status: SanityStatus, detail: impl Into<String>) -> Self {
+        SanityCheck {
+            check: check.to_string(),
+            status,
+            detail: detail.into(),
+        }
+    }
+}
+
+/// Outcome of a sanity check.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SanityStatus {
+    /// Holds.
+    Pass,
+    /// Does not hold: the recording is not fit for judgment.
+    Fail,
+    /// The recording holds nothing to check it on (e.g. no rate segment).
+    NotEvaluated,
+}
+
+impl SanityStatus {
+    /// How the terminal shows it (a failure in capitals).
+    pub fn label(self) -> &'static str {
+        match self {
+            SanityStatus::Pass => "pass",
+            SanityStatus::Fail => "FAIL",
+            SanityStatus::NotEvaluated => "not evaluated",
+        }
+    }
+}
+
 /// The verdict of a whole run (or of several runs analysed together).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -271,6 +327,9 @@ pub enum RunVerdict {
     Incomplete,
     /// The run was aborted (or otherwise did not complete).
     Aborted,
+    /// No acceptance check was evaluated (no procedure, a procedure without `accept`, or
+    /// only checks decided over several runs): nothing to judge, never a pass.
+    NotJudged,
 }
 
 impl RunVerdict {
@@ -281,7 +340,13 @@ impl RunVerdict {
             RunVerdict::Fail => "fail",
             RunVerdict::Incomplete => "incomplete",
             RunVerdict::Aborted => "aborted",
+            RunVerdict::NotJudged => "not_judged",
         }
+    }
+
+    /// How the terminal shows it (`PASS`, `NOT JUDGED`, ...).
+    pub fn label(self) -> String {
+        self.as_str().replace('_', " ").to_uppercase()
     }
 }
 
@@ -506,20 +571,57 @@ impl Results {
         self.acceptance.iter().any(|a| a.verdict == Verdict::Fail)
     }
 
-    /// Sets `verdict` from the checks: `aborted` when the run did not complete, else `fail`
-    /// on a failed check, `incomplete` on one not evaluated or undecided, else `pass`
-    /// (deferred checks leave it at `pass`).
+    /// The sanity checks that failed.
+    pub fn sanity_failures(&self) -> impl Iterator<Item = &SanityCheck> {
+        self.sanity
+            .iter()
+            .filter(|c| c.status == SanityStatus::Fail)
+    }
+
+    /// Sets `verdict` from the checks: `aborted` when the run did not complete, else
+    /// `incomplete` on a failed sanity check (the recording is not fit for judgment), else
+    /// `fail` on a failed acceptance check, `incomplete` on one not evaluated or undecided,
+    /// `not_judged` when none was evaluated (none declared, or all deferred), else `pass`.
     pub fn decide(&mut self, aborted: bool) {
         let any = |v: Verdict| self.acceptance.iter().any(|a| a.verdict == v);
         self.verdict = if aborted {
             RunVerdict::Aborted
+        } else if self.sanity_failures().next().is_some() {
+            RunVerdict::Incomplete
         } else if any(Verdict::Fail) {
             RunVerdict::Fail
         } else if any(Verdict::NotEvaluated) || any(Verdict::Indeterminate) {
             RunVerdict::Incomplete
+        } else if !any(Verdict::Pass) {
+            RunVerdict::NotJudged
         } else {
             RunVerdict::Pass
         };
+        self.verdict_reason = self.reason();
+    }
+
+    /// The sentence `verdict_reason` holds for the verdict decided.
+    fn reason(&self) -> Option<String> {
+        let failed: Vec<&str> = self.sanity_failures().map(|c| c.check.as_str()).collect();
+        match self.verdict {
+            RunVerdict::Incomplete if !failed.is_empty() => Some(format!(
+                "the recording is not fit for judgment: sanity check{} {} failed",
+                if failed.len() == 1 { "" } else { "s" },
+                failed.join(", ")
+            )),
+            RunVerdict::NotJudged => Some(match &self.model.procedure {
+                Some(p) if self.acceptance.is_empty() => format!(
+                    "procedure {} {} declares no acceptance check: the results are measurements, not judged against any standard",
+                    p.name, p.version
+                ),
+                Some(p) => format!(
+                    "the checks of procedure {} {} are decided over several runs, none on this one: the results are measurements, not judged",
+                    p.name, p.version
+                ),
+                None => "analysed without a procedure: no acceptance check applies; the results are measurements, not judged against any standard".into(),
+            }),
+            _ => None,
+        }
     }
 
     /// An estimate by name: `(value, u)`.
@@ -603,6 +705,8 @@ mod tests {
                 false,
                 RunVerdict::Fail,
             ),
+            (vec![], false, RunVerdict::NotJudged),
+            (vec![Verdict::Deferred], false, RunVerdict::NotJudged),
             (vec![Verdict::Pass], true, RunVerdict::Aborted),
         ];
         for (checks, aborted, want) in cases {
@@ -611,6 +715,16 @@ mod tests {
             assert_eq!(r.verdict, want, "{checks:?} aborted={aborted}");
         }
         assert!(r.to_json().contains("\"verdict\": \"aborted\""));
+        // A failed sanity check is never a pass, whatever the acceptance says.
+        r.acceptance = vec![check(Verdict::Pass)];
+        r.sanity = vec![SanityCheck::new(
+            "gravity_magnitude_at_rest",
+            SanityStatus::Fail,
+            "1.0 m/s^2",
+        )];
+        r.decide(false);
+        assert_eq!(r.verdict, RunVerdict::Incomplete);
+        assert!(r.to_json().contains("\"status\": \"fail\""));
     }
 
     #[test]

@@ -104,6 +104,11 @@ fn accel_bias_step_is_unexplained_on_the_accelerometers_at_its_instant() {
     assert_eq!(accel.len(), 1, "{:?}", x.unexplained);
     let u = accel[0];
     assert!(u.channels.contains(&"ax".to_string()) && u.channels.contains(&"ay".to_string()));
+    assert!(
+        !u.channels.contains(&"az".to_string()),
+        "az has no step: {:?}",
+        u.channels
+    );
     // The strongest form is a step between the segments around t = 1500 s.
     let best = &u.signature[0];
     assert!(best.in_time, "{best:?}");

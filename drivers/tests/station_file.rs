@@ -232,3 +232,75 @@ fn errors_after_a_bare_cr_are_located_where_the_message_says() {
     assert_eq!((err.line, err.column), (Some(2), Some(2)), "{shown}");
     assert!(shown.contains("lab.yaml:2:2"), "{shown}");
 }
+
+#[test]
+fn the_ieee_terms_map_to_the_model_and_the_encoder_error_to_the_table() {
+    let text = with(
+        "  effects: {}",
+        "  effects:\n    accel_second_order: { x: 150 }\n    clock_rate: { ppm: 60 }\n    gyro_scale_asymmetry: { z: -40 }",
+    )
+    .replace(
+        "feedback_rate: 50 Hz",
+        "feedback_rate: 50 Hz\n  effects: { table_encoder_eccentricity: { outer_sin_arcsec: 36, inner_cos_arcsec: -18 } }",
+    );
+    let s = Station::from_yaml(&text, "lab.yaml").unwrap();
+    let m = s.imu_model();
+    let values = |id: &str| {
+        m.terms
+            .iter()
+            .find(|t| t.effect.id() == id)
+            .map(|t| t.values.clone())
+    };
+    assert_eq!(values("accel_second_order"), Some(vec![150.0, 0.0, 0.0]));
+    assert_eq!(values("clock_rate"), Some(vec![60.0]));
+    assert_eq!(values("gyro_scale_asymmetry"), Some(vec![0.0, 0.0, -40.0]));
+    // A station error is not the IMU's: the table carries it.
+    assert_eq!(values("table_encoder_eccentricity"), None);
+    let e = s.encoder_error();
+    let arcsec = ratecal_physics::DEG / 3600.0;
+    assert!((e.outer[0] - 36.0 * arcsec).abs() < 1e-18 && e.outer[1] == 0.0);
+    assert!((e.inner[1] + 18.0 * arcsec).abs() < 1e-18 && e.inner[0] == 0.0);
+    // The clock's lag grows with the stamp: 60 ppm of 1000 s.
+    assert!((m.delay_at_s(1000.0) - 1000.0 * 60e-6 / (1.0 + 60e-6)).abs() < 1e-12);
+}
+
+#[test]
+fn each_effect_goes_in_its_own_block() {
+    assert_refused_at_its_line(
+        "  effects: {}",
+        "  effects: { table_encoder_eccentricity: { outer_sin_arcsec: 10 } }",
+        "write it under `table.effects`",
+    );
+    assert_refused_in_the_table_block("clock_rate: { ppm: 10 }", "write it under `imu.effects`");
+}
+
+/// The default station with `table.effects: { block }` is refused on that block's line.
+fn assert_refused_in_the_table_block(block: &str, needle: &str) {
+    let line = DEFAULT_STATION_YAML
+        .lines()
+        .position(|l| l.contains("feedback_rate: 50 Hz"))
+        .unwrap()
+        + 2;
+    let text = with(
+        "feedback_rate: 50 Hz",
+        &format!("feedback_rate: 50 Hz\n  effects: {{ {block} }}"),
+    );
+    let err = Station::from_yaml(&text, "lab.yaml").unwrap_err();
+    let shown = render(&err);
+    assert_eq!(err.line, Some(line), "{shown}");
+    assert!(shown.contains(needle), "{shown}");
+}
+
+#[test]
+fn retiming_values_the_simulator_cannot_evaluate_are_refused() {
+    // 1 + eps = 0 stops the IMU's clock; an encoder error of radians has no inverse.
+    assert_refused_at_its_line(
+        "  effects: {}",
+        "  effects: { clock_rate: { ppm: -1e6 } }",
+        "within 10 %",
+    );
+    assert_refused_in_the_table_block(
+        "table_encoder_eccentricity: { inner_sin_arcsec: 1e6 }",
+        "within a degree",
+    );
+}

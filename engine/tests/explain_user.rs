@@ -1,7 +1,7 @@
 //! User effects (docs/user-effects.md) in explain, on recordings the simulator makes of the
 //! standard plan: a file that re-states a built-in effect finds what the built-in finds,
-//! with the same values; a file with physics the registry lacks (an accelerometer
-//! second-order nonlinearity, added to the simulated outputs) is found and measured.
+//! with the same values; a file with physics the registry lacks (a cross-coupling of the X
+//! and Z accelerometers, added to the simulated outputs) is found and measured.
 
 mod common;
 
@@ -104,14 +104,16 @@ fn a_restated_lever_arm_gives_the_built_in_finding_and_values() {
     assert_eq!(restated.user_effects[0].effect, "centripetal");
 }
 
-/// K2 (ug/g^2) added to the simulated accelerometer outputs: `1e-6 K2 a^2 / g` (the output
-/// stands for the specific force; the difference is of second order in the scale error).
-fn add_k2(rec: &mut Recording, k2: [f64; 3]) {
+/// Cross-coupling (ug/g^2) of the X and Z accelerometers added to the simulated outputs:
+/// `1e-6 k f_x f_z / g` on X and on Z (the outputs stand for the specific force; the
+/// difference is of second order in the scale error).
+fn add_cross_xz(rec: &mut Recording, [xz, zx]: [f64; 2]) {
     let g = rec.manifest.station.site.gravity_mps2;
-    for (axis, k) in rec.imu.accel.iter_mut().zip(k2) {
-        for a in axis.iter_mut() {
-            *a += k * 1e-6 * *a * *a / g;
-        }
+    let [ax, _, az] = &mut rec.imu.accel;
+    for (x, z) in ax.iter_mut().zip(az.iter_mut()) {
+        let p = 1e-6 * *x * *z / g;
+        *x += xz * p;
+        *z += zx * p;
     }
 }
 
@@ -119,40 +121,60 @@ fn add_k2(rec: &mut Recording, k2: [f64; 3]) {
 fn physics_the_registry_lacks_is_found_from_its_file() {
     for seed in [11, 12] {
         let mut rec = record("{}", seed);
-        let truth = [20.0, 0.0, -15.0];
-        add_k2(&mut rec, truth);
-        let x = run(&rec, &["accel_k2.effect", "centripetal.effect"], &[]);
+        let truth = [60.0, -40.0];
+        add_cross_xz(&mut rec, truth);
+        let x = run(&rec, &["accel_cross_xz.effect", "centripetal.effect"], &[]);
         assert_eq!(
             found(&x),
-            ["accel_k2", "earth_rate"],
+            ["accel_cross_xz", "earth_rate"],
             "seed {seed}: {:?}",
             x.rejected
         );
-        for (p, t) in ["x", "y", "z"].iter().zip(truth) {
-            let (v, u) = estimate(&x, "accel_k2", p);
+        for (p, t) in ["xz", "zx"].iter().zip(truth) {
+            let (v, u) = estimate(&x, "accel_cross_xz", p);
             assert!(
                 (v - t).abs() < 3.0 * u,
-                "seed {seed}: k2.{p} = {v} ± {u}, truth {t}"
+                "seed {seed}: cross.{p} = {v} ± {u}, truth {t}"
             );
-            assert!(u < 2.0, "seed {seed}: k2.{p} ± {u}");
+            assert!(u < 5.0, "seed {seed}: cross.{p} ± {u}");
         }
         assert!(x.final_.rms.accel_mps2 < 1.2 * x.final_.noise_floor.accel_mps2);
-        // Located where gravity lies along X or Z; there the residual falls to the noise.
-        let f = x.findings.iter().find(|f| f.effect == "accel_k2").unwrap();
+        // Located where gravity turns through the X-Z plane: the rotations about the outer
+        // axis; there the residual falls to the noise.
+        let f = x
+            .findings
+            .iter()
+            .find(|f| f.effect == "accel_cross_xz")
+            .unwrap();
         let top = &f.located[0];
         assert!(["ax", "az"].contains(&top.channel.as_str()), "{top:?}");
+        assert!(top.segment.starts_with("gyro_scale/outer"), "{top:?}");
         assert!(top.rms_before > 1.25 * top.rms_after, "{top:?}");
         assert!(
             top.rms_after < 1.1 * x.final_.noise_floor.accel_mps2,
             "{top:?}"
         );
-        // Without the file the nonlinearity stays unexplained, on the held-out segments too.
+        // Without the file the cross-coupling stays unexplained, on the held-out segments
+        // too (and no registry effect is named for it: the test below).
         let bare = run(&rec, &[], &[]);
-        assert!(!found(&bare).contains(&"accel_k2"), "seed {seed}");
         let (b, w) = (bare.final_.holdout_rms, x.final_.holdout_rms);
         assert!(
             b.accel_mps2 > 1.02 * w.accel_mps2,
             "seed {seed}: {b:?} {w:?}"
         );
+    }
+}
+
+/// Issue 27: physics the grown registry lacks is not named as a registry effect (before
+/// explain learnt to say what it cannot explain, seed 12 named `accel_scale_thermal`,
+/// `f_x (T - T_ref)`, which the rate segments' partial revolutions and the IMU's warm-up
+/// make correlate with `f_x f_z`).
+#[test]
+fn physics_the_registry_lacks_is_not_named_as_a_registry_effect() {
+    for seed in [11, 12] {
+        let mut rec = record("{}", seed);
+        add_cross_xz(&mut rec, [60.0, -40.0]);
+        let bare = run(&rec, &[], &[]);
+        assert_eq!(found(&bare), ["earth_rate"], "seed {seed}");
     }
 }

@@ -162,7 +162,9 @@ fn foreign_recording_plots_what_it_has() {
     let html = render(&foreign(), &Templates::bundled(), Format::Html).unwrap();
     // Residuals (accel, gyro), rate-point residuals, Allan; no temperature series, no findings.
     assert_eq!(html.matches("<svg ").count(), 4);
-    assert!(html.contains("No findings."));
+    // No findings section at all: never a "No findings." beside a warning that points at
+    // explain.
+    assert!(!html.contains("No findings.") && !html.contains("id=\"findings\""));
     assert!(!html.contains("<title>Temperature"));
 }
 
@@ -181,5 +183,37 @@ fn minimal_results_without_manifest_still_make_a_report() {
             r.file_name
         );
         assert!(!r.text.contains("DRY RUN"), "{}", r.file_name);
+    }
+}
+
+/// A failed sanity check: the report says the recording is not fit for judgment, names
+/// the check in the verdict line, the sanity table and the conclusions, and does not tell
+/// the reader the results meet (or miss) the standard.
+#[test]
+fn a_failed_sanity_check_is_not_fit_for_judgment() {
+    let mut input = foreign();
+    input.results["verdict"] = "incomplete".into();
+    input.results["verdict_reason"] =
+        "the recording is not fit for judgment: sanity check gravity_magnitude_at_rest failed"
+            .into();
+    input.results["sanity"] = serde_json::json!([
+        { "check": "gravity_magnitude_at_rest", "status": "fail",
+          "detail": "segment accel_static/1: |specific force| 1.0009 m/s^2" },
+        { "check": "gyro_at_rest", "status": "pass", "detail": "worst segment ..." }
+    ]);
+    for format in [Format::Markdown, Format::Html] {
+        let text = render(&input, &Templates::bundled(), format).unwrap();
+        assert!(
+            text.contains(
+                "INCOMPLETE</span>: the recording is not fit for judgment: sanity check gravity_magnitude_at_rest failed"
+            ) || text.contains(
+                "**INCOMPLETE**: the recording is not fit for judgment: sanity check gravity_magnitude_at_rest failed"
+            ),
+            "{format:?}"
+        );
+        assert!(text.contains("not fit for judgment</strong>: sanity check <code>gravity_magnitude_at_rest</code> failed")
+            || text.contains("**not fit for judgment**: sanity check `gravity_magnitude_at_rest` failed"), "{format:?}");
+        assert!(!text.contains("meet the standard"), "{format:?}");
+        assert!(!text.contains("PASS"), "{format:?}");
     }
 }

@@ -88,7 +88,7 @@ fn assert_graceful(text: &str) {
     }
 }
 
-const K2: &str = include_str!("../../docs/examples/effects/accel_k2.effect");
+const CROSS: &str = include_str!("../../docs/examples/effects/accel_cross_xz.effect");
 
 fn tokens() -> impl Strategy<Value = String> {
     let words = vec![
@@ -157,8 +157,8 @@ proptest! {
     }
 
     #[test]
-    fn mutated_example(cut in 0usize..K2.len(), len in 0usize..40, insert in "[ -~\n]{0,12}") {
-        let mut text = K2.to_string();
+    fn mutated_example(cut in 0usize..CROSS.len(), len in 0usize..40, insert in "[ -~\n]{0,12}") {
+        let mut text = CROSS.to_string();
         let start = (0..=cut).rev().find(|&i| text.is_char_boundary(i)).unwrap_or(0);
         let end = (start + len).min(text.len());
         let end = (end..=text.len()).find(|&i| text.is_char_boundary(i)).unwrap_or(text.len());

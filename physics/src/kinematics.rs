@@ -158,6 +158,9 @@ impl TableState {
         let c_bl = (r_o * r_i * geo.c_pb).transpose();
         let rt_ao = r_i.transpose() * geo.outer_axis;
         Snapshot {
+            state: *self,
+            outer_b: c_bl * geo.outer_axis,
+            inner_b: geo.c_pb.transpose() * geo.inner_axis,
             c_bl,
             c_bp: geo.c_pb.transpose(),
             w_p: rt_ao * self.outer.rate + geo.inner_axis * self.inner.rate,
@@ -177,6 +180,12 @@ fn dw_p(geo: &Geometry, rt_ao: &Vec3, s: &TableState) -> Vec3 {
 /// One table state's kinematics, rotations done: see [`TableState::snapshot`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Snapshot {
+    /// The table state it was computed from (angles, rates, accelerations).
+    pub state: TableState,
+    /// `a_o` in body axes at this instant (`C_LB^T a_o`).
+    pub outer_b: Vec3,
+    /// `a_i` in body axes (`C_PB^T a_i`, constant for a mount).
+    pub inner_b: Vec3,
     /// `C_LB^T`.
     pub c_bl: Mat3,
     /// `C_PB^T`.

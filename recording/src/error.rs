@@ -93,11 +93,15 @@ pub enum RecordingError {
         span: SourceSpan,
     },
 
-    /// Time stamps that do not strictly increase.
-    #[error("{file}:{line}:{column}: time goes backwards or repeats ({t} s after {prev} s)")]
+    /// Time stamps that do not strictly increase (sanity check `time_increasing`).
+    #[error(
+        "{file}:{line}:{column}: time goes backwards or repeats ({t} s after {prev} s): sanity check `time_increasing` fails"
+    )]
     #[diagnostic(
-        code(recording::time_not_increasing),
-        help("the `t` column of {file} must strictly increase, one sample a line")
+        code(sanity::time_increasing),
+        help(
+            "the `t` column of {file} must strictly increase, one sample a line; a clock reset or two runs in one file does this: cut the file there or re-stamp it"
+        )
     )]
     TimeNotIncreasing {
         /// File name.
@@ -138,6 +142,40 @@ pub enum RecordingError {
         src: Excerpt,
         /// The line.
         #[label("no line break here")]
+        span: SourceSpan,
+    },
+
+    /// The IMU's and the table's clocks have no time in common (sanity check
+    /// `clocks_overlap`): the two streams cannot be one clock's.
+    #[error(
+        "{file}:{line}:{column}: the table feedback ({table_first} s .. {table_last} s) and the IMU stream ({imu_first} s .. {imu_last} s) do not overlap in time: sanity check `clocks_overlap` fails"
+    )]
+    #[diagnostic(
+        code(sanity::clocks_overlap),
+        help(
+            "imu.csv and table.csv share one clock (spec/recording-format.md); stamp both with it (e.g. subtract the difference of their origins from one `t` column)"
+        )
+    )]
+    ClocksDisjoint {
+        /// File name (the table feedback's).
+        file: String,
+        /// Line, 1-based.
+        line: u64,
+        /// Column, 1-based.
+        column: usize,
+        /// The table's first and last stamps, s.
+        table_first: f64,
+        /// Last table stamp, s.
+        table_last: f64,
+        /// First IMU stamp, s.
+        imu_first: f64,
+        /// Last IMU stamp, s.
+        imu_last: f64,
+        /// File text.
+        #[source_code]
+        src: Excerpt,
+        /// The table's first stamp.
+        #[label("the table's clock starts here")]
         span: SourceSpan,
     },
 

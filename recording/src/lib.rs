@@ -38,6 +38,7 @@
 //! # }
 //! ```
 
+pub mod cadence;
 mod data;
 mod error;
 mod excerpt;
@@ -46,6 +47,7 @@ mod manifest;
 mod read;
 mod write;
 
+pub use cadence::{Cadence, CadenceReport};
 pub use data::{ImuSample, ImuStream, Recording, TableSample, TableStream};
 pub use error::{RecordingError, yaml_offset};
 pub use excerpt::Excerpt;

@@ -255,3 +255,20 @@ fn a_byte_order_mark_before_the_header_is_no_column() {
         assert_eq!(rec.table, want.table);
     }
 }
+
+/// A table stamped on another clock (here 1000 s later) shares no time with the IMU: the
+/// sanity check `clocks_overlap` refuses it, located at the table's first stamp, whether
+/// the folder is read whole or opened span by span.
+#[test]
+fn err_clocks_disjoint() {
+    let mut table = String::from("t,outer,inner,outer_rate,inner_rate\n");
+    for i in 0..6 {
+        table += &format!("{:.2},0,0,0,0\n", 1000.0 + i as f64 * 0.1);
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    small(tmp.path(), MANIFEST, &imu_text(), &table);
+    let whole = recording::read(tmp.path()).expect_err("must be refused");
+    let opened = recording::Recording::open(tmp.path()).expect_err("must be refused");
+    assert_eq!(render(tmp.path(), &whole), render(tmp.path(), &opened));
+    insta::assert_snapshot!(render(tmp.path(), &whole));
+}

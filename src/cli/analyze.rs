@@ -1,7 +1,9 @@
 //! `ratecal analyze RUN_DIR... [--procedure PROCEDURE] [--out results.json]`: fits,
 //! uncertainties and acceptance for one recording, or repeatability over several runs.
-//! Exit codes: 0 the verdict is pass, 3 it is not (a failed check, a check that could not
-//! be evaluated, an aborted run), 1 input error, 2 usage error (clap).
+//! Exit codes: 0 the verdict is pass or not_judged (no acceptance check to judge), 3 it is
+//! not (a failed check, a check that could not be evaluated, a failed sanity check, an
+//! aborted run), 1 input error (a refused recording: time going backwards, clocks that do
+//! not overlap...), 2 usage error (clap).
 
 use super::procedure::{self, FsSources};
 use ratecal_engine::check::{CheckOptions, check_text};
@@ -100,8 +102,13 @@ pub fn main(args: Args) -> ExitCode {
         None => outln!("{json}"),
     }
     summary(&results);
-    match results.verdict {
-        RunVerdict::Pass => ExitCode::SUCCESS,
+    exit_code(results.verdict)
+}
+
+/// 0 for a pass and for nothing judged, 3 for every other verdict (spec/cli.md).
+pub(crate) fn exit_code(v: RunVerdict) -> ExitCode {
+    match v {
+        RunVerdict::Pass | RunVerdict::NotJudged => ExitCode::SUCCESS,
         _ => ExitCode::from(3),
     }
 }
@@ -149,6 +156,11 @@ fn summary(r: &Results) {
         Some(p) if r.model.selection == "procedure" => {
             errln!("model: the fits of procedure {} {}", p.name, p.version)
         }
+        Some(p) => errln!(
+            "model: segments chosen by kind (procedure {} {} has no fit statements)",
+            p.name,
+            p.version
+        ),
         _ => errln!(
             "model: segments chosen by kind (no --procedure: no procedure's fits or thresholds apply)"
         ),
@@ -167,8 +179,43 @@ fn summary(r: &Results) {
     for a in &r.acceptance {
         errln!("  [{}] {}", a.verdict.label(), a.name);
     }
-    for w in &r.warnings {
-        errln!("  warning: {w}");
+    for line in verdict_lines(r) {
+        errln!("{line}");
     }
-    errln!("verdict: {}", r.verdict.as_str().to_uppercase());
+}
+
+/// The end of every terminal summary (`analyze`, `run`): the sanity checks that did not
+/// pass, the warnings with their count (the count results.json and the report give), the
+/// verdict and why it is what it is.
+pub(crate) fn verdict_lines(r: &Results) -> Vec<String> {
+    use ratecal_engine::results::SanityStatus;
+    let mut out = Vec::new();
+    let passed = r
+        .sanity
+        .iter()
+        .filter(|c| c.status == SanityStatus::Pass)
+        .count();
+    out.push(format!(
+        "sanity: {passed} of {} checks pass",
+        r.sanity.len()
+    ));
+    for c in r.sanity.iter().filter(|c| c.status != SanityStatus::Pass) {
+        out.push(format!(
+            "  [{}] {}: {}",
+            c.status.label(),
+            c.check,
+            c.detail
+        ));
+    }
+    out.push(format!("warnings: {}", r.warnings.len()));
+    for w in &r.warnings {
+        out.push(format!("  warning: {w}"));
+    }
+    let why = r
+        .verdict_reason
+        .as_ref()
+        .map(|w| format!(" ({w})"))
+        .unwrap_or_default();
+    out.push(format!("verdict: {}{why}", r.verdict.label()));
+    out
 }

@@ -42,6 +42,8 @@ enum VerdictArg {
     Fail,
     Incomplete,
     Aborted,
+    /// No acceptance check was evaluated (`not_judged`).
+    NotJudged,
 }
 
 #[derive(Subcommand)]
@@ -348,6 +350,7 @@ fn verdict_name(v: VerdictArg) -> &'static str {
         VerdictArg::Fail => "fail",
         VerdictArg::Incomplete => "incomplete",
         VerdictArg::Aborted => "aborted",
+        VerdictArg::NotJudged => "not_judged",
     }
 }
 

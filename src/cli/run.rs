@@ -1,7 +1,8 @@
 //! `ratecal run`: runs a procedure on a station (simulated with `--dry-run` or without a
 //! station), records the run folder, analyses it, writes the reports and seals the folder.
-//! Exit codes (spec/cli.md): 0 the verdict is pass, 3 it is not (a failed check, a check
-//! that could not be evaluated), 4 aborted, 1 input error (or a run that failed: its folder
+//! Exit codes (spec/cli.md): 0 the verdict is pass or not_judged (no acceptance check), 3 it
+//! is not (a failed check, a check that could not be evaluated, a failed sanity check), 4
+//! aborted, 1 input error (or a run that failed: its folder
 //! ends with `status: failed`), 2 usage.
 
 mod check;

@@ -93,6 +93,11 @@ pub fn mini_run(dir: &Path, out: &str, extra: &[&str]) -> Output {
     ratecal(&args, dir)
 }
 
+/// `../shared/examples/<name>`, or `None` with a "skipped" line when this machine lacks it.
+pub fn shared_example(name: &str) -> Option<PathBuf> {
+    shared::shared_example(name)
+}
+
 /// The shared lever-arm example recording (`../shared/examples/standard-with-lever-arm`),
 /// or `None` with a "skipped" line when this machine lacks it.
 pub fn example() -> Option<PathBuf> {

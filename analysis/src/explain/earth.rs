@@ -26,12 +26,16 @@ static PARAMS: [Param; 2] = [
         unit: "1",
         channel: None,
         needs: "static attitudes that turn the Earth's axis through the gyro axes",
+        // Judged against 1 by explain itself, not by a magnitude.
+        max_abs: f64::INFINITY,
     },
     Param {
         name: "east_dph",
         unit: "deg/h",
         channel: None,
         needs: "static attitudes that turn the lab's East axis through the gyro axes",
+        // No component of the Earth's rate exceeds it.
+        max_abs: ratecal_physics::EARTH_RATE_RADPS / DEG * 3600.0,
     },
 ];
 

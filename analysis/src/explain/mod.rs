@@ -300,6 +300,7 @@ fn finding(
             .iter()
             .map(|&e| lay.effects[e].id().to_string())
             .collect(),
+        station_side: fx.station_side(),
         separate_by: (!step.alternatives.is_empty()).then(|| {
             step.alternatives
                 .iter()

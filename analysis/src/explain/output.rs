@@ -134,6 +134,9 @@ pub struct Finding {
     /// With alternatives: the motion that would separate them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub separate_by: Option<String>,
+    /// An error of the station (the table's encoders), not of the IMU.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub station_side: bool,
 }
 
 /// One form a leftover follows.

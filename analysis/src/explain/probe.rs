@@ -28,6 +28,10 @@ pub(crate) enum Form {
     RateAbs,
     /// `w_ib,i^2` (deg/s)^2: even in the rate.
     RateSquare,
+    /// `f_i |w_b|^2` (accel, (rad/s)^2): the specific force scaled by the rate squared,
+    /// what a timing error leaves at second order (`-tau^2 w^2 f / 2`) or a scale that
+    /// changes with the rate.
+    ForceRateSquare,
     /// `(t - t0) / 3600`: a linear drift per hour.
     Drift { t0: f64 },
     /// `exp(-(t - t0) / tau)`: a decay since the recording began.
@@ -63,6 +67,8 @@ impl Probe {
                 unit: "1",
                 channel: Some((sensor, i)),
                 needs: "",
+                // A probe is a form, not physics: no range.
+                max_abs: f64::INFINITY,
             })
             .collect();
         Box::leak(Box::new(Probe {
@@ -90,6 +96,9 @@ impl Probe {
             Form::ForceAbs => format!("abs(f_b.{a})"),
             Form::RateAbs => format!("abs(w_ib.{a} / deg)"),
             Form::RateSquare => format!("(w_ib.{a} / deg)^2"),
+            Form::ForceRateSquare => {
+                format!("f_b.{a} * (w_b.x^2 + w_b.y^2 + w_b.z^2)")
+            }
             Form::Drift { t0 } => format!("(t_s - {t0}) / 3600"),
             Form::Decay { t0, tau } => format!("exp(-(t_s - {t0}) / {tau})"),
             Form::Step { at } => format!("(sign(t_s - {at:.1}) + 1) / 2"),
@@ -108,6 +117,7 @@ impl Probe {
             Form::ForceAbs => f[i].abs() / if gyro { g } else { 1.0 },
             Form::RateAbs => w[i].abs(),
             Form::RateSquare => w[i] * w[i],
+            Form::ForceRateSquare => f[i] * s.w_b.norm_squared(),
             Form::Drift { t0 } => (s.t_s - t0) / 3600.0,
             Form::Decay { t0, tau } => (-(s.t_s - t0).max(0.0) / tau).exp(),
             // Derived from the bias column (add_steps): never evaluated per sample.
@@ -147,6 +157,9 @@ impl Probe {
             }
             Form::RateAbs => "the output depends on the sign of the rate: scale asymmetry",
             Form::RateSquare => "the output grows with the square of the rate, whatever its sign",
+            Form::ForceRateSquare => {
+                "the output follows the specific force times the rate squared: a timing error's second order, or a scale that changes with the rate"
+            }
             Form::Drift { .. } => "the bias drifts linearly with time",
             Form::Decay { .. } => "the bias decays with time since the recording began: warm-up",
             Form::Step { .. } => "the bias jumps between two segments: a bias step",
@@ -199,6 +212,8 @@ pub(crate) fn sampled(t0: f64) -> Vec<&'static Probe> {
         ];
         if sensor == Sensor::Gyro {
             forms.extend([Form::RateAbs, Form::RateSquare]);
+        } else {
+            forms.push(Form::ForceRateSquare);
         }
         forms.extend(DECAYS_S.iter().map(|&tau| Form::Decay { t0, tau }));
         out.extend(forms.into_iter().map(|f| Probe::new(sensor, f)));
@@ -250,7 +265,8 @@ pub(crate) fn add_steps(
         let t = starts[i].0;
         for c in 0..6 {
             let sensor = if c < 3 { Sensor::Accel } else { Sensor::Gyro };
-            let base = if c < 3 { ba } else { bg };
+            // The bias column of this channel's own axis.
+            let base = if c < 3 { ba + c } else { bg + c - 3 };
             let k_old = old.by_channel[c].len();
             let local_bias = old.by_channel[c].iter().position(|&g| g == base);
             let k_new = layout.by_channel[c].len();

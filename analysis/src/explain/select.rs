@@ -91,7 +91,7 @@ fn plausible(data: &Data, fit: &Fit, e: usize) -> Result<(), String> {
             continue;
         }
         let p = lay.param(g);
-        let max = super::plausible::max_abs(lay.effects[e].id(), p);
+        let max = super::plausible::max_abs(p);
         if let Some(max) = max
             && fit.theta[g].abs() > max
         {
@@ -160,11 +160,12 @@ fn mimics(data: &Data, terms: &Terms, e: usize, probes: &[usize], a: f64, a_prob
     let (f, _) = fit(data, &t, &work, &work);
     let ce: Vec<usize> = lay.columns_of(e).collect();
     let (c1, d1) = wald(&f, &ce);
-    let probe_left = probes.iter().any(|&p| {
-        let cp: Vec<usize> = lay.columns_of(p).collect();
-        let (c2, d2) = wald(&f, &cp);
-        p_value(c2, d2) < a_probe
-    });
+    // Jointly: rival probes are often near copies of one another (a square and an
+    // absolute value on +-1 g attitudes), and each alone loses its significance to the
+    // others.
+    let cp: Vec<usize> = probes.iter().flat_map(|&p| lay.columns_of(p)).collect();
+    let (c2, d2) = wald(&f, &cp);
+    let probe_left = p_value(c2, d2) < a_probe;
     if std::env::var_os("RATECAL_EXPLAIN_DEBUG").is_some() {
         let ids: Vec<&str> = probes.iter().map(|&p| lay.effects[p].id()).collect();
         eprintln!(

@@ -33,7 +33,13 @@ pub fn render_text(x: &Explanation) -> String {
             .defined_in
             .as_ref()
             .map(|file| format!(" (user effect, {file})"))
-            .unwrap_or_default();
+            .unwrap_or_else(|| {
+                if f.station_side {
+                    " (a station error: the table, not the IMU)".into()
+                } else {
+                    String::new()
+                }
+            });
         let _ = writeln!(s, "\n{}. {}{origin}: {}", k + 1, f.effect, f.explanation);
         let _ = writeln!(
             s,

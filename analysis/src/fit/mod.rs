@@ -16,6 +16,7 @@ mod models;
 pub(crate) mod prep;
 mod repeat;
 mod residuals;
+mod sanity;
 mod segment;
 mod select;
 pub mod size_effect;
@@ -186,6 +187,15 @@ pub fn analyze_source<S: Source>(
             }
         }
     }
+    let mut checks = sanity::recording_checks(
+        m,
+        &sums,
+        &src.imu_cadence(),
+        src.imu_extent(),
+        src.table(),
+        &mut out.warnings,
+    );
+    checks.push(sanity::plausible(&out.params));
     out.residuals = fitted.residuals.iter().map(|(r, _)| r.clone()).collect();
     unfitted_residual_warnings(&fitted.residuals, &mut out);
     let (verification, wh) = accept::verify(&sel, &sums, &out, m);
@@ -200,6 +210,8 @@ pub fn analyze_source<S: Source>(
     let mut res = Results {
         format: results::FORMAT.into(),
         verdict: results::RunVerdict::default(),
+        verdict_reason: None,
+        sanity: checks,
         parameters: std::mem::take(&mut out.params),
         acceptance: Vec::new(),
         observability: std::mem::take(&mut out.observability),
@@ -336,7 +348,7 @@ fn unfitted_residual_warnings(rs: &[(ResidualStats, bool)], out: &mut Out) {
             && r.mean.abs() > 5.0 * noise
         {
             out.warnings.push(format!(
-                "{sensor} {} residual on segment {}, which the {sensor} fit does not use: mean {:.4} {}, {:.0} times the fit's noise: the model leaves out {physics}; see `ratecal explain`",
+                "{sensor} {} residual on segment {}, which the {sensor} fit does not use: mean {:.4} {}, {:.0} times the fit's noise: the nominal model does not describe that segment ({physics}, or a disturbance during it); `ratecal explain` tests the catalogue's effects against it and says whether one accounts for it",
                 r.channel,
                 r.segment,
                 r.mean,

@@ -114,6 +114,9 @@ pub fn analyze_runs<S: Source>(
                 .map(move |w| format!("run {}: {w}", k + 1))
         })
         .collect();
+    let sanity: Vec<&[crate::results::SanityCheck]> =
+        each.iter().map(|r| r.sanity.as_slice()).collect();
+    res.sanity = super::sanity::merge(&sanity);
     res.repeatability = Some(Repeatability {
         runs: each.len(),
         parameters: rep,

@@ -100,21 +100,21 @@ pub(crate) fn select(m: &Manifest, plan: Option<&Plan>, opts: &Options) -> Selec
         lowpass: opts.lowpass,
     };
     let mut sel = Selection::default();
+    // The procedure applied (its thresholds, and its fits when it has any). The recording
+    // names the procedure it ran, with its hash: the same one here.
+    sel.model.procedure = plan.map(|plan| crate::recording::ProcedureRef {
+        name: plan.name.clone(),
+        version: plan.version.clone(),
+        sha256: m
+            .procedure
+            .as_ref()
+            .filter(|p| p.name == plan.name && p.version == plan.version)
+            .map(|p| p.sha256.clone())
+            .unwrap_or_default(),
+    });
     match plan.filter(|p| !p.fits.is_empty()) {
         Some(plan) => {
             sel.model.selection = "procedure".into();
-            // The recording names the procedure it ran, with its hash: the same one here.
-            let sha256 = m
-                .procedure
-                .as_ref()
-                .filter(|p| p.name == plan.name && p.version == plan.version)
-                .map(|p| p.sha256.clone())
-                .unwrap_or_default();
-            sel.model.procedure = Some(crate::recording::ProcedureRef {
-                name: plan.name.clone(),
-                version: plan.version.clone(),
-                sha256,
-            });
             for f in &plan.fits {
                 let ix: Vec<usize> = (0..segs.len())
                     .filter(|&i| f.segments.iter().any(|p| segment_matches(p, &segs[i].id)))

@@ -3,7 +3,9 @@
 //! in bounded memory. Either way the analysis sees the manifest, the table feedback (small:
 //! tens of hertz) and the IMU rows of one time span at a time ([`ImuView`]).
 
-use crate::recording::{Manifest, OpenRecording, Recording, RecordingError, TableStream};
+use crate::recording::{
+    CadenceReport, Manifest, OpenRecording, Recording, RecordingError, TableStream,
+};
 use std::borrow::Cow;
 use std::convert::Infallible;
 use std::path::Path;
@@ -55,6 +57,8 @@ pub trait Source: Sync {
     fn imu_rows(&self) -> usize;
     /// First and last IMU stamp, s.
     fn imu_extent(&self) -> (f64, f64);
+    /// Gaps, jitter and order of the IMU stamps.
+    fn imu_cadence(&self) -> CadenceReport;
     /// Whether the IMU stream has the temperature column.
     fn has_temp(&self) -> bool;
     /// The mean of its finite temperatures over every row, degC (0 without any).
@@ -114,6 +118,10 @@ impl Source for Recording {
             t.first().copied().unwrap_or(0.0),
             t.last().copied().unwrap_or(0.0),
         )
+    }
+
+    fn imu_cadence(&self) -> CadenceReport {
+        CadenceReport::of(&self.imu.t)
     }
 
     fn has_temp(&self) -> bool {
@@ -177,6 +185,10 @@ impl Source for Streamed {
 
     fn imu_extent(&self) -> (f64, f64) {
         self.open.imu_extent()
+    }
+
+    fn imu_cadence(&self) -> CadenceReport {
+        self.open.imu_cadence()
     }
 
     fn has_temp(&self) -> bool {

@@ -1,5 +1,8 @@
-//! The simulated IMU: `ratecal_physics` applied to the table's true motion at `t - tau`,
-//! plus white noise, a wandering gyro bias, thermal drift, saturation and dropouts.
+//! The simulated IMU: `ratecal_physics` applied to the table's true motion at the table
+//! time of each stamp (`t / (1 + eps) - tau`: the clock rate and the time offset), plus
+//! white noise, a wandering gyro bias, thermal drift, saturation and dropouts. The
+//! table's profile is its encoder angle (its servo follows the encoder); the IMU turns
+//! with the true angle, which differs by the encoder's eccentricity.
 
 use super::{SharedWorld, Temperatures, lock};
 use crate::station::{DropoutMode, FaultSpec, Station};
@@ -8,6 +11,7 @@ use async_trait::async_trait;
 use rand::rngs::ChaCha8Rng;
 use rand::{RngExt, SeedableRng};
 use rand_distr::StandardNormal;
+use ratecal_physics::effects::EncoderError;
 use ratecal_physics::{AxisMotion, DEG, Geometry, ImuModel, Mat3, Signals, Site, TableState, Vec3};
 
 /// The gyro bias wander is stepped at least this often (s); between steps it holds.
@@ -31,7 +35,8 @@ pub struct SimImu {
     site: Site,
     /// The IMU's error model: registry terms (spec/physics.md), the Earth's rate among them.
     model: ImuModel,
-    tau: f64,
+    /// The table's encoder errors: the profile is the encoder's angle, not the true one.
+    encoder: EncoderError,
     next_k: u64,
     hints: [usize; 2],
     cache: Option<Cache>,
@@ -81,7 +86,7 @@ impl SimImu {
             info: imu.info(true),
             geo: station.geometry(),
             site: station.site(),
-            tau: model.delay_s(),
+            encoder: station.encoder_error(),
             model,
             next_k: 0,
             hints: [0; 2],
@@ -131,10 +136,10 @@ impl SimImu {
                     self.rw[i] += self.rw_drive * n2;
                 }
             }
-            let te = t - self.tau;
+            let te = t - self.model.delay_at_s(t);
             let o = w.axes[0].eval(te, &mut self.hints[0]);
             let i = w.axes[1].eval(te, &mut self.hints[1]);
-            let state = TableState {
+            let reported = TableState {
                 outer: AxisMotion {
                     angle: o.angle * DEG,
                     rate: o.rate * DEG,
@@ -146,6 +151,7 @@ impl SimImu {
                     accel: i.accel * DEG,
                 },
             };
+            let state = self.encoder.true_motion(&reported);
             // Holds are bit-for-bit constant: reuse the physics while nothing changes.
             let temp = self.temp;
             let (a, g) = match &self.cache {

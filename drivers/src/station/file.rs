@@ -2,7 +2,7 @@
 //! carry their units (see `quantity.rs`), keys whose name ends in a unit take bare numbers.
 //! `docs/station.md` documents every key.
 
-use super::effects::EffectsSpec;
+use super::effects::{EffectsSpec, TableEffectsSpec};
 use super::quantity::{
     Accel, AccelDensity, Angle, Freq, Pressure, Rate, RateDensity, RateWalk, Ratio, Rotation, Temp,
     TempDelta, TempRate, Time, UnitVec, damping, finite, fraction, frequency, positive,
@@ -127,6 +127,9 @@ pub struct TableSpec {
     /// Feedback sample rate.
     #[serde(deserialize_with = "frequency")]
     pub feedback_rate: Freq,
+    /// Station-side catalogue effects (the encoder eccentricity) under their canonical ids.
+    #[serde(default)]
+    pub effects: TableEffectsSpec,
 }
 
 fn default_table_model() -> String {

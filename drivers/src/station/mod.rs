@@ -9,7 +9,7 @@ mod quantity;
 
 pub use describe::{Environment, ImuIdentity, StationInfo};
 
-pub use effects::EffectsSpec;
+pub use effects::{EffectsSpec, TableEffectsSpec};
 pub use faults::{AxisName, DropoutMode, FaultSpec, LinkName, TableFaultMode};
 pub use file::{
     AmbientSpec, EnvironmentSpec, ImuSpec, ImuTemperatureSpec, MountSpec, SettlingSpec, SiteSpec,
@@ -21,7 +21,7 @@ pub use quantity::{
 };
 
 use miette::{Diagnostic, NamedSource, SourceSpan};
-use ratecal_physics::effects::ImuModel;
+use ratecal_physics::effects::{EncoderError, ImuModel};
 use ratecal_physics::{Geometry, Mat3, Site, Vec3};
 
 /// The embedded default station's YAML (a simulated tactical-grade IMU on a simulated table).
@@ -114,6 +114,13 @@ impl Station {
             }
         }
         m
+    }
+
+    /// The table's encoder errors (`table.effects`): what its feedback reports, and its
+    /// servo follows, against the true motion.
+    pub fn encoder_error(&self) -> EncoderError {
+        let e = ratecal_physics::effect("table_encoder_eccentricity").expect("a registry id");
+        EncoderError::from_values(&self.table.effects.0.values(e))
     }
 
     /// The IMU's time offset `tau`, s.

@@ -135,6 +135,7 @@ pub fn build(input: &ReportInput) -> Value {
         "allan": results.get("allan").cloned().unwrap_or(Value::Null),
         "sync": sync,
         "warnings": results.get("warnings").cloned().unwrap_or(json!([])),
+        "sanity": results.get("sanity").cloned().unwrap_or(json!([])),
         "explain": input.explain.clone().unwrap_or(Value::Null),
         "archive_trend": views::trend_view(&trend),
         "findings": results.get("findings").cloned().unwrap_or(json!([])),

@@ -263,8 +263,14 @@ pub fn summary(checks: &Value, results: &Value, params: &Value) -> Value {
         .map(|p| json!({ "name": p.get("name"), "reason": p.get("reason") }))
         .collect();
     let [failed, indeterminate, not_evaluated, deferred] = by;
+    let sanity_failed: Vec<Value> = arr(results.get("sanity"))
+        .into_iter()
+        .filter(|c| c.get("status").and_then(Value::as_str) == Some("fail"))
+        .collect();
     json!({
         "verdict": verdict,
+        "reason": results.get("verdict_reason").cloned().unwrap_or(Value::Null),
+        "sanity_failed": sanity_failed,
         "meets_standard": verdict == "pass",
         "counts": counts,
         "failed": failed,

@@ -11,16 +11,23 @@ pub struct Bias {
 
 const NEEDS: [&str; 3] = ["any data of the sensor"; 3];
 
+// Consumer MEMS parts: zero-g offsets up to about 150 mg after soldering, zero-rate
+// outputs up to about 25 deg/s.
+/// Largest plausible accelerometer bias, m/s^2 (about 200 mg).
+const ACCEL_MAX: f64 = 2.0;
+/// Largest plausible gyro bias, deg/s.
+const GYRO_MAX: f64 = 30.0;
+
 /// `accel_bias`: accelerometer outputs at zero input, m/s^2.
 pub static ACCEL_BIAS: Bias = Bias {
     sensor: Sensor::Accel,
-    params: &per_axis!(Sensor::Accel, "m/s^2", NEEDS),
+    params: &per_axis!(Sensor::Accel, "m/s^2", NEEDS, ACCEL_MAX),
 };
 
 /// `gyro_bias`: gyro outputs at zero input, deg/s.
 pub static GYRO_BIAS: Bias = Bias {
     sensor: Sensor::Gyro,
-    params: &per_axis!(Sensor::Gyro, "deg/s", NEEDS),
+    params: &per_axis!(Sensor::Gyro, "deg/s", NEEDS, GYRO_MAX),
 };
 
 impl Effect for Bias {

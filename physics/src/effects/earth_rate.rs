@@ -16,18 +16,24 @@ pub static EARTH_RATE: EarthRate = EarthRate;
 
 const HOUR: f64 = 3600.0;
 
+/// The Earth's rate, deg/h: no component of it can be larger (the plausible range of both
+/// parameters; a fit's uncertainty is the caller's to allow for).
+const OMEGA_DPH: f64 = EARTH_RATE_RADPS / DEG * HOUR;
+
 static PARAMS: [Param; 2] = [
     Param {
         name: "north_dph",
         unit: "deg/h",
         channel: None,
         needs: "static attitudes that turn the north direction through the gyro axes",
+        max_abs: OMEGA_DPH,
     },
     Param {
         name: "up_dph",
         unit: "deg/h",
         channel: None,
         needs: "static attitudes that turn the vertical through the gyro axes",
+        max_abs: OMEGA_DPH,
     },
 ];
 
@@ -35,8 +41,7 @@ impl EarthRate {
     /// The parameters that a site at `latitude_deg` gives: `[north_dph, up_dph]`.
     pub fn values(latitude_deg: f64) -> [f64; 2] {
         let (s, c) = (latitude_deg * DEG).sin_cos();
-        let w = EARTH_RATE_RADPS / DEG * HOUR;
-        [w * c, w * s]
+        [OMEGA_DPH * c, OMEGA_DPH * s]
     }
 
     /// The latitude (deg) and its standard uncertainty from fitted components and their

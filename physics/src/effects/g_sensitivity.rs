@@ -10,12 +10,17 @@ pub struct GSensitivity;
 /// The registry's instance.
 pub static G_SENSITIVITY: GSensitivity = GSensitivity;
 
+/// Largest plausible g-sensitivity, deg/s per g (consumer MEMS gyros: up to about 0.1;
+/// the range allows an order of magnitude more).
+const MAX_DPS_PER_G: f64 = 1.0;
+
 const fn p(name: &'static str, i: usize, needs: &'static str) -> Param {
     Param {
         name,
         unit: "deg/s per g",
         channel: Some((Sensor::Gyro, i)),
         needs,
+        max_abs: MAX_DPS_PER_G,
     }
 }
 

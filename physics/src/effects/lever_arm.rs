@@ -11,12 +11,17 @@ pub struct LeverArm;
 /// The registry's instance.
 pub static LEVER_ARM: LeverArm = LeverArm;
 
+/// Largest plausible sensing-point coordinate, mm: an IMU mounted anywhere on a table's
+/// platform is within 300 mm of the axes' intersection.
+const MAX_MM: f64 = 300.0;
+
 const fn p(name: &'static str, i: usize, needs: &'static str) -> Param {
     Param {
         name,
         unit: "mm",
         channel: Some((Sensor::Accel, i)),
         needs,
+        max_abs: MAX_MM,
     }
 }
 

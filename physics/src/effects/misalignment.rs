@@ -13,12 +13,17 @@ pub struct Misalignment {
 /// Index pairs `(i, j)` of the six off-diagonal terms, in the catalogue's order.
 const PAIRS: [(usize, usize); 6] = [(0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1)];
 
+/// Largest plausible cross-coupling, mrad (about 3 deg: a consumer part soldered askew on
+/// its board).
+const MAX_MRAD: f64 = 50.0;
+
 const fn p(sensor: Sensor, name: &'static str, i: usize, needs: &'static str) -> Param {
     Param {
         name,
         unit: "mrad",
         channel: Some((sensor, i)),
         needs,
+        max_abs: MAX_MRAD,
     }
 }
 

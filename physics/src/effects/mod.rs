@@ -8,19 +8,26 @@
 //! checker, the analysis and explain read this one list: adding an effect is adding a
 //! file here and a line to [`REGISTRY`].
 
+mod asymmetry;
 mod bias;
+mod clock_rate;
 mod earth_rate;
+mod eccentricity;
 mod g_sensitivity;
 mod lever_arm;
 mod misalignment;
 mod model;
 mod nonlinearity;
 mod scale;
+mod scale_thermal;
+mod second_order;
 mod signals;
 mod thermal;
 mod time_offset;
 
+pub use clock_rate::ClockRate;
 pub use earth_rate::EarthRate;
+pub use eccentricity::{Eccentricity, EncoderError};
 pub use misalignment::pair as misalignment_pair;
 pub use model::{ImuModel, Term};
 pub use signals::Signals;
@@ -66,6 +73,18 @@ pub struct Param {
     pub channel: Option<(Sensor, usize)>,
     /// The motion that excites it, in an engineer's words ("rotate about Z").
     pub needs: &'static str,
+    /// Its physically plausible range, `-max_abs..=max_abs` in `unit`: the largest
+    /// magnitude a real part (consumer to navigation grade; for a station-side term, a
+    /// real rate table) can have. A fit beyond it is not that physics. Infinite for a
+    /// user effect, which declares none.
+    pub max_abs: f64,
+}
+
+impl Param {
+    /// Whether `value` (in `unit`) lies within the plausible range.
+    pub fn plausible(&self, value: f64) -> bool {
+        value.abs() <= self.max_abs
+    }
 }
 
 /// The six output channels' partial derivatives with respect to one parameter.
@@ -137,6 +156,18 @@ pub trait Effect: Send + Sync + std::fmt::Debug {
     fn delay_s(&self, _values: &[f64]) -> f64 {
         0.0
     }
+    /// How much later than the motion the sample stamped `t_s` (the IMU's clock, s) is
+    /// stamped, s: the simulator evaluates the motion at `t_s - delay_at_s`. The default
+    /// is the constant [`Effect::delay_s`]; the clock rate's delay grows with `t_s`.
+    fn delay_at_s(&self, values: &[f64], _t_s: f64) -> f64 {
+        self.delay_s(values)
+    }
+    /// Whether it is an error of the station (the table's feedback), not of the IMU:
+    /// reports call it a station error, and the simulator applies it to the table's
+    /// motion rather than to the IMU's outputs.
+    fn station_side(&self) -> bool {
+        false
+    }
     /// The sensors whose outputs it touches.
     fn sensors(&self) -> &'static [Sensor];
     /// Whether its regressors read the IMU temperature (`Signals::dtemp_c`): the analysis
@@ -146,7 +177,9 @@ pub trait Effect: Send + Sync + std::fmt::Debug {
     }
 }
 
-/// Every effect, the nominal terms first, then the catalogue in physics.md's order.
+/// Every effect, the nominal terms first, then the catalogue in physics.md's order, then
+/// the model-equation terms of the IEEE standards (1293, 952, 528) that a rate table
+/// excites.
 pub static REGISTRY: &[&dyn Effect] = &[
     &bias::ACCEL_BIAS,
     &scale::ACCEL_SCALE,
@@ -161,6 +194,13 @@ pub static REGISTRY: &[&dyn Effect] = &[
     &thermal::GYRO_THERMAL_DRIFT,
     &thermal::ACCEL_THERMAL_DRIFT,
     &nonlinearity::GYRO_SCALE_NONLINEARITY,
+    &second_order::ACCEL_SECOND_ORDER,
+    &asymmetry::ACCEL_SCALE_ASYMMETRY,
+    &asymmetry::GYRO_SCALE_ASYMMETRY,
+    &scale_thermal::ACCEL_SCALE_THERMAL,
+    &scale_thermal::GYRO_SCALE_THERMAL,
+    &clock_rate::CLOCK_RATE,
+    &eccentricity::TABLE_ENCODER_ECCENTRICITY,
 ];
 
 /// Looks an effect up by its canonical id.
@@ -173,27 +213,31 @@ pub fn catalogue() -> impl Iterator<Item = &'static dyn Effect> {
     REGISTRY.iter().copied().filter(|e| !e.nominal())
 }
 
-/// Per-axis parameters `x`, `y`, `z` of one sensor, with a unit and what excites them.
+/// Per-axis parameters `x`, `y`, `z` of one sensor, with a unit, what excites them and
+/// their plausible magnitude.
 macro_rules! per_axis {
-    ($sensor:expr, $unit:expr, $needs:expr) => {
+    ($sensor:expr, $unit:expr, $needs:expr, $max_abs:expr) => {
         [
             $crate::effects::Param {
                 name: "x",
                 unit: $unit,
                 channel: Some(($sensor, 0)),
                 needs: $needs[0],
+                max_abs: $max_abs,
             },
             $crate::effects::Param {
                 name: "y",
                 unit: $unit,
                 channel: Some(($sensor, 1)),
                 needs: $needs[1],
+                max_abs: $max_abs,
             },
             $crate::effects::Param {
                 name: "z",
                 unit: $unit,
                 channel: Some(($sensor, 2)),
                 needs: $needs[2],
+                max_abs: $max_abs,
             },
         ]
     };

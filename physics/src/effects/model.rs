@@ -57,8 +57,19 @@ impl ImuModel {
         (a, g)
     }
 
-    /// How long after the motion the samples are stamped, s.
+    /// How long after the motion the samples are stamped, s (the constant part: the time
+    /// offset).
     pub fn delay_s(&self) -> f64 {
         self.terms.iter().map(|t| t.effect.delay_s(&t.values)).sum()
+    }
+
+    /// How long after the motion the sample stamped `t_s` (IMU clock) is stamped, s: the
+    /// time offset plus the clock rate's growing lag. The motion it saw is that of table
+    /// time `t_s - delay_at_s(t_s)` (`t_s / (1 + eps) - tau`).
+    pub fn delay_at_s(&self, t_s: f64) -> f64 {
+        self.terms
+            .iter()
+            .map(|t| t.effect.delay_at_s(&t.values, t_s))
+            .sum()
     }
 }

@@ -16,7 +16,10 @@ static PARAMS: [Param; 3] = per_axis!(
         "rate points of several magnitudes about X",
         "rate points of several magnitudes about Y",
         "rate points of several magnitudes about Z"
-    ]
+    ],
+    // A consumer gyro's nonlinearity (up to 1 % of a 250 deg/s full scale) as a quadratic
+    // term: 0.01 * 250 / 250^2 = 40e-6 per deg/s.
+    50.0
 );
 
 impl Effect for Nonlinearity {

@@ -9,6 +9,10 @@ pub struct Scale {
     params: &'static [Param],
 }
 
+/// Largest plausible scale-factor error, ppm: consumer MEMS sensitivities are specified to
+/// +-3 % (5 % allows for the worst parts).
+const MAX_PPM: f64 = 50_000.0;
+
 /// `accel_scale`: accelerometer scale-factor errors, ppm.
 pub static ACCEL_SCALE: Scale = Scale {
     sensor: Sensor::Accel,
@@ -19,7 +23,8 @@ pub static ACCEL_SCALE: Scale = Scale {
             "attitudes with gravity along +X and -X",
             "attitudes with gravity along +Y and -Y",
             "attitudes with gravity along +Z and -Z"
-        ]
+        ],
+        MAX_PPM
     ),
 };
 
@@ -29,7 +34,8 @@ pub static GYRO_SCALE: Scale = Scale {
     params: &per_axis!(
         Sensor::Gyro,
         "ppm",
-        ["rotate about X", "rotate about Y", "rotate about Z"]
+        ["rotate about X", "rotate about Y", "rotate about Z"],
+        MAX_PPM
     ),
 };
 

@@ -1,6 +1,6 @@
 //! The kinematic signals of one instant that every effect reads.
 
-use crate::{DEG, Mat3, Site, Snapshot, Vec3};
+use crate::{DEG, Mat3, Site, Snapshot, TableState, Vec3};
 
 /// What the table's motion and the IMU's temperature give at one instant, in body axes:
 /// the inputs of every effect's forward contribution and regressors.
@@ -25,8 +25,16 @@ pub struct Signals {
     /// Local gravity, m/s^2.
     pub g: f64,
     /// Time stamp of the instant, s (the recording's time axis; 0 unless set with
-    /// [`Signals::at`]). No registry effect reads it; user effects may.
+    /// [`Signals::at`]). The clock rate reads it; user effects may.
     pub t_s: f64,
+    /// The table's angles, rates and accelerations the signals were computed from (rad):
+    /// the table's feedback in the analysis, the true motion in the simulator. The encoder
+    /// eccentricity reads them.
+    pub table: TableState,
+    /// The outer axis `a_o` in body axes (`C_LB^T a_o`).
+    pub outer_b: Vec3,
+    /// The inner axis `a_i` in body axes (`C_PB^T a_i`).
+    pub inner_b: Vec3,
 }
 
 impl Signals {
@@ -47,6 +55,9 @@ impl Signals {
             dtemp_c,
             g: site.gravity_mps2,
             t_s: 0.0,
+            table: snap.state,
+            outer_b: snap.outer_b,
+            inner_b: snap.inner_b,
         }
     }
 

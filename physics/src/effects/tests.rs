@@ -33,6 +33,12 @@ fn signals(t: f64) -> Signals {
     Signals::new(&moving(t).snapshot(&geo(), &SITE), &SITE, 0.0)
 }
 
+/// The ideal outputs of a table state: `f_B(0)` (m/s^2) and `w_ib` (deg/s).
+fn ideal(state: &TableState) -> (Vec3, Vec3) {
+    let snap = state.snapshot(&geo(), &SITE);
+    (snap.f_b(&Vec3::zeros()), snap.w_ib() / DEG)
+}
+
 #[test]
 fn ids_are_unique_and_the_catalogue_is_physics_md() {
     let ids: Vec<&str> = catalogue().map(|e| e.id()).collect();
@@ -47,7 +53,14 @@ fn ids_are_unique_and_the_catalogue_is_physics_md() {
             "g_sensitivity",
             "gyro_thermal_drift",
             "accel_thermal_drift",
-            "gyro_scale_nonlinearity"
+            "gyro_scale_nonlinearity",
+            "accel_second_order",
+            "accel_scale_asymmetry",
+            "gyro_scale_asymmetry",
+            "accel_scale_thermal",
+            "gyro_scale_thermal",
+            "clock_rate",
+            "table_encoder_eccentricity"
         ]
     );
     for e in REGISTRY {
@@ -138,8 +151,8 @@ fn regressors_are_the_derivatives_of_forward() {
         let n = e.params().len();
         let mut parts = vec![Partials::default(); n];
         e.regressors(&s, &mut parts);
-        if e.id() == "time_offset" {
-            continue; // applied by delaying the motion: tested above
+        if ["time_offset", "clock_rate", "table_encoder_eccentricity"].contains(&e.id()) {
+            continue; // applied to the motion, not the outputs: tested above
         }
         for k in 0..n {
             let mut v = vec![0.0; n];
@@ -149,4 +162,192 @@ fn regressors_are_the_derivatives_of_forward() {
             assert!((f.gyro - parts[k].gyro).norm() < 1e-12, "{} {k}", e.id());
         }
     }
+}
+
+#[test]
+fn second_order_is_k2_ug_per_g_squared() {
+    let mut s = signals(0.4);
+    s.f_b = Vec3::new(s.g, -0.5 * s.g, 0.0);
+    let out = effect("accel_second_order")
+        .unwrap()
+        .forward(&[150.0, 40.0, 7.0], &s)
+        .accel;
+    // One g along X: 150 ug; half a g along Y: 40 / 4 ug.
+    let want = Vec3::new(150e-6, 10e-6, 0.0) * s.g;
+    assert!((out - want).norm() < 1e-15, "{out} vs {want}");
+}
+
+#[test]
+fn asymmetry_changes_the_scale_with_the_sign_of_the_input() {
+    for (id, sensor) in [
+        ("accel_scale_asymmetry", Sensor::Accel),
+        ("gyro_scale_asymmetry", Sensor::Gyro),
+    ] {
+        let e = effect(id).unwrap();
+        let mut s = signals(0.2);
+        s.earth_b = Vec3::zeros();
+        for sign in [1.0, -1.0] {
+            s.f_b = Vec3::new(2.0, 0.0, 0.0) * sign;
+            s.w_b = Vec3::new(2.0, 0.0, 0.0) * sign * DEG;
+            let out = *e.forward(&[300.0, 0.0, 0.0], &s).of(sensor);
+            // The output at +x and -x: scale 1 + 300 ppm at +2, 1 - 300 ppm at -2 (the
+            // output moves by +600 ppm of 2 either way).
+            assert!((out.x - 600e-6).abs() < 1e-15, "{id} {sign}: {out}");
+            let scale = (2.0 * sign + out.x) / (2.0 * sign) - 1.0;
+            assert!((scale - sign * 300e-6).abs() < 1e-15);
+        }
+    }
+}
+
+#[test]
+fn scale_thermal_scales_the_input_by_the_temperature() {
+    let mut s = signals(0.9);
+    s.dtemp_c = 5.0;
+    let a = effect("accel_scale_thermal")
+        .unwrap()
+        .forward(&[100.0, -50.0, 20.0], &s)
+        .accel;
+    let g = effect("gyro_scale_thermal")
+        .unwrap()
+        .forward(&[100.0, -50.0, 20.0], &s)
+        .gyro;
+    let k = Vec3::new(100.0, -50.0, 20.0) * 5.0 * 1e-6;
+    assert!((a - k.component_mul(&s.f_b)).norm() < 1e-15);
+    assert!((g - k.component_mul(&s.w_ib_dps())).norm() < 1e-15);
+    assert!(effect("accel_scale_thermal").unwrap().uses_temperature());
+    assert!(effect("gyro_scale_thermal").unwrap().uses_temperature());
+}
+
+#[test]
+fn clock_rate_regressor_is_the_derivative_of_re_timing() {
+    let e = effect("clock_rate").unwrap();
+    // Stamped 2.5 s: the first-order lag is t eps, the exact one t eps / (1 + eps).
+    let t = 2.5;
+    let y = |ppm: f64| ideal(&moving(super::clock_rate::ClockRate::table_time_s(ppm, t)));
+    let h = 1.0;
+    let ((fp, wp), (fm, wm)) = (y(h), y(-h));
+    let mut out = [Partials::default()];
+    e.regressors(&signals(t).at(t), &mut out);
+    let (fa, fg) = ((fp - fm) / (2.0 * h), (wp - wm) / (2.0 * h));
+    assert!(
+        (out[0].accel - fa).norm() < 1e-9,
+        "{} vs {fa}",
+        out[0].accel
+    );
+    assert!((out[0].gyro - fg).norm() < 1e-9, "{} vs {fg}", out[0].gyro);
+    // The simulator's delay: exact re-timing, composed with the time offset.
+    let mut m = ImuModel::default();
+    m.push("clock_rate", vec![60.0]);
+    m.push("time_offset", vec![2.0]);
+    let t = 1800.0;
+    let te = t - m.delay_at_s(t);
+    assert!((te - (t / (1.0 + 60e-6) - 2e-3)).abs() < 1e-9, "{te}");
+    assert!(
+        (t - te - 0.110).abs() < 1e-3,
+        "60 ppm is about 0.1 s after half an hour"
+    );
+}
+
+#[test]
+fn encoder_true_motion_reads_back_as_the_encoder() {
+    let err = EncoderError::from_values(&[40.0, -25.0, 15.0, 60.0]);
+    let enc = |t: f64| moving(t);
+    let truth = |t: f64| err.true_motion(&enc(t));
+    let (t, h) = (0.8, 1e-4);
+    let arcsec = DEG / 3600.0;
+    for (k, (tr, en)) in [
+        (truth(t).outer, enc(t).outer),
+        (truth(t).inner, enc(t).inner),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let [s, c] = if k == 0 { err.outer } else { err.inner };
+        let back = tr.angle + s * tr.angle.sin() + c * tr.angle.cos();
+        assert!((back - en.angle).abs() < 1e-15, "axis {k}");
+        // Tens of arc seconds apart.
+        assert!((tr.angle - en.angle).abs() > 5.0 * arcsec);
+    }
+    // The true rate and acceleration are the derivatives of the true angle.
+    let d = |f: &dyn Fn(&TableState) -> f64| (f(&truth(t + h)) - f(&truth(t - h))) / (2.0 * h);
+    let now = truth(t);
+    assert!((d(&|s| s.outer.angle) - now.outer.rate).abs() < 1e-8);
+    assert!((d(&|s| s.inner.angle) - now.inner.rate).abs() < 1e-8);
+    assert!((d(&|s| s.outer.rate) - now.outer.accel).abs() < 1e-7);
+    assert!((d(&|s| s.inner.rate) - now.inner.accel).abs() < 1e-7);
+}
+
+#[test]
+fn eccentricity_regressors_are_the_derivatives_of_the_true_motion() {
+    let e = effect("table_encoder_eccentricity").unwrap();
+    assert!(e.station_side());
+    for t in [0.3, 1.1, 2.9] {
+        let reported = moving(t);
+        let mut out = [Partials::default(); 4];
+        e.regressors(&signals(t), &mut out);
+        for k in 0..4 {
+            let y = |v: f64| {
+                let mut values = [0.0; 4];
+                values[k] = v;
+                ideal(&EncoderError::from_values(&values).true_motion(&reported))
+            };
+            let h = 1.0;
+            let ((fp, wp), (fm, wm)) = (y(h), y(-h));
+            let (fa, fg) = ((fp - fm) / (2.0 * h), (wp - wm) / (2.0 * h));
+            assert!(fa.norm() + fg.norm() > 1e-6, "{t} {k}: excited");
+            assert!(
+                (out[k].accel - fa).norm() < 1e-10,
+                "{t} {k}: {} vs {fa}",
+                out[k].accel
+            );
+            assert!(
+                (out[k].gyro - fg).norm() < 1e-10,
+                "{t} {k}: {} vs {fg}",
+                out[k].gyro
+            );
+        }
+    }
+}
+
+#[test]
+fn eccentricity_amplitude_and_phase_round_trip() {
+    let (s, c) = Eccentricity::components(20.0, 30.0);
+    // e sin(theta + phi) = s sin(theta) + c cos(theta) at any theta.
+    for th in [0.0, 0.7, 2.0, -1.3] {
+        let want = 20.0 * (th + 30.0 * DEG).sin();
+        assert!((s * th.sin() + c * th.cos() - want).abs() < 1e-12);
+    }
+    let ((e, ue), (phi, uphi)) = Eccentricity::amplitude_phase(s, c, [[1.0, 0.0], [0.0, 1.0]]);
+    assert!((e - 20.0).abs() < 1e-12 && (phi - 30.0).abs() < 1e-12);
+    // Isotropic 1 arcsec: 1 arcsec on the amplitude, 1/20 rad on the phase.
+    assert!((ue - 1.0).abs() < 1e-12);
+    assert!((uphi - 1.0 / 20.0 / DEG).abs() < 1e-9);
+}
+
+#[test]
+fn every_parameter_has_a_plausible_range() {
+    for e in REGISTRY {
+        for p in e.params() {
+            assert!(
+                p.max_abs.is_finite() && p.max_abs > 0.0,
+                "{}.{}",
+                e.id(),
+                p.name
+            );
+            assert!(p.plausible(p.max_abs) && !p.plausible(-1.01 * p.max_abs));
+        }
+    }
+    let max = |id: &str| effect(id).unwrap().params()[0].max_abs;
+    assert_eq!(max("accel_misalignment"), 50.0);
+    assert_eq!(max("gyro_misalignment"), 50.0);
+    assert_eq!(max("g_sensitivity"), 1.0);
+    assert_eq!(max("lever_arm"), 300.0);
+    assert_eq!(max("time_offset"), 1000.0);
+    assert!((max("earth_rate") - 15.041).abs() < 1e-3);
+    let station: Vec<&str> = REGISTRY
+        .iter()
+        .filter(|e| e.station_side())
+        .map(|e| e.id())
+        .collect();
+    assert_eq!(station, ["table_encoder_eccentricity"]);
 }

@@ -12,16 +12,23 @@ pub struct ThermalDrift {
 
 const NEEDS: [&str; 3] = ["a change of the IMU's temperature during the data"; 3];
 
+// Consumer MEMS parts: zero-rate drift up to about 0.15 deg/s per degC, zero-g drift up to
+// about 1.5 mg per degC.
+/// Largest plausible gyro bias drift, deg/s per degC.
+const GYRO_MAX: f64 = 0.2;
+/// Largest plausible accelerometer bias drift, m/s^2 per degC (about 2 mg per degC).
+const ACCEL_MAX: f64 = 0.02;
+
 /// `gyro_thermal_drift`, deg/s per degC.
 pub static GYRO_THERMAL_DRIFT: ThermalDrift = ThermalDrift {
     sensor: Sensor::Gyro,
-    params: &per_axis!(Sensor::Gyro, "deg/s per degC", NEEDS),
+    params: &per_axis!(Sensor::Gyro, "deg/s per degC", NEEDS, GYRO_MAX),
 };
 
 /// `accel_thermal_drift`, m/s^2 per degC.
 pub static ACCEL_THERMAL_DRIFT: ThermalDrift = ThermalDrift {
     sensor: Sensor::Accel,
-    params: &per_axis!(Sensor::Accel, "m/s^2 per degC", NEEDS),
+    params: &per_axis!(Sensor::Accel, "m/s^2 per degC", NEEDS, ACCEL_MAX),
 };
 
 impl Effect for ThermalDrift {

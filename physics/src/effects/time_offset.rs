@@ -16,6 +16,8 @@ static PARAMS: [Param; 1] = [Param {
     unit: "ms",
     channel: None,
     needs: "motion that changes the references: rotation that turns gravity through the accelerometers, or changing rates",
+    // A second of clock disagreement is a broken setup, not a calibration result.
+    max_abs: 1000.0,
 }];
 
 impl Effect for TimeOffset {

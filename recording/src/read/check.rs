@@ -35,11 +35,51 @@ pub(super) fn too_few(path: &Path) -> RecordingError {
 
 /// Data row `row` (0-based) whose time `t` is not after the previous row's `prev`.
 pub(super) fn time_error(path: &Path, row: usize, prev: f64, t: f64) -> RecordingError {
+    match t_cell(path, row) {
+        Ok((file, line, column, src, span)) => RecordingError::TimeNotIncreasing {
+            file,
+            line,
+            column,
+            t,
+            prev,
+            src,
+            span,
+        },
+        Err(e) => e,
+    }
+}
+
+/// The IMU and table streams share no time (sanity check `clocks_overlap`), located at
+/// the table's first stamp.
+pub(super) fn check_overlap(
+    table_path: &Path,
+    imu: Extent,
+    table: Extent,
+) -> Result<(), RecordingError> {
+    if imu.first.max(table.first) < imu.last.min(table.last) {
+        return Ok(());
+    }
+    let (file, line, column, src, span) = t_cell(table_path, 0)?;
+    Err(RecordingError::ClocksDisjoint {
+        file,
+        line,
+        column,
+        table_first: table.first,
+        table_last: table.last,
+        imu_first: imu.first,
+        imu_last: imu.last,
+        src,
+        span,
+    })
+}
+
+/// File name, line, column, text and span of the `t` cell of data row `row` (0-based).
+fn t_cell(
+    path: &Path,
+    row: usize,
+) -> Result<(String, u64, usize, Excerpt, miette::SourceSpan), RecordingError> {
     let file = path.display().to_string();
-    let bytes = match std::fs::read(path) {
-        Ok(b) => b,
-        Err(e) => return io_error(path, e),
-    };
+    let bytes = std::fs::read(path).map_err(|e| io_error(path, e))?;
     let start = row_start(&bytes, row);
     let line = line_col_bytes(&bytes, start).0;
     let header = &bytes[..bytes
@@ -56,15 +96,8 @@ pub(super) fn time_error(path: &Path, row: usize, prev: f64, t: f64) -> Recordin
         .position(|&b| b == b',' || b == b'\n' || b == b'\r')
         .unwrap_or(1)
         .max(1);
-    RecordingError::TimeNotIncreasing {
-        file: file.clone(),
-        line,
-        column,
-        t,
-        prev,
-        src: Excerpt::around(&file, &bytes, offset, offset + len).0,
-        span: Excerpt::around(&file, &bytes, offset, offset + len).1,
-    }
+    let (src, span) = Excerpt::around(&file, &bytes, offset, offset + len);
+    Ok((file, line, column, src, span))
 }
 
 /// The first two and the last time stamps of a stream of at least two: what the segment

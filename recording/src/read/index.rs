@@ -49,6 +49,8 @@ pub(super) struct Times<'a> {
     last: f64,
     /// First row whose time is not after the previous one: `(row, previous, t)`.
     pub backwards: Option<(usize, f64, f64)>,
+    /// Gaps and jitter of the stamps.
+    pub cadence: crate::Cadence,
     block_first: Option<f64>,
     /// Segment starts, ascending.
     starts: &'a [f64],
@@ -63,6 +65,7 @@ impl<'a> Times<'a> {
             first: [f64::NAN; 2],
             last: f64::NAN,
             backwards: None,
+            cadence: crate::Cadence::default(),
             block_first: None,
             starts,
             first_at: vec![f64::INFINITY; starts.len()],
@@ -78,6 +81,7 @@ impl<'a> Times<'a> {
         if self.rows > 0 && self.backwards.is_none() && t <= self.last {
             self.backwards = Some((self.rows, self.last, t));
         }
+        self.cadence.see(t);
         while self.next < self.starts.len() && self.starts[self.next] <= t {
             self.first_at[self.next] = t;
             self.next += 1;

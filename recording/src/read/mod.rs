@@ -44,6 +44,7 @@ pub fn read(dir: &Path) -> Result<Recording, RecordingError> {
     };
     check::check_time(&imu_path, &imu.t)?;
     check::check_time(&table_path, &table.t)?;
+    check::check_overlap(&table_path, Extent::of(&imu.t), Extent::of(&table.t))?;
     check::check_segments(
         &manifest_name,
         &manifest_text,

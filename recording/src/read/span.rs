@@ -29,6 +29,8 @@ pub struct OpenRecording {
     /// IMU rows, first and last stamp.
     imu_rows: usize,
     imu_extent: (f64, f64),
+    /// Gaps and jitter of the IMU stamps.
+    imu_cadence: crate::CadenceReport,
 }
 
 /// The rows of both streams whose time lies in a span.
@@ -63,6 +65,11 @@ impl Recording {
             return Err(check::time_error(&imu.path, row, prev, t));
         }
         let table = table?;
+        check::check_overlap(
+            &dir.join(TableStream::FILE),
+            imu_times.extent(),
+            Extent::of(&table.t),
+        )?;
         check::check_segments(
             &manifest_name,
             &manifest_text,
@@ -78,6 +85,7 @@ impl Recording {
             table,
             imu_rows: imu_times.rows,
             imu_extent: (extent.first, extent.last),
+            imu_cadence: imu_times.cadence.report(),
         })
     }
 }
@@ -116,6 +124,11 @@ impl OpenRecording {
     /// The first and the last IMU stamp, s.
     pub fn imu_extent(&self) -> (f64, f64) {
         self.imu_extent
+    }
+
+    /// Gaps and jitter of the IMU stamps, counted when the file was indexed.
+    pub fn imu_cadence(&self) -> crate::CadenceReport {
+        self.imu_cadence
     }
 
     /// Whether `imu.csv` has the optional `temp` column.

@@ -44,11 +44,10 @@ impl End<'_> {
             run_s / self.wall_s.max(1e-9)
         );
         outln!(
-            "steps: {}/{}, segments: {}, warnings: {}",
+            "steps: {}/{}, segments: {}",
             out.steps_completed,
             self.plan.steps.len(),
             out.segments,
-            out.warnings.len()
         );
         if let Some(sync) = &out.sync {
             for (name, l) in [("imu", &sync.imu), ("table", &sync.table)] {
@@ -72,9 +71,6 @@ impl End<'_> {
                 );
             }
         }
-        for w in &out.warnings {
-            outln!("  warning: {w}");
-        }
         let aborted = matches!(out.status, RunStatus::Aborted(_));
         if let RunStatus::Aborted(a) = &out.status {
             let step = a.step.as_ref().map(|s| format!(" in step {s}"));
@@ -96,6 +92,13 @@ impl End<'_> {
             );
         }
         let verdict = analyze(dir, self.plan, self.archive);
+        if verdict.is_none() {
+            // Without results, the run's own warnings are all there is to tell.
+            outln!("warnings: {}", out.warnings.len());
+            for w in &out.warnings {
+                outln!("  warning: {w}");
+            }
+        }
         if let Err(e) = crate::cli::seal::write(dir, self.key) {
             errln!("cannot seal {}: {e}", dir.display());
             self.warn_not_at_rest();
@@ -105,8 +108,7 @@ impl End<'_> {
         self.warn_not_at_rest();
         match verdict {
             _ if aborted => ExitCode::from(4),
-            Some(RunVerdict::Pass) => ExitCode::SUCCESS,
-            Some(_) => ExitCode::from(3),
+            Some(v) => crate::cli::analyze::exit_code(v),
             None => ExitCode::from(1),
         }
     }
@@ -193,7 +195,11 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
             format_value(a.limit, &a.unit)
         );
     }
-    outln!("verdict: {}", results.verdict.as_str().to_uppercase());
+    // Sanity, warnings (the run's and the analysis's: the count results.json and the
+    // report give) and the verdict, as `ratecal analyze` tells them.
+    for line in crate::cli::analyze::verdict_lines(&results) {
+        outln!("{line}");
+    }
     outln!("results: {}", dir.join("results.json").display());
     // The checked plan beside the results lets `ratecal report` describe the process later.
     if let Ok(json) = serde_json::to_string_pretty(plan) {

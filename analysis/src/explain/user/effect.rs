@@ -64,6 +64,8 @@ impl UserEffect {
                     _ => None,
                 },
                 needs: leak(needs),
+                // A user effect declares no plausible range.
+                max_abs: f64::INFINITY,
             })
             .collect();
         let accel = c.regs.iter().any(|r| r.channel < 3);

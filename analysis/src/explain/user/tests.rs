@@ -15,6 +15,9 @@ fn sig(k: f64) -> Signals {
         dtemp_c: 2.5 * k,
         g: 9.81,
         t_s: 0.0,
+        table: Default::default(),
+        outer_b: Vec3::new(0.0, -1.0, 0.0),
+        inner_b: Vec3::new(1.0, 0.0, 0.0),
     };
     s.at(100.0 * k)
 }

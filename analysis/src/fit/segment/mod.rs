@@ -13,7 +13,7 @@
 mod kin;
 mod stats;
 
-pub(crate) use stats::ChannelStats;
+pub(crate) use stats::{ChannelStats, RawSums};
 
 use super::joint::{Accumulator, Layout, SegAcc};
 use super::prep::{self, PrepOptions};
@@ -81,6 +81,8 @@ pub(crate) struct Summary {
     pub channels: [ChannelStats; 6],
     /// The kept gyro outputs per axis, in order (the Allan block only).
     pub allan: Option<[Vec<f64>; 3]>,
+    /// Raw outputs against references over every row, for the sanity checks.
+    pub raw: RawSums,
 }
 
 /// Runs the pass over one segment.
@@ -117,6 +119,7 @@ pub(crate) fn pass<S: Source>(src: &S, job: &Job) -> Result<(Summary, SegAcc), S
             step_s: f64::NAN,
             channels: Default::default(),
             allan: (job.allan && job.prep.is_some()).then(Default::default),
+            raw: RawSums::default(),
         },
         angle_sums: (0.0, 0.0),
     };
@@ -246,6 +249,17 @@ impl Window<'_> {
                     Err(_) => {}
                 }
             }
+        }
+        // The raw rows against their references, for the sanity checks.
+        for i in ca..cb {
+            let out = [0, 1, 2, 3, 4, 5].map(|c| {
+                if c < 3 {
+                    v.accel[c][i]
+                } else {
+                    v.gyro[c - 3][i]
+                }
+            });
+            self.sum.raw.add(out, reference(&sig_at(i)));
         }
         // The window's own rows, into the fit and the sums.
         let temp_at = |i: usize| v.temp.map_or(f64::NAN, |x| x[i]);

@@ -58,3 +58,66 @@ impl ChannelStats {
         }
     }
 }
+
+/// Sums of a segment's raw outputs (no outlier removal, no low-pass) against their
+/// references, per channel (`ax ay az gx gy gz`), over every row: what the sanity checks
+/// read (means, and the mismatch `out - b - ref` for any bias `b`).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct RawSums {
+    /// Rows.
+    pub n: usize,
+    /// Sum of the outputs.
+    pub so: [f64; 6],
+    /// Sum of the references.
+    pub sr: [f64; 6],
+    /// Sum of the squared outputs.
+    pub soo: [f64; 6],
+    /// Sum of output times reference.
+    pub sor: [f64; 6],
+    /// Sum of the squared references.
+    pub srr: [f64; 6],
+}
+
+impl RawSums {
+    /// One row.
+    #[inline]
+    pub(super) fn add(&mut self, out: [f64; 6], refs: [f64; 6]) {
+        self.n += 1;
+        for c in 0..6 {
+            let (o, r) = (out[c], refs[c]);
+            self.so[c] += o;
+            self.sr[c] += r;
+            self.soo[c] += o * o;
+            self.sor[c] += o * r;
+            self.srr[c] += r * r;
+        }
+    }
+
+    /// Mean output of channel `c`.
+    pub(crate) fn mean_out(&self, c: usize) -> f64 {
+        self.so[c] / self.n.max(1) as f64
+    }
+
+    /// Mean reference of channel `c`.
+    pub(crate) fn mean_ref(&self, c: usize) -> f64 {
+        self.sr[c] / self.n.max(1) as f64
+    }
+
+    /// Mean square of `out - b - ref` on channel `c`.
+    pub(crate) fn mismatch_ms(&self, c: usize, b: f64) -> f64 {
+        let n = self.n.max(1) as f64;
+        let s = self.soo[c] - 2.0 * self.sor[c] + self.srr[c] - 2.0 * b * (self.so[c] - self.sr[c])
+            + n * b * b;
+        (s / n).max(0.0)
+    }
+
+    /// Mean square reference of channel `c`.
+    pub(crate) fn ref_ms(&self, c: usize) -> f64 {
+        self.srr[c] / self.n.max(1) as f64
+    }
+
+    /// Least-squares gain of `out - b` on the reference of channel `c` (NaN without one).
+    pub(crate) fn gain(&self, c: usize, b: f64) -> f64 {
+        (self.sor[c] - b * self.sr[c]) / self.srr[c]
+    }
+}
