@@ -349,9 +349,20 @@ fn a_refused_safe_stop_is_counted_and_printed_last() {
         .filter(|l| l.contains("\"event\":\"warning\"") || l.contains("\"action\":\"warn\""))
         .count();
     assert!(warnings >= 1, "{journal}");
+    // Every warning the journal holds is listed as one of the run's, and the summary's count
+    // is that of the warnings it lists (the run's and the analysis's).
+    let during = stdout
+        .lines()
+        .filter(|l| l.starts_with("  warning: during the run"))
+        .count();
+    assert_eq!(during, warnings, "{all}\n{journal}");
+    let listed = stdout
+        .lines()
+        .filter(|l| l.starts_with("  warning: "))
+        .count();
     assert!(
-        all.contains(&format!("warnings: {warnings}\n")),
-        "the summary's count is not the journal's {warnings}: {all}\n{journal}"
+        all.contains(&format!("warnings: {listed}\n")),
+        "the summary's count is not the {listed} listed: {all}\n{journal}"
     );
     let last = stdout
         .lines()
