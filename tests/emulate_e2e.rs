@@ -241,7 +241,11 @@ fn station_check_against_the_emulator() {
             None,
             4,
             "aborted",
-            &["abort:", "\"safe_state\",\"at_rest\":false"],
+            &[
+                "abort:",
+                "\"safe_state\",\"at_rest\":false",
+                "WARNING: the table was NOT confirmed at rest",
+            ],
         ),
         (
             "imu stall",
@@ -312,4 +316,62 @@ fn station_check_against_the_emulator() {
         .flat_map(|h| h.join().unwrap())
         .collect();
     assert!(wrong.is_empty(), "{}", wrong.join("\n\n"));
+}
+
+/// The emulator stops mid-run (issue 26, item 9): the table cannot answer the safe stop.
+/// The refusal and the table not seen at rest are counted warnings, the summary's count is
+/// the journal's, and the console's last line says plainly to check the table.
+#[test]
+fn a_refused_safe_stop_is_counted_and_printed_last() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (emu, conn) = emulate(tmp.path(), "  []", false);
+    let out = tmp.path().join("run");
+    let child = Command::new(BIN)
+        .args(["run", "procedures/station-check", "--station"])
+        .arg(&conn)
+        .arg("--out")
+        .arg(&out)
+        .current_dir(repo())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_secs(3));
+    drop(emu); // killed: nothing answers any more
+    let o = child.wait_with_output().unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout).into_owned();
+    let all = format!("{stdout}{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(o.status.code(), Some(4), "{all}");
+    let journal = std::fs::read_to_string(out.join("journal.jsonl")).unwrap();
+    assert!(journal.contains("\"at_rest\":false"), "{journal}");
+    let warnings = journal
+        .lines()
+        .filter(|l| l.contains("\"event\":\"warning\"") || l.contains("\"action\":\"warn\""))
+        .count();
+    assert!(warnings >= 1, "{journal}");
+    // Every warning the journal holds is listed as one of the run's, and the summary's count
+    // is that of the warnings it lists (the run's and the analysis's).
+    let during = stdout
+        .lines()
+        .filter(|l| l.starts_with("  warning: during the run"))
+        .count();
+    assert_eq!(during, warnings, "{all}\n{journal}");
+    let listed = stdout
+        .lines()
+        .filter(|l| l.starts_with("  warning: "))
+        .count();
+    assert!(
+        all.contains(&format!("warnings: {listed}\n")),
+        "the summary's count is not the {listed} listed: {all}\n{journal}"
+    );
+    let last = stdout
+        .lines()
+        .rev()
+        .find(|l| !l.trim().is_empty())
+        .unwrap_or("");
+    assert_eq!(
+        last, "WARNING: the table was NOT confirmed at rest: check it before approaching",
+        "{all}"
+    );
+    assert!(!all.contains("warnings: 0"), "{all}");
 }

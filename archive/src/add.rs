@@ -26,6 +26,8 @@ impl Archive {
 
     /// Stores and indexes a folder already read.
     pub async fn add_folder(&self, folder: &Folder) -> Result<Added> {
+        // What a killed add left unfinished goes first (never named by the index).
+        self.store.remove_leftovers();
         let id = folder.facts.id.clone();
         let files = folder.files.len();
         if self.exists(&id).await? {
@@ -40,15 +42,14 @@ impl Archive {
                 continue;
             }
             let full = folder.dir.join(path);
-            let bytes = std::fs::read(&full).map_err(|e| ArchiveError::io(&full, e))?;
-            // The folder changed since it was read (and verified): refuse it.
-            if ratecal_engine::audit::verify::sha256_hex(&bytes) != *sha {
+            // Copied streaming and hashed on the way; refused when the folder changed since
+            // it was read (and verified).
+            if !self.store.put_file(&self.pool, sha, &full).await? {
                 return Err(ArchiveError::NotARun {
                     path: folder.dir.clone(),
                     why: format!("{path} changed while it was being added"),
                 });
             }
-            self.store.put(&self.pool, sha, &bytes).await?;
         }
         let new = self.insert_index(folder).await?;
         Ok(Added { id, new, files })

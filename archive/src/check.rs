@@ -20,6 +20,8 @@ pub struct CheckReport {
     pub unreferenced: usize,
     /// Unfinished writes left by an interrupted add (harmless).
     pub leftovers: usize,
+    /// Unfinished writes removed (`check --fix`).
+    pub removed: usize,
 }
 
 impl CheckReport {
@@ -41,6 +43,14 @@ impl CheckReport {
             "{} run(s), {} stored file(s) rehashed, {} unreferenced, {} unfinished write(s)\n",
             self.runs, self.files_checked, self.unreferenced, self.leftovers
         ));
+        if self.removed > 0 {
+            s.push_str(&format!(
+                "removed {} unfinished write(s) left by an interrupted add\n",
+                self.removed
+            ));
+        } else if self.leftovers > 0 {
+            s.push_str("help: `ratecal archive check --fix` removes the unfinished writes\n");
+        }
         s.push_str(if self.ok() {
             "consistent: every stored file matches its hash and every index row points at a stored file\n"
         } else {
@@ -53,7 +63,15 @@ impl CheckReport {
 impl Archive {
     /// Rehashes every stored file and checks every index row against the store.
     pub async fn check(&self) -> Result<CheckReport> {
+        self.check_fix(false).await
+    }
+
+    /// [`Archive::check`]; with `fix`, first removes the unfinished writes a killed add left.
+    pub async fn check_fix(&self, fix: bool) -> Result<CheckReport> {
         let mut report = CheckReport::default();
+        if fix {
+            report.removed = self.store.remove_leftovers().len();
+        }
         let stored = self.store.hashes(&self.pool).await?;
         let mut intact = std::collections::HashSet::new();
         for sha in &stored {

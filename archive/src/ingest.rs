@@ -2,8 +2,9 @@
 //! index facts (from manifest.yaml and, when present, results.json).
 
 use crate::{ArchiveError, Result};
+use ratecal_engine::audit::seal::LOCK_FILE;
 use ratecal_engine::audit::verify::sha256_hex;
-use ratecal_engine::recording::Manifest;
+use ratecal_engine::recording::{FileState, Manifest, hash_folder, regular};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -94,12 +95,14 @@ pub fn read(dir: &Path) -> Result<Folder> {
         path: dir.to_path_buf(),
         why,
     };
-    let text = std::fs::read_to_string(dir.join("manifest.yaml"))
+    let manifest_path = dir.join("manifest.yaml");
+    let text = regular(&manifest_path)
+        .and_then(|()| std::fs::read_to_string(&manifest_path))
         .map_err(|e| not_run(format!("manifest.yaml: {e}")))?;
     let manifest: Manifest = serde_saphyr::from_str(&text)
         .map_err(|e| not_run(format!("manifest.yaml does not parse: {e}")))?;
     let mut files = Vec::new();
-    walk(dir, dir, &mut files)?;
+    walk(dir, &mut files)?;
     files.sort();
     let results = std::fs::read(dir.join("results.json"))
         .ok()
@@ -125,21 +128,20 @@ pub fn content_id(files: &[(String, String, u64)]) -> String {
     sha256_hex(s.as_bytes())[..16].to_string()
 }
 
-fn walk(root: &Path, dir: &Path, out: &mut Vec<(String, String, u64)>) -> Result<()> {
-    let rd = std::fs::read_dir(dir).map_err(|e| ArchiveError::io(dir, e))?;
-    for entry in rd.flatten() {
-        let path = entry.path();
-        let ft = entry.file_type().map_err(|e| ArchiveError::io(&path, e))?;
-        if ft.is_dir() {
-            walk(root, &path, out)?;
-        } else if ft.is_file() {
-            let bytes = std::fs::read(&path).map_err(|e| ArchiveError::io(&path, e))?;
-            let rel = path.strip_prefix(root).unwrap_or(&path);
-            let rel: Vec<String> = rel
-                .components()
-                .map(|c| c.as_os_str().to_string_lossy().into_owned())
-                .collect();
-            out.push((rel.join("/"), sha256_hex(&bytes), bytes.len() as u64));
+/// Every file of the folder as `verify` sees it (symlinks followed, hashed streaming, the
+/// lock file left out); an entry that cannot be read refuses the folder, named.
+fn walk(root: &Path, out: &mut Vec<(String, String, u64)>) -> Result<()> {
+    let files =
+        hash_folder(root, |name| name == LOCK_FILE).map_err(|e| ArchiveError::io(root, e))?;
+    for (name, state) in files {
+        match state {
+            FileState::Hashed { sha256, size } => out.push((name, sha256, size)),
+            FileState::Unreadable(why) => {
+                return Err(ArchiveError::NotARun {
+                    path: root.to_path_buf(),
+                    why: format!("{name}: {why}"),
+                });
+            }
         }
     }
     Ok(())

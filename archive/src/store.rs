@@ -44,6 +44,23 @@ impl Store {
         }
     }
 
+    /// Stores the file at `src` under `sha` unless already there; false (nothing stored)
+    /// when its content does not hash to `sha`. A folder store copies it streaming (memory
+    /// flat in its size); the database store binds it whole (one row per file).
+    pub async fn put_file(&self, pool: &AnyPool, sha: &str, src: &Path) -> Result<bool> {
+        match self {
+            Store::Folder(root) => copy_file(root, sha, src),
+            Store::Database => {
+                let bytes = std::fs::read(src).map_err(|e| ArchiveError::io(src, e))?;
+                if ratecal_engine::audit::verify::sha256_hex(&bytes) != sha {
+                    return Ok(false);
+                }
+                self.put(pool, sha, &bytes).await?;
+                Ok(true)
+            }
+        }
+    }
+
     /// The bytes stored under `sha`, `None` when absent.
     pub async fn get(&self, pool: &AnyPool, sha: &str) -> Result<Option<Vec<u8>>> {
         match self {
@@ -95,6 +112,19 @@ impl Store {
         }
     }
 
+    /// Removes the unfinished writes a killed add left in `tmp/`: those whose writer (the
+    /// pid in their name) is no longer running, and any older than a day. A write another
+    /// add is making now is left alone. Returns what was removed.
+    pub fn remove_leftovers(&self) -> Vec<PathBuf> {
+        let mut removed = Vec::new();
+        for path in self.leftovers() {
+            if abandoned(&path) && std::fs::remove_file(&path).is_ok() {
+                removed.push(path);
+            }
+        }
+        removed
+    }
+
     /// Unfinished writes left by an interrupted add (harmless: never named by the index).
     pub fn leftovers(&self) -> Vec<PathBuf> {
         match self {
@@ -104,6 +134,30 @@ impl Store {
             Store::Database => Vec::new(),
         }
     }
+}
+
+/// Whether an unfinished write (`tmp/<sha>.<pid>.<nanos>`) was abandoned: its writer is
+/// gone (no `/proc/<pid>`, where the system has `/proc`), or it is older than a day.
+fn abandoned(path: &Path) -> bool {
+    let day = std::time::Duration::from_secs(24 * 3600);
+    let old = std::fs::metadata(path)
+        .and_then(|m| m.modified())
+        .ok()
+        .and_then(|t| t.elapsed().ok())
+        .is_some_and(|age| age > day);
+    let pid = path
+        .file_name()
+        .and_then(|n| n.to_str())
+        .and_then(|n| n.split('.').nth(1))
+        .and_then(|p| p.parse::<u32>().ok());
+    let proc_ = Path::new("/proc/self").exists();
+    let gone = match pid {
+        Some(p) if proc_ => {
+            p != std::process::id() && !Path::new("/proc").join(p.to_string()).exists()
+        }
+        _ => false,
+    };
+    old || gone
 }
 
 /// Writes into `tmp/`, syncs, then renames into place: the name appears only when whole.
@@ -126,6 +180,54 @@ fn put_file(root: &Path, sha: &str, bytes: &[u8]) -> Result<()> {
     f.sync_all().map_err(|e| io(&tmp, e))?;
     drop(f);
     std::fs::rename(&tmp, &dest).map_err(|e| io(&dest, e))
+}
+
+/// `put_file` into a folder store: copies `src` into `tmp/` hashing it on the way, syncs,
+/// then renames into place only when the hash is `sha`.
+fn copy_file(root: &Path, sha: &str, src: &Path) -> Result<bool> {
+    use sha2::{Digest, Sha256};
+    use std::io::Read;
+    let dest = Store::path(root, sha);
+    if dest.is_file() {
+        return Ok(true);
+    }
+    let tmp_dir = root.join(TMP);
+    let io = |p: &Path, e| ArchiveError::io(p, e);
+    std::fs::create_dir_all(&tmp_dir).map_err(|e| io(&tmp_dir, e))?;
+    let parent = dest.parent().unwrap_or(root);
+    std::fs::create_dir_all(parent).map_err(|e| io(parent, e))?;
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.subsec_nanos());
+    let tmp = tmp_dir.join(format!("{sha}.{}.{nanos}", std::process::id()));
+    ratecal_engine::recording::regular(src).map_err(|e| io(src, e))?;
+    let mut from = std::fs::File::open(src).map_err(|e| io(src, e))?;
+    let mut to = std::fs::File::create(&tmp).map_err(|e| io(&tmp, e))?;
+    let mut hasher = Sha256::new();
+    let mut buf = vec![0u8; 256 * 1024];
+    let copied = (|| -> std::io::Result<()> {
+        loop {
+            let n = match from.read(&mut buf) {
+                Ok(0) => return to.sync_all(),
+                Ok(n) => n,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+                Err(e) => return Err(e),
+            };
+            hasher.update(&buf[..n]);
+            to.write_all(&buf[..n])?;
+        }
+    })();
+    drop(to);
+    if let Err(e) = copied {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(io(&tmp, e));
+    }
+    if hex::encode(hasher.finalize()) != sha {
+        let _ = std::fs::remove_file(&tmp);
+        return Ok(false);
+    }
+    std::fs::rename(&tmp, &dest).map_err(|e| io(&dest, e))?;
+    Ok(true)
 }
 
 fn folder_hashes(root: &Path) -> Result<Vec<String>> {

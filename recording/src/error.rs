@@ -1,6 +1,7 @@
 //! Why a recording folder is refused: every variant names the file, line and column.
 
-use miette::{Diagnostic, NamedSource, SourceSpan};
+use crate::excerpt::Excerpt;
+use miette::{Diagnostic, SourceSpan};
 use thiserror::Error;
 
 /// A recording that cannot be read, located in its file.
@@ -38,7 +39,7 @@ pub enum RecordingError {
         found: String,
         /// File text.
         #[source_code]
-        src: NamedSource<String>,
+        src: Excerpt,
         /// The header line.
         #[label("no `{column}` here")]
         span: SourceSpan,
@@ -63,7 +64,7 @@ pub enum RecordingError {
         cell: String,
         /// File text.
         #[source_code]
-        src: NamedSource<String>,
+        src: Excerpt,
         /// The cell.
         #[label("not a number")]
         span: SourceSpan,
@@ -86,7 +87,7 @@ pub enum RecordingError {
         expected: usize,
         /// File text.
         #[source_code]
-        src: NamedSource<String>,
+        src: Excerpt,
         /// The row.
         #[label("this row")]
         span: SourceSpan,
@@ -115,9 +116,32 @@ pub enum RecordingError {
         prev: f64,
         /// File text.
         #[source_code]
-        src: NamedSource<String>,
+        src: Excerpt,
         /// The stamp.
         #[label("not after the previous line's {prev} s")]
+        span: SourceSpan,
+    },
+
+    /// A line far longer than a sample's (a file zeroed or preallocated by a crash).
+    #[error("{file}:{line}: a line of more than {max} bytes without a line break")]
+    #[diagnostic(
+        code(recording::line_too_long),
+        help(
+            "a line of {file} holds one sample, at most a few hundred bytes; this one looks like a file zeroed or preallocated by a crash (NUL bytes show as \\0)"
+        )
+    )]
+    LineTooLong {
+        /// File name.
+        file: String,
+        /// Line, 1-based.
+        line: u64,
+        /// The longest line accepted, bytes.
+        max: usize,
+        /// The start of the line.
+        #[source_code]
+        src: Excerpt,
+        /// The line.
+        #[label("no line break here")]
         span: SourceSpan,
     },
 
@@ -149,7 +173,7 @@ pub enum RecordingError {
         imu_last: f64,
         /// File text.
         #[source_code]
-        src: NamedSource<String>,
+        src: Excerpt,
         /// The table's first stamp.
         #[label("the table's clock starts here")]
         span: SourceSpan,
@@ -170,7 +194,7 @@ pub enum RecordingError {
         column: u64,
         /// File text.
         #[source_code]
-        src: NamedSource<String>,
+        src: Excerpt,
         /// The end of the file's text.
         #[label("the samples end here")]
         span: SourceSpan,
@@ -193,7 +217,7 @@ pub enum RecordingError {
         message: String,
         /// File text.
         #[source_code]
-        src: NamedSource<String>,
+        src: Excerpt,
         /// Where.
         #[label("{message}")]
         span: SourceSpan,
@@ -217,7 +241,7 @@ pub enum RecordingError {
         help: String,
         /// File text.
         #[source_code]
-        src: NamedSource<String>,
+        src: Excerpt,
         /// The value.
         #[label("{problem}")]
         span: SourceSpan,
@@ -240,7 +264,7 @@ pub enum RecordingError {
         found: String,
         /// File text.
         #[source_code]
-        src: NamedSource<String>,
+        src: Excerpt,
         /// Where.
         #[label("unknown format")]
         span: SourceSpan,
@@ -268,7 +292,7 @@ pub enum RecordingError {
         help: String,
         /// File text.
         #[source_code]
-        src: NamedSource<String>,
+        src: Excerpt,
         /// The segment.
         #[label("this segment")]
         span: SourceSpan,
@@ -297,7 +321,7 @@ pub enum RecordingError {
         t_end: f64,
         /// File text.
         #[source_code]
-        src: NamedSource<String>,
+        src: Excerpt,
         /// The segment.
         #[label("empty segment")]
         span: SourceSpan,
@@ -306,15 +330,15 @@ pub enum RecordingError {
 
 /// A stream with fewer than two samples, located where its text ends.
 pub(crate) fn empty_stream(file: &str, bytes: &[u8]) -> RecordingError {
-    let text = String::from_utf8_lossy(bytes).into_owned();
-    let end = text.trim_end().len();
-    let (line, column) = line_col(&text, end);
+    let end = bytes.trim_ascii_end().len();
+    let (line, column) = line_col_bytes(bytes, end);
+    let (src, span) = Excerpt::around(file, bytes, end, end);
     RecordingError::EmptyStream {
         file: file.to_string(),
         line,
-        column,
-        src: NamedSource::new(file, text),
-        span: (end, 0).into(),
+        column: column as u64,
+        src,
+        span,
     }
 }
 
@@ -337,7 +361,12 @@ pub(crate) fn line_col_bytes(bytes: &[u8], offset: usize) -> (u64, usize) {
             start = i + 1;
         }
     }
-    let column = String::from_utf8_lossy(&before[start..]).chars().count() + 1;
+    // Counted without copying the line (it may be a gigabyte without a line break).
+    let column = before[start..]
+        .utf8_chunks()
+        .map(|c| c.valid().chars().count() + c.invalid().len())
+        .sum::<usize>()
+        + 1;
     (line, column)
 }
 

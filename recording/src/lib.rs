@@ -41,6 +41,8 @@
 pub mod cadence;
 mod data;
 mod error;
+mod excerpt;
+mod files;
 mod manifest;
 mod read;
 mod write;
@@ -48,6 +50,8 @@ mod write;
 pub use cadence::{Cadence, CadenceReport};
 pub use data::{ImuSample, ImuStream, Recording, TableSample, TableStream};
 pub use error::{RecordingError, yaml_offset};
+pub use excerpt::Excerpt;
+pub use files::{FileState, hash_folder, regular, sha256_file};
 pub use manifest::{
     AbortRecord, EnvironmentRecord, FORMAT, LinkRecord, Manifest, ManifestStation, Mount,
     ProcedureRef, ResumeRecord, RunInfo, Segment, SegmentKind, SyncRecord, TableAxes,

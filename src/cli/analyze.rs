@@ -40,6 +40,19 @@ pub struct Args {
 
 /// Runs the subcommand.
 pub fn main(args: Args) -> ExitCode {
+    // Writing into a run folder: its lock first, so a second writer is refused at once.
+    let _lock = match args
+        .out
+        .as_deref()
+        .map(|p| super::lock::for_file(p, &super::seal::command_line()))
+    {
+        Some(Err(e)) => {
+            errln!("{e:?}");
+            return ExitCode::from(1);
+        }
+        Some(Ok(l)) => l,
+        None => None,
+    };
     let load = |p: &std::path::Path| load_plan(p, args.allow_changed);
     let (plan, sha256) = match args.procedure.as_deref().map(load).transpose() {
         Ok(Some((p, h))) => (Some(p), h),

@@ -110,6 +110,9 @@ enum Command {
     Check {
         #[arg(long, value_enum, default_value_t = Format::Table)]
         format: Format,
+        /// Remove the unfinished writes a killed `archive add` left (`files/tmp/`).
+        #[arg(long)]
+        fix: bool,
     },
 }
 
@@ -221,8 +224,8 @@ async fn run(loc: &Location, cmd: Command) -> Result<ExitCode, Report> {
             );
             ExitCode::SUCCESS
         }
-        Command::Check { format } => {
-            let r = archive.check().await?;
+        Command::Check { format, fix } => {
+            let r = archive.check_fix(fix).await?;
             match format {
                 Format::Json => println!("{}", to_json(&r)?),
                 Format::Table => print!("{}", r.text()),

@@ -2,7 +2,7 @@
 //! [--format text|json] [--plots DIR]`: where the recording and the nominal model disagree,
 //! what physics was left out, the refit with it, and one before/after figure per finding
 //! (`explain-<effect>.svg`). Exit codes, like diff(1): 0 nothing found, 1 findings
-//! reported, 2 error.
+//! reported, 2 error; 4 the run folder's seal fails (or it was never sealed).
 
 use super::procedure;
 use ratecal_engine::explain::{self, AdoptTarget, NominalModel, Options, UserEffect};
@@ -118,6 +118,12 @@ fn adopt_target(arg: &Path) -> Option<AdoptTarget> {
 
 /// Runs the subcommand.
 pub fn main(args: Args) -> ExitCode {
+    // A folder whose seal fails (or a run never sealed) is not explained, and its seal
+    // gains nothing (exit 4, as `report`).
+    if let Err(e) = super::verify::require_intact(&args.run, "explanation") {
+        eprintln!("{e:?}");
+        return ExitCode::from(4);
+    }
     // The IMU stream is read a window at a time (`fit::Streamed`), as `analyze` reads it.
     let rec = match Streamed::open(&args.run) {
         Ok(r) => r,
@@ -125,6 +131,19 @@ pub fn main(args: Args) -> ExitCode {
             eprintln!("{:?}", miette::Report::new(e));
             return ExitCode::from(2);
         }
+    };
+    // A ratecal run folder gains explain.json: its lock first, so a second writer is
+    // refused at once (exit 2, an error as spec/cli.md has it for explain).
+    let _lock = if rec.manifest().run.is_some() {
+        match super::lock::acquire(&args.run, &super::seal::command_line()) {
+            Ok(l) => Some(l),
+            Err(e) => {
+                eprintln!("{e:?}");
+                return ExitCode::from(2);
+            }
+        }
+    } else {
+        None
     };
     let Ok(user) = load_effects(&args.effects) else {
         return ExitCode::from(2);

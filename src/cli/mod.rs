@@ -9,6 +9,7 @@ pub mod emulate;
 pub mod explain;
 pub mod fmt;
 pub mod key;
+pub mod lock;
 pub mod log;
 pub mod procedure;
 pub mod report;

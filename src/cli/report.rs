@@ -4,7 +4,8 @@
 //! write report.md and report.html into the run folder.
 //!
 //! Exit codes: 0 report written, 1 input error (no run folder, no or bad results.json or
-//! manifest, template error), 2 usage.
+//! manifest, template error), 2 usage, 4 the folder's seal fails (or a run folder was never
+//! sealed).
 
 use miette::{Diagnostic, NamedSource, SourceSpan};
 use ratecal_engine::plan::Plan;
@@ -69,6 +70,14 @@ enum InputError {
 
 /// Runs the subcommand.
 pub fn main(args: Args) -> ExitCode {
+    // A folder whose seal fails (or a run never sealed) gets no report, and its seal no
+    // addition (spec/cli.md: exit 4).
+    if args.run_dir.is_dir()
+        && let Err(e) = super::verify::require_intact(&args.run_dir, "report")
+    {
+        errln!("{e:?}");
+        return ExitCode::from(4);
+    }
     match report(&args) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -79,6 +88,11 @@ pub fn main(args: Args) -> ExitCode {
 }
 
 fn report(args: &Args) -> miette::Result<()> {
+    // Writing into a run folder: its lock first, so a second writer is refused at once.
+    let _lock = match &args.out {
+        Some(out) => super::lock::for_file(out, &super::seal::command_line())?,
+        None => None,
+    };
     let mut input = read_run(&args.run_dir)?;
     let serial = serial_of(&input);
     input.archive_trend = super::archive::trend_json(args.archive.as_deref(), serial.as_deref());

@@ -12,6 +12,7 @@ mod progress;
 mod resume;
 mod setup;
 
+use super::lock::FolderLock;
 use ed25519_dalek::SigningKey;
 use miette::Report;
 use ratecal_engine::recording::{Columns, RecordingWriter};
@@ -91,7 +92,8 @@ fn run(args: Args) -> Result<ExitCode, Report> {
         .as_deref()
         .map(super::seal::signing_key)
         .transpose()?;
-    let prep = match &args.resume {
+    // The folder's lock is held to the end, the failure record and the seal included.
+    let (prep, _lock) = match &args.resume {
         Some(dir) => resume::prepare(dir)?,
         None => prepare_new(&args)?,
     };
@@ -195,7 +197,7 @@ fn link_timeout_s(station: &ratecal_drivers::Station) -> Option<f64> {
     table.into_iter().chain(imu).reduce(f64::max)
 }
 
-fn prepare_new(args: &Args) -> Result<Prepared, Report> {
+fn prepare_new(args: &Args) -> Result<(Prepared, FolderLock), Report> {
     let proc_path = setup::procedure_file(args.procedure.as_deref().unwrap_or(Path::new(".")))?;
     // Without --station the procedure's geometry picks the embedded station.
     let builtin = std::fs::read_to_string(&proc_path)
@@ -218,6 +220,15 @@ fn prepare_new(args: &Args) -> Result<Prepared, Report> {
     let io =
         |e: std::io::Error| miette::miette!("cannot write the run folder {}: {e}", dir.display());
     std::fs::create_dir_all(&dir).map_err(io)?;
+    let lock = super::lock::acquire(&dir, &super::seal::command_line())?;
+    // Asked again under the lock: another `run --out` may have started it meanwhile.
+    if dir.join("manifest.yaml").exists() {
+        return Err(miette::miette!(
+            help = "choose another --out, or continue it with --resume",
+            "{} already holds a run",
+            dir.display()
+        ));
+    }
     std::fs::write(dir.join("procedure.rcal"), &pr.text).map_err(io)?;
     pr.imports.save(&dir).map_err(io)?;
     std::fs::write(dir.join("station.yaml"), &st.yaml).map_err(io)?;
@@ -237,12 +248,13 @@ fn prepare_new(args: &Args) -> Result<Prepared, Report> {
         table_t_host: st.station.table.driver.kind.host_arrival,
     };
     let writer = RecordingWriter::create(&dir, manifest, columns).map_err(io)?;
-    Ok(Prepared {
+    let prep = Prepared {
         dir,
         plan: pr.plan,
         station: st.station,
         writer,
         opts: RunOptions::default(),
         seed: args.seed,
-    })
+    };
+    Ok((prep, lock))
 }

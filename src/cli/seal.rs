@@ -4,41 +4,35 @@
 use ed25519_dalek::pkcs8::{DecodePrivateKey, DecodePublicKey};
 use ed25519_dalek::{SigningKey, VerifyingKey};
 use miette::{Report, miette};
-use ratecal_engine::audit::seal::{SEAL_FILE, SEAL_HASH_FILE, Seal, is_seal_file};
-use ratecal_engine::recording::rfc3339;
+use ratecal_engine::audit::seal::{SEAL_FILE, SEAL_HASH_FILE, Seal, is_unsealed_file};
+use ratecal_engine::recording::{FileState, hash_folder, rfc3339, sha256_file};
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-/// Every file under `dir` but the seal's own, by `/`-separated relative path, with its bytes.
-pub fn folder_files(dir: &Path) -> std::io::Result<BTreeMap<String, Vec<u8>>> {
-    let mut out = BTreeMap::new();
-    let mut stack: Vec<PathBuf> = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for entry in std::fs::read_dir(&d)? {
-            let path = entry?.path();
-            if path.is_dir() {
-                stack.push(path);
-                continue;
-            }
-            let rel = path.strip_prefix(dir).unwrap_or(&path);
-            let name = rel
-                .components()
-                .map(|c| c.as_os_str().to_string_lossy().into_owned())
-                .collect::<Vec<_>>()
-                .join("/");
-            if !is_seal_file(&name) {
-                out.insert(name, std::fs::read(&path)?);
+/// Every entry under `dir` but the seal's own files and the lock file, by `/`-separated
+/// relative path: its SHA-256 (hashed streaming, symlinks followed) or why it cannot be
+/// read (docs/archive.md, Symlinks and special files).
+pub fn folder_files(dir: &Path) -> std::io::Result<BTreeMap<String, FileState>> {
+    hash_folder(dir, is_unsealed_file)
+}
+
+/// Seals every file of a run folder, signed with `key` if given; written last. Refused
+/// when an entry cannot be read (it could not be shown unaltered later).
+pub fn write(dir: &Path, key: Option<&SigningKey>) -> std::io::Result<()> {
+    let files = folder_files(dir)?;
+    let mut hashes = Vec::with_capacity(files.len());
+    for (path, state) in &files {
+        match state {
+            FileState::Hashed { sha256, .. } => hashes.push((path.as_str(), sha256.as_str())),
+            FileState::Unreadable(why) => {
+                return Err(std::io::Error::other(format!(
+                    "{path}: {why} (a sealed folder holds regular files only)"
+                )));
             }
         }
     }
-    Ok(out)
-}
-
-/// Seals every file of a run folder, signed with `key` if given; written last.
-pub fn write(dir: &Path, key: Option<&SigningKey>) -> std::io::Result<()> {
-    let files = folder_files(dir)?;
     let now = rfc3339(std::time::SystemTime::now());
-    let mut seal = Seal::new(&now, files.iter().map(|(p, b)| (p.as_str(), b.as_slice())));
+    let mut seal = Seal::from_hashes(&now, hashes);
     if let Some(k) = key {
         seal.sign(k);
     }
@@ -81,14 +75,14 @@ pub fn record_additions(files: &[&Path], command: &str) -> std::io::Result<bool>
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
-        named.push((name, std::fs::read(file)?));
+        named.push((name, sha256_file(file)?.0));
     }
-    let borrowed: Vec<(&str, &[u8])> = named
+    let borrowed: Vec<(&str, &str)> = named
         .iter()
-        .map(|(n, b)| (n.as_str(), b.as_slice()))
+        .map(|(n, h)| (n.as_str(), h.as_str()))
         .collect();
     let now = rfc3339(std::time::SystemTime::now());
-    seal.add(&now, command, &borrowed);
+    seal.add_hashes(&now, command, &borrowed);
     save(dir, &seal)?;
     Ok(true)
 }

@@ -5,7 +5,7 @@
 //! or not signed by the key; 2 error (no such run folder, unreadable key).
 
 use ed25519_dalek::VerifyingKey;
-use ratecal_engine::audit::seal::{SEAL_FILE, SEAL_HASH_FILE, verify_seal};
+use ratecal_engine::audit::seal::{SEAL_FILE, SEAL_HASH_FILE, verify_hashes};
 use ratecal_engine::audit::verify::VerifyReport;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -26,7 +26,9 @@ pub fn verify_folder(
     dir: &Path,
     key: Option<&VerifyingKey>,
 ) -> Result<VerifyReport, miette::Report> {
-    let is_run = dir.join("manifest.yaml").is_file() || dir.join(SEAL_FILE).is_file();
+    // A dangling or looping manifest.yaml is still there: `verify` names it, unreadable.
+    let there = |name: &str| std::fs::symlink_metadata(dir.join(name)).is_ok();
+    let is_run = dir.is_dir() && (there("manifest.yaml") || there(SEAL_FILE));
     let files = match super::seal::folder_files(dir) {
         Ok(f) if is_run => f,
         Ok(_) | Err(_) => {
@@ -38,13 +40,60 @@ pub fn verify_folder(
             ));
         }
     };
-    let seal = std::fs::read_to_string(dir.join(SEAL_FILE)).ok();
-    let seal_hash = std::fs::read_to_string(dir.join(SEAL_HASH_FILE)).ok();
-    Ok(verify_seal(
+    // Read only when regular: a FIFO in their place would block (it is named unreadable).
+    let read = |name: &str| {
+        let p = dir.join(name);
+        ratecal_engine::recording::regular(&p)
+            .ok()
+            .and_then(|()| std::fs::read_to_string(p).ok())
+    };
+    let seal = read(SEAL_FILE);
+    let seal_hash = read(SEAL_HASH_FILE);
+    Ok(verify_hashes(
         seal.as_deref(),
         seal_hash.as_deref(),
         &files,
         key,
+    ))
+}
+
+/// Why a command that reads a run folder to publish from it (`report`, `explain`) refuses it:
+/// its seal fails, or a ratecal run folder was never sealed. `Ok` for an intact folder and
+/// for a recording another system wrote (no seal, no `run` section in its manifest).
+pub fn require_intact(dir: &Path, command: &str) -> Result<(), miette::Report> {
+    let sealed = std::fs::symlink_metadata(dir.join(SEAL_FILE)).is_ok();
+    if !sealed {
+        let ratecal_run = std::fs::read_to_string(dir.join("manifest.yaml"))
+            .ok()
+            .and_then(|t| ratecal_engine::recording::parse_manifest("manifest.yaml", &t).ok())
+            .is_some_and(|m| m.run.is_some());
+        if !ratecal_run {
+            return Ok(());
+        }
+        return Err(miette::miette!(
+            code = "verify::never_sealed",
+            help = format!(
+                "a run seals its folder when it ends; finish it with `ratecal run --resume {}`",
+                dir.display()
+            ),
+            "{} was never sealed: no {command} from it (nothing shows it unaltered)",
+            dir.display()
+        ));
+    }
+    let report = verify_folder(dir, None)?;
+    if report.intact() {
+        return Ok(());
+    }
+    let names: Vec<&str> = report.altered().map(|c| c.file.as_str()).collect();
+    Err(miette::miette!(
+        code = "verify::altered",
+        help = format!(
+            "`ratecal verify {}` shows what changed; nothing was added to its seal",
+            dir.display()
+        ),
+        "{} fails its seal ({}): no {command} from it",
+        dir.display(),
+        names.join(", ")
     ))
 }
 

@@ -4,6 +4,7 @@
 //! and hands the files in; nothing here opens a file.
 
 use super::verify::{FileCheck, Status, VerifyReport, sha256_hex};
+use crate::recording::FileState;
 use ed25519_dalek::{Signature, Signer, SigningKey, Verifier, VerifyingKey};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -54,21 +55,40 @@ pub struct Addition {
     pub files: BTreeMap<String, String>,
 }
 
+/// The run folder's lock file: who writes the folder now. Never sealed, archived or
+/// exported: it says nothing about the run.
+pub const LOCK_FILE: &str = ".ratecal.lock";
+
 /// Whether a path names the seal itself (never listed in it).
 pub fn is_seal_file(path: &str) -> bool {
     path == SEAL_FILE || path == SEAL_HASH_FILE
 }
 
+/// Whether a path is outside what a seal covers: the seal's own files and the lock file.
+pub fn is_unsealed_file(path: &str) -> bool {
+    is_seal_file(path) || path == LOCK_FILE
+}
+
 impl Seal {
     /// Seals `files` (path and bytes, the seal's own files left out) at time `sealed`.
     pub fn new<'a>(sealed: &str, files: impl IntoIterator<Item = (&'a str, &'a [u8])>) -> Self {
+        let hashed: Vec<(&str, String)> =
+            files.into_iter().map(|(p, b)| (p, sha256_hex(b))).collect();
+        Self::from_hashes(sealed, hashed.iter().map(|(p, h)| (*p, h.as_str())))
+    }
+
+    /// Seals files by their SHA-256 (hashed streaming by the caller) at time `sealed`.
+    pub fn from_hashes<'a>(
+        sealed: &str,
+        files: impl IntoIterator<Item = (&'a str, &'a str)>,
+    ) -> Self {
         Seal {
             format: SEAL_FORMAT.into(),
             sealed: sealed.into(),
             files: files
                 .into_iter()
                 .filter(|(p, _)| !is_seal_file(p))
-                .map(|(p, b)| (p.to_string(), sha256_hex(b)))
+                .map(|(p, h)| (p.to_string(), h.to_string()))
                 .collect(),
             signature: None,
             added: Vec::new(),
@@ -97,12 +117,19 @@ impl Seal {
 
     /// Records files written after sealing.
     pub fn add(&mut self, time: &str, command: &str, files: &[(&str, &[u8])]) {
+        let hashed: Vec<(&str, String)> = files.iter().map(|(p, b)| (*p, sha256_hex(b))).collect();
+        let refs: Vec<(&str, &str)> = hashed.iter().map(|(p, h)| (*p, h.as_str())).collect();
+        self.add_hashes(time, command, &refs);
+    }
+
+    /// Records files written after sealing, by their SHA-256.
+    pub fn add_hashes(&mut self, time: &str, command: &str, files: &[(&str, &str)]) {
         self.added.push(Addition {
             time: time.into(),
             command: command.into(),
             files: files
                 .iter()
-                .map(|(p, b)| (p.to_string(), sha256_hex(b)))
+                .map(|(p, h)| (p.to_string(), h.to_string()))
                 .collect(),
         });
     }
@@ -125,6 +152,27 @@ pub fn verify_seal(
     seal: Option<&str>,
     seal_hash: Option<&str>,
     files: &BTreeMap<String, Vec<u8>>,
+    key: Option<&VerifyingKey>,
+) -> VerifyReport {
+    let hashed: BTreeMap<String, FileState> = files
+        .iter()
+        .map(|(p, b)| {
+            let state = FileState::Hashed {
+                sha256: sha256_hex(b),
+                size: b.len() as u64,
+            };
+            (p.clone(), state)
+        })
+        .collect();
+    verify_hashes(seal, seal_hash, &hashed, key)
+}
+
+/// [`verify_seal`] of files hashed by the caller (streaming); an entry it could not read
+/// is named with why.
+pub fn verify_hashes(
+    seal: Option<&str>,
+    seal_hash: Option<&str>,
+    files: &BTreeMap<String, FileState>,
     key: Option<&VerifyingKey>,
 ) -> VerifyReport {
     let mut report = VerifyReport::default();
@@ -181,8 +229,9 @@ pub fn verify_seal(
         };
         let status = match files.get(*path) {
             None => Status::Missing,
-            Some(b) => {
-                let now = sha256_hex(b);
+            Some(FileState::Unreadable(why)) => Status::Unreadable(why.clone()),
+            Some(FileState::Hashed { sha256: now, .. }) => {
+                let now = now.clone();
                 if now.eq_ignore_ascii_case(sha) {
                     Status::Intact
                 } else {
@@ -195,8 +244,14 @@ pub fn verify_seal(
         };
         push(&name, status);
     }
-    for path in files.keys().filter(|p| !expected.contains_key(p.as_str())) {
-        push(path, Status::Unknown);
+    for (path, state) in files
+        .iter()
+        .filter(|(p, _)| !expected.contains_key(p.as_str()))
+    {
+        match state {
+            FileState::Unreadable(why) => push(path, Status::Unreadable(why.clone())),
+            FileState::Hashed { .. } => push(path, Status::Unknown),
+        }
     }
     if let Some(key) = key {
         push(

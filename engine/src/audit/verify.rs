@@ -41,6 +41,9 @@ pub enum Status {
     Unknown,
     /// Not signed by the given key: why.
     Unsigned(String),
+    /// In the folder but not readable as a regular file (a dangling symlink, a loop, a
+    /// FIFO...): why.
+    Unreadable(String),
 }
 
 /// One file checked against its recorded hash.
@@ -105,6 +108,7 @@ impl VerifyReport {
                 }
                 Status::Unknown => format!("! UNKNOWN  {}: not in the seal\n", c.file),
                 Status::Unsigned(why) => format!("! UNSIGNED {}: {why}\n", c.file),
+                Status::Unreadable(why) => format!("! UNREADABLE {}: {why}\n", c.file),
             };
             s.push_str(&line);
         }

@@ -754,6 +754,8 @@ impl Exec<'_> {
                 rule: "safe stop refused".into(),
                 values: e.message.clone(),
             });
+            self.warnings
+                .push(format!("safe stop refused: {}", e.message));
         }
         self.cmd = CmdState::default();
         let started = self.now();
@@ -790,5 +792,15 @@ impl Exec<'_> {
             }
         };
         self.journal(JournalEvent::SafeState { at_rest });
+        if !at_rest {
+            // Counted like every warning (the summary's count is the journal's), and the
+            // console prints it last.
+            self.journal(JournalEvent::Warning {
+                rule: "not at rest".into(),
+                values: super::NOT_AT_REST.into(),
+            });
+            self.warnings
+                .push(format!("not at rest: {}", super::NOT_AT_REST));
+        }
     }
 }

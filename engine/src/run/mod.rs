@@ -27,6 +27,10 @@ mod live;
 mod monitor;
 
 pub use exec::execute;
+
+/// What the operator is told, last and plainly, when the safe stop could not be confirmed
+/// (the table refused it, or its feedback never showed it at rest).
+pub const NOT_AT_REST: &str = "the table was NOT confirmed at rest: check it before approaching";
 pub use journal::{JournalEntry, JournalEvent, ResumePoint, resume_point};
 
 /// Where a run's data goes. [`RecordingWriter`] is the implementation that writes a run

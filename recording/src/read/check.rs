@@ -5,12 +5,12 @@
 // A refused recording is built once per read: the error's size costs nothing.
 #![allow(clippy::result_large_err)]
 
-use super::csvread::{cell_offset, lossy_span, row_start};
+use super::csvread::{cell_offset, row_start};
 use super::io_error;
 use super::manifest::find_segment;
 use crate::Manifest;
 use crate::error::{RecordingError, empty_stream, line_col, line_col_bytes};
-use miette::NamedSource;
+use crate::excerpt::Excerpt;
 use std::path::Path;
 
 /// Time strictly increasing, at least two rows; a problem is located by reading the file
@@ -77,7 +77,7 @@ pub(super) fn check_overlap(
 fn t_cell(
     path: &Path,
     row: usize,
-) -> Result<(String, u64, usize, NamedSource<String>, miette::SourceSpan), RecordingError> {
+) -> Result<(String, u64, usize, Excerpt, miette::SourceSpan), RecordingError> {
     let file = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| io_error(path, e))?;
     let start = row_start(&bytes, row);
@@ -96,8 +96,7 @@ fn t_cell(
         .position(|&b| b == b',' || b == b'\n' || b == b'\r')
         .unwrap_or(1)
         .max(1);
-    let span = lossy_span(&bytes, offset, offset + len);
-    let src = NamedSource::new(file.clone(), String::from_utf8_lossy(&bytes).into_owned());
+    let (src, span) = Excerpt::around(&file, &bytes, offset, offset + len);
     Ok((file, line, column, src, span))
 }
 
@@ -160,8 +159,8 @@ pub(super) fn check_segments(
             t_end: seg.t_end,
             problem,
             help,
-            src: NamedSource::new(file, text.to_string()),
-            span: (offset, len).into(),
+            src: Excerpt::around(file, text.as_bytes(), offset, offset + len).0,
+            span: Excerpt::around(file, text.as_bytes(), offset, offset + len).1,
         };
         if !(seg.t_start.is_finite() && seg.t_end.is_finite()) || seg.t_end <= seg.t_start {
             return Err(outside(
@@ -183,8 +182,8 @@ pub(super) fn check_segments(
                 id: seg.id.clone(),
                 t_start: seg.t_start,
                 t_end: seg.t_end,
-                src: NamedSource::new(file, text.to_string()),
-                span: (offset, len).into(),
+                src: Excerpt::around(file, text.as_bytes(), offset, offset + len).0,
+                span: Excerpt::around(file, text.as_bytes(), offset, offset + len).1,
             });
         }
     }

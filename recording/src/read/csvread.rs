@@ -5,7 +5,7 @@
 #![allow(clippy::result_large_err)]
 
 use crate::error::{RecordingError, empty_stream, line_col_bytes};
-use miette::{NamedSource, SourceSpan};
+use crate::excerpt::{Excerpt, short};
 use std::ops::Range;
 
 /// Columns of one CSV file, in the order they were asked for; `None` for an absent
@@ -42,7 +42,7 @@ pub(crate) fn read_rows(
         .flexible(true)
         .from_reader(bytes);
     let mut rec = csv::ByteRecord::new();
-    let src = || NamedSource::new(file, String::from_utf8_lossy(bytes).into_owned());
+    let src = |start: usize, end: usize| Excerpt::around(file, bytes, start, end);
     let header_ok = rdr.read_byte_record(&mut rec).map_err(|e| io(file, e))?;
     if !header_ok {
         return Err(empty_stream(file, bytes));
@@ -57,13 +57,14 @@ pub(crate) fn read_rows(
         match names.iter().position(|n| n == c) {
             Some(i) => idx.push(Some(i)),
             None => {
+                let (src, span) = src(0, header_len);
                 return Err(RecordingError::MissingColumn {
                     file: file.to_string(),
                     column: c.to_string(),
                     required: required.join(", "),
-                    found: names.join(", "),
-                    src: src(),
-                    span: lossy_span(bytes, 0, header_len),
+                    found: short(&names.join(", "), 200),
+                    src,
+                    span,
                 });
             }
         }
@@ -102,13 +103,14 @@ pub(crate) fn read_rows(
                 .iter()
                 .position(|&b| b == b'\n' || b == b'\r')
                 .map_or(bytes.len(), |p| start + p);
+            let (src, span) = src(start, end);
             return Err(RecordingError::RaggedRow {
                 file: file.to_string(),
                 line: line_col_bytes(bytes, start).0,
                 found: rec.len(),
                 expected: width,
-                src: src(),
-                span: lossy_span(bytes, start, end),
+                src,
+                span,
             });
         }
         for (k, i) in idx.iter().enumerate() {
@@ -120,14 +122,15 @@ pub(crate) fn read_rows(
                     let start = record_start(bytes, pos);
                     let (offset, column) = cell_offset(bytes, start, i);
                     let end = (offset + cell.len().max(1)).min(bytes.len());
+                    let (src, span) = src(offset, end);
                     return Err(RecordingError::NotANumber {
                         file: file.to_string(),
                         line: line_col_bytes(bytes, start).0,
                         column,
-                        name: names[i].clone(),
-                        cell: String::from_utf8_lossy(cell).into_owned(),
-                        src: src(),
-                        span: lossy_span(bytes, offset, end),
+                        name: short(&names[i], 60),
+                        cell: short(&String::from_utf8_lossy(cell), 60),
+                        src,
+                        span,
                     });
                 }
             }
@@ -188,14 +191,6 @@ pub(crate) fn column_name(cell: &[u8]) -> String {
         .trim_start_matches('\u{feff}')
         .trim()
         .to_string()
-}
-
-/// The span of `bytes[start..end]` in the text the diagnostics show (`bytes` made valid
-/// UTF-8: an invalid byte there takes the three of U+FFFD).
-pub(crate) fn lossy_span(bytes: &[u8], start: usize, end: usize) -> SourceSpan {
-    let at = |o: usize| String::from_utf8_lossy(&bytes[..o.min(bytes.len())]).len();
-    let (s, e) = (at(start), at(end.max(start)));
-    (s, e - s).into()
 }
 
 /// Byte offset and 1-based character column of field `field` of the line starting at `start`.

@@ -25,6 +25,8 @@ pub(super) fn layout<S: Stream>(names: &[String], data_start: u64) -> Option<(La
 
 /// The header of `path` (names, where the data starts) and the file's length.
 pub(super) fn head(p: &Path) -> Result<(Vec<String>, u64, u64), RecordingError> {
+    // A FIFO or device is refused before it is opened (opening a FIFO blocks).
+    crate::files::regular(p).map_err(|e| io_error(p, e))?;
     let (names, start) = scan::header(p).map_err(|e| io_error(p, e))?;
     let len = std::fs::metadata(p).map_err(|e| io_error(p, e))?.len();
     Ok((names, start, len))

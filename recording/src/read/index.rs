@@ -175,6 +175,7 @@ fn fast_entries(
 /// The exact reader over the whole file (it is read once, whole: a file the fast path
 /// gives up on costs its size in memory at opening). Every cell is checked here.
 fn exact_index<S: Stream>(path: PathBuf, times: &mut Times) -> Result<StreamIndex, RecordingError> {
+    super::lines::refuse_long_lines(&path)?;
     let bytes = std::fs::read(&path).map_err(|e| io_error(&path, e))?;
     let file = path.display().to_string();
     let (mut row, mut next, mut marks) = (0usize, 0usize, Vec::new());

@@ -4,8 +4,8 @@
 #![allow(clippy::result_large_err)]
 
 use crate::error::{RecordingError, line_col, yaml_offset};
+use crate::excerpt::Excerpt;
 use crate::{FORMAT, Manifest};
-use miette::NamedSource;
 
 /// Parses manifest text (`file` names it in errors).
 pub fn parse_manifest(file: &str, text: &str) -> Result<Manifest, RecordingError> {
@@ -40,8 +40,8 @@ pub fn parse_manifest(file: &str, text: &str) -> Result<Manifest, RecordingError
             line,
             column,
             message,
-            src: NamedSource::new(file, text.to_string()),
-            span: (offset.min(text.len()), len).into(),
+            src: Excerpt::around(file, text.as_bytes(), offset, offset + len).0,
+            span: Excerpt::around(file, text.as_bytes(), offset, offset + len).1,
         }
     })?;
     if manifest.format != FORMAT {
@@ -55,8 +55,20 @@ pub fn parse_manifest(file: &str, text: &str) -> Result<Manifest, RecordingError
             line,
             column,
             found: manifest.format.clone(),
-            src: NamedSource::new(file, text.to_string()),
-            span: (offset, manifest.format.len().max(1)).into(),
+            src: Excerpt::around(
+                file,
+                text.as_bytes(),
+                offset,
+                offset + manifest.format.len().max(1),
+            )
+            .0,
+            span: Excerpt::around(
+                file,
+                text.as_bytes(),
+                offset,
+                offset + manifest.format.len().max(1),
+            )
+            .1,
         });
     }
     super::validate::manifest(file, text, &manifest)?;

@@ -7,6 +7,7 @@ mod check;
 mod csvread;
 mod fast;
 mod index;
+mod lines;
 mod manifest;
 mod number;
 mod scan;
@@ -62,6 +63,7 @@ pub fn read(dir: &Path) -> Result<Recording, RecordingError> {
 /// `dir/manifest.yaml`: its name as errors show it, its text, and the parsed manifest.
 fn read_manifest(dir: &Path) -> Result<(String, String, Manifest), RecordingError> {
     let path = dir.join("manifest.yaml");
+    crate::files::regular(&path).map_err(|e| io_error(&path, e))?;
     let bytes = std::fs::read(&path).map_err(|e| io_error(&path, e))?;
     let name = path.display().to_string();
     let text = String::from_utf8_lossy(&bytes).into_owned();
@@ -79,6 +81,7 @@ fn io_error(path: &Path, e: std::io::Error) -> RecordingError {
 /// The exact reader (csv crate), for what the fast path does not handle: it accepts
 /// quoted cells and locates every problem.
 fn exact<S: Stream>(path: &Path) -> Result<S, RecordingError> {
+    lines::refuse_long_lines(path)?;
     let bytes = std::fs::read(path).map_err(|e| io_error(path, e))?;
     let file = path.display().to_string();
     read_columns(&file, &bytes, S::REQUIRED, &[S::OPTIONAL]).map(S::from_columns)

@@ -162,6 +162,11 @@ pub(crate) fn scan_range<S: RowSink>(
             match buf[pos..filled].iter().rposition(|&b| b == b'\n') {
                 Some(p) => pos + p + 1,
                 None => {
+                    // A line far longer than a sample's: the exact reader refuses it,
+                    // located, without this buffer growing to the size of the file.
+                    if filled - pos > super::lines::MAX_LINE {
+                        return Err(GiveUp);
+                    }
                     // One line fills the buffer: grow it.
                     if pos > 0 {
                         buf.copy_within(pos..filled, 0);

@@ -6,8 +6,8 @@
 #![allow(clippy::result_large_err)]
 
 use crate::error::{RecordingError, line_col};
+use crate::excerpt::Excerpt;
 use crate::{Manifest, Mount};
-use miette::NamedSource;
 use ratecal_physics::{Mat3, check_rotation};
 
 /// Tolerance on unit vectors and on the orthonormality of a mount.
@@ -25,8 +25,8 @@ pub(crate) fn manifest(file: &str, text: &str, m: &Manifest) -> Result<(), Recor
             column,
             problem,
             help: help.to_string(),
-            src: NamedSource::new(file, text.to_string()),
-            span: (offset, len).into(),
+            src: Excerpt::around(file, text.as_bytes(), offset, offset + len).0,
+            span: Excerpt::around(file, text.as_bytes(), offset, offset + len).1,
         }
     };
     let station = text.find("station").unwrap_or(0);

@@ -81,8 +81,13 @@ impl End<'_> {
                 a.rule
             );
             outln!("  {}", a.values);
+            let upto = if self.at_rest() {
+                "the safe stop"
+            } else {
+                "the end of the safe stop's wait"
+            };
             outln!(
-                "the recording holds every sample up to the safe stop; continue with `ratecal run --resume {}`",
+                "the recording holds every sample up to {upto}; continue with `ratecal run --resume {}`",
                 dir.display()
             );
         }
@@ -96,13 +101,36 @@ impl End<'_> {
         }
         if let Err(e) = crate::cli::seal::write(dir, self.key) {
             errln!("cannot seal {}: {e}", dir.display());
+            self.warn_not_at_rest();
             return ExitCode::from(1);
         }
         outln!("sealed: {}", dir.join("seal.json").display());
+        self.warn_not_at_rest();
         match verdict {
             _ if aborted => ExitCode::from(4),
             Some(v) => crate::cli::analyze::exit_code(v),
             None => ExitCode::from(1),
+        }
+    }
+}
+
+impl End<'_> {
+    /// Whether the safe stop (if there was one) was seen to end at rest.
+    fn at_rest(&self) -> bool {
+        !self
+            .outcome
+            .warnings
+            .iter()
+            .any(|w| w.ends_with(ratecal_engine::run::NOT_AT_REST))
+    }
+
+    /// The last lines on the console when the table may still be moving: plain, on both
+    /// streams (a script may keep only one).
+    fn warn_not_at_rest(&self) {
+        if !self.at_rest() {
+            let line = format!("WARNING: {}", ratecal_engine::run::NOT_AT_REST);
+            outln!("{line}");
+            errln!("{line}");
         }
     }
 }

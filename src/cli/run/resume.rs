@@ -4,16 +4,17 @@
 //! seal: the rest of a run must follow what its start followed.
 
 use super::{Prepared, imports, setup};
+use crate::cli::lock::FolderLock;
 use miette::{Report, miette};
-use ratecal_engine::audit::seal::{SEAL_FILE, SEAL_HASH_FILE, verify_seal};
+use ratecal_engine::audit::seal::{SEAL_FILE, SEAL_HASH_FILE, verify_hashes};
 use ratecal_engine::recording::{
     Manifest, RecordingWriter, ResumeRecord, parse_manifest, rfc3339, sha256_hex,
 };
 use ratecal_engine::run::{RunOptions, resume_point};
 use std::path::Path;
 
-/// Prepares the rest of an interrupted run.
-pub fn prepare(dir: &Path) -> Result<Prepared, Report> {
+/// Prepares the rest of an interrupted run, holding the folder's lock.
+pub fn prepare(dir: &Path) -> Result<(Prepared, FolderLock), Report> {
     let io = |e: std::io::Error| {
         miette!(
             help = "--resume takes a run folder written by `ratecal run`",
@@ -21,6 +22,11 @@ pub fn prepare(dir: &Path) -> Result<Prepared, Report> {
             dir.display()
         )
     };
+    if !dir.is_dir() {
+        return Err(io(std::io::ErrorKind::NotFound.into()));
+    }
+    // Taken before the folder's state is read: a second resume is refused, not interleaved.
+    let lock = crate::cli::lock::acquire(dir, &crate::cli::seal::command_line())?;
     let journal = std::fs::read_to_string(dir.join("journal.jsonl")).map_err(io)?;
     let point = resume_point(&journal);
     if point.completed {
@@ -89,14 +95,15 @@ pub fn prepare(dir: &Path) -> Result<Prepared, Report> {
         t_offset: last_t.map_or(0.0, |t| t + 1.0),
         ..RunOptions::default()
     };
-    Ok(Prepared {
+    let prep = Prepared {
         dir: dir.to_path_buf(),
         plan: pr.plan,
         station: st.station,
         writer,
         opts,
         seed,
-    })
+    };
+    Ok((prep, lock))
 }
 
 /// A sealed folder (an aborted run is sealed) must still match its seal.
@@ -107,7 +114,7 @@ fn unaltered(dir: &Path) -> Result<(), Report> {
     let hash = std::fs::read_to_string(dir.join(SEAL_HASH_FILE)).ok();
     let files = crate::cli::seal::folder_files(dir)
         .map_err(|e| miette!("cannot read {}: {e}", dir.display()))?;
-    let report = verify_seal(Some(&seal), hash.as_deref(), &files, None);
+    let report = verify_hashes(Some(&seal), hash.as_deref(), &files, None);
     if report.intact() {
         return Ok(());
     }

@@ -1,0 +1,199 @@
+//! A folder's files as the seal, `verify` and the archive see them, read the same way by
+//! each: symlinks are followed everywhere (the content counts, not the link), every file is
+//! hashed streaming (memory flat in its size), and an entry that cannot be read as a
+//! regular file (a dangling symlink, a symlink loop, a FIFO, a socket, a device) is named
+//! with why, never opened (opening a FIFO would block).
+
+use sha2::{Digest, Sha256};
+use std::collections::{BTreeMap, BTreeSet};
+use std::io::{self, Read};
+use std::path::{Path, PathBuf};
+
+/// One entry of a folder: its content's hash, or why it cannot be read.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum FileState {
+    /// A regular file (or a symlink to one): lowercase hex SHA-256 and size in bytes.
+    Hashed {
+        /// SHA-256, lowercase hex.
+        sha256: String,
+        /// Bytes.
+        size: u64,
+    },
+    /// Not readable as a regular file: why (`a dangling symlink`, `a FIFO`...).
+    Unreadable(String),
+}
+
+/// Streaming SHA-256 and size of a regular file (a symlink is followed); refuses anything
+/// else without opening it.
+pub fn sha256_file(path: &Path) -> io::Result<(String, u64)> {
+    regular(path)?;
+    let mut f = std::fs::File::open(path)?;
+    let mut hasher = Sha256::new();
+    let mut buf = vec![0u8; 256 * 1024];
+    let mut size = 0u64;
+    loop {
+        let n = match f.read(&mut buf) {
+            Ok(0) => break,
+            Ok(n) => n,
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(e),
+        };
+        hasher.update(&buf[..n]);
+        size += n as u64;
+    }
+    Ok((hex::encode(hasher.finalize()), size))
+}
+
+/// `Ok` when `path` is (or a symlink leads to) a regular file; otherwise an error saying
+/// what it is instead (kind `InvalidInput` for a FIFO, socket or device).
+pub fn regular(path: &Path) -> io::Result<()> {
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_file() => Ok(()),
+        Ok(m) => Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!("not a regular file ({})", kind_of(&m)),
+        )),
+        Err(e) => Err(io::Error::new(e.kind(), why_unreadable(path, &e))),
+    }
+}
+
+/// Every file under `dir` by `/`-separated relative path, symlinks followed, each hashed
+/// streaming; `skip` leaves out names (relative paths) that are not part of the folder's
+/// content. Errs only when `dir` itself cannot be listed.
+pub fn hash_folder(
+    dir: &Path,
+    skip: impl Fn(&str) -> bool,
+) -> io::Result<BTreeMap<String, FileState>> {
+    let mut out = BTreeMap::new();
+    let mut seen = BTreeSet::new();
+    seen.insert(dir.canonicalize()?);
+    let mut stack: Vec<PathBuf> = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        let mut entries: Vec<PathBuf> = std::fs::read_dir(&d)?
+            .map(|e| e.map(|e| e.path()))
+            .collect::<io::Result<_>>()?;
+        entries.sort();
+        for path in entries {
+            let rel = path.strip_prefix(dir).unwrap_or(&path);
+            let name = rel
+                .components()
+                .map(|c| c.as_os_str().to_string_lossy().into_owned())
+                .collect::<Vec<_>>()
+                .join("/");
+            if skip(&name) {
+                continue;
+            }
+            let state = match std::fs::metadata(&path) {
+                Ok(m) if m.is_dir() => {
+                    // A symlink back to a folder already walked would never end.
+                    match path.canonicalize() {
+                        Ok(c) if seen.insert(c.clone()) => {
+                            stack.push(path);
+                            continue;
+                        }
+                        Ok(_) => {
+                            FileState::Unreadable("a symlink loop (a folder seen already)".into())
+                        }
+                        Err(e) => FileState::Unreadable(e.to_string()),
+                    }
+                }
+                Ok(m) if m.is_file() => match sha256_file(&path) {
+                    Ok((sha256, size)) => FileState::Hashed { sha256, size },
+                    Err(e) => FileState::Unreadable(e.to_string()),
+                },
+                Ok(m) => FileState::Unreadable(format!("not a regular file ({})", kind_of(&m))),
+                Err(e) => FileState::Unreadable(why_unreadable(&path, &e)),
+            };
+            out.insert(name, state);
+        }
+    }
+    Ok(out)
+}
+
+/// Why `path` cannot be read, in words: a dangling symlink, a loop, or the OS's message.
+fn why_unreadable(path: &Path, e: &io::Error) -> String {
+    let link = std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink());
+    if link && e.kind() == io::ErrorKind::NotFound {
+        let to = std::fs::read_link(path)
+            .map(|t| t.display().to_string())
+            .unwrap_or_default();
+        return format!("a dangling symlink (to {to})");
+    }
+    if link && e.raw_os_error() == Some(ELOOP) {
+        return "a symlink loop".into();
+    }
+    e.to_string()
+}
+
+/// ELOOP on Linux (and most Unix systems but the BSDs, where it is 62).
+#[cfg(any(
+    target_os = "macos",
+    target_os = "freebsd",
+    target_os = "openbsd",
+    target_os = "netbsd"
+))]
+const ELOOP: i32 = 62;
+#[cfg(not(any(
+    target_os = "macos",
+    target_os = "freebsd",
+    target_os = "openbsd",
+    target_os = "netbsd"
+)))]
+const ELOOP: i32 = 40;
+
+/// What a non-regular, non-folder entry is.
+fn kind_of(m: &std::fs::Metadata) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let t = m.file_type();
+        if t.is_fifo() {
+            return "a FIFO";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+        if t.is_block_device() || t.is_char_device() {
+            return "a device";
+        }
+    }
+    if m.is_dir() {
+        "a folder"
+    } else {
+        "a special file"
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hashes_stream_and_follow_symlinks() {
+        let tmp = tempfile::tempdir().unwrap();
+        let d = tmp.path();
+        std::fs::write(d.join("a.csv"), b"abc").unwrap();
+        let big = vec![7u8; 600_000];
+        std::fs::write(d.join("big"), &big).unwrap();
+        let (sha, n) = sha256_file(&d.join("big")).unwrap();
+        assert_eq!((sha, n), (crate::sha256_hex(&big), 600_000));
+        #[cfg(unix)]
+        {
+            std::os::unix::fs::symlink(d.join("a.csv"), d.join("link.csv")).unwrap();
+            std::os::unix::fs::symlink(d.join("gone"), d.join("dangling")).unwrap();
+            std::os::unix::fs::symlink(d.join("loop"), d.join("loop")).unwrap();
+            let f = hash_folder(d, |_| false).unwrap();
+            assert_eq!(f["link.csv"], f["a.csv"]);
+            let why = |k: &str| match &f[k] {
+                FileState::Unreadable(w) => w.clone(),
+                s => panic!("{k}: {s:?}"),
+            };
+            assert!(
+                why("dangling").contains("dangling symlink"),
+                "{}",
+                why("dangling")
+            );
+            assert!(why("loop").contains("symlink loop"), "{}", why("loop"));
+        }
+    }
+}
