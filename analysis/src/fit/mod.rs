@@ -249,13 +249,11 @@ pub fn analyze_source<S: Source>(
 pub(crate) fn accumulate_all<S: Source>(src: &S, layout: &Layout) -> Result<Vec<SegAcc>, S::Error> {
     use rayon::prelude::*;
     let m = src.manifest();
-    let geos = prep::geometries(m);
-    let rate_hz = mean_rate(src);
-    let t_ref_c = if layout.effects.iter().any(|e| e.uses_temperature()) {
-        src.mean_temp()?
-    } else {
-        0.0
-    };
+    let Context {
+        geos,
+        rate_hz,
+        t_ref_c,
+    } = Context::of(src, layout)?;
     let mut jobs = Vec::new();
     for (i, seg) in m.segments.iter().enumerate() {
         let rows = (seg.t_end - seg.t_start) * rate_hz;
@@ -310,6 +308,30 @@ pub(crate) fn accumulate_all<S: Source>(src: &S, layout: &Layout) -> Result<Vec<
     Ok(accs)
 }
 
+/// What every segment's pass shares: the station geometry per segment, the recording's mean
+/// IMU rate, and the temperature the thermal terms refer to (the recording's mean, read only
+/// when a term of `layout` uses it).
+struct Context {
+    geos: Vec<ratecal_physics::Geometry>,
+    rate_hz: f64,
+    t_ref_c: f64,
+}
+
+impl Context {
+    fn of<S: Source>(src: &S, layout: &Layout) -> Result<Context, S::Error> {
+        let t_ref_c = if layout.effects.iter().any(|e| e.uses_temperature()) {
+            src.mean_temp()?
+        } else {
+            0.0
+        };
+        Ok(Context {
+            geos: prep::geometries(src.manifest()),
+            rate_hz: mean_rate(src),
+            t_ref_c,
+        })
+    }
+}
+
 /// Rows of one piece of a long segment in [`accumulate_all`].
 const PIECE_ROWS: usize = 65_536;
 
@@ -326,13 +348,11 @@ fn pass_segments<S: Source>(
 ) -> Result<(Vec<Summary>, Vec<SegAcc>), S::Error> {
     use rayon::prelude::*;
     let m = src.manifest();
-    let geos = prep::geometries(m);
-    let rate_hz = mean_rate(src);
-    let t_ref_c = if layout.effects.iter().any(|e| e.uses_temperature()) {
-        src.mean_temp()?
-    } else {
-        0.0
-    };
+    let Context {
+        geos,
+        rate_hz,
+        t_ref_c,
+    } = Context::of(src, layout)?;
     let dur = |i: usize| m.segments[i].t_end - m.segments[i].t_start;
     let mut order: Vec<usize> = (0..m.segments.len()).collect();
     order.sort_by(|a, b| dur(*b).total_cmp(&dur(*a)));
