@@ -138,6 +138,11 @@ impl Data {
         m
     }
 
+    /// The probe behind layout effect `e`, if it is one.
+    pub(crate) fn probe(&self, e: usize) -> Option<&'static Probe> {
+        self.probes.iter().find(|q| q.0 == e).map(|q| q.1)
+    }
+
     /// The fitted (not held-out) accumulations.
     pub(crate) fn working(&self) -> Vec<usize> {
         (0..self.accs.len())

@@ -250,13 +250,11 @@ pub(crate) fn add_steps(
     };
     let mut added = Vec::new();
     let mut effects = layout.effects.clone();
-    let mut steps = Vec::new();
     for &at in &instants {
         for sensor in [Sensor::Accel, Sensor::Gyro] {
             let p = Probe::new(sensor, Form::Step { at });
             added.push((effects.len(), p));
             effects.push(p as &dyn Effect);
-            steps.push((sensor, at));
         }
     }
     let old = layout.clone();
@@ -264,7 +262,7 @@ pub(crate) fn add_steps(
     for (i, acc) in accs.iter_mut().enumerate() {
         let t = starts[i].0;
         for c in 0..6 {
-            let sensor = if c < 3 { Sensor::Accel } else { Sensor::Gyro };
+            // Every sensor has a step at each instant, in order: the channel's new columns.
             // The bias column of this channel's own axis.
             let base = if c < 3 { ba + c } else { bg + c - 3 };
             let k_old = old.by_channel[c].len();
@@ -279,13 +277,7 @@ pub(crate) fn add_steps(
                 }
                 m[(row, k_new)] = r[(row, k_old)];
             }
-            let mut extra = Vec::new();
-            for (s, at) in &steps {
-                if *s == sensor {
-                    extra.push(*at);
-                }
-            }
-            for (j, at) in extra.iter().enumerate() {
+            for (j, at) in instants.iter().enumerate() {
                 if t > *at
                     && let Some(lb) = local_bias
                 {
@@ -300,7 +292,7 @@ pub(crate) fn add_steps(
             acc.r[c] = m;
             for b in &mut acc.blocks {
                 let bias_sum = local_bias.map_or(0.0, |lb| b.sx[c][lb]);
-                for at in &extra {
+                for at in &instants {
                     b.sx[c].push(if t > *at { bias_sum } else { 0.0 });
                 }
             }

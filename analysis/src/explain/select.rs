@@ -116,7 +116,6 @@ pub(crate) struct Refused {
 /// The score and fit of one probe added to a model.
 struct ProbeTry {
     probe: usize,
-    fit: Fit,
     chi2: f64,
     dof: usize,
     score: f64,
@@ -138,7 +137,6 @@ fn try_probes(data: &Data, terms: &Terms, work: &[usize], n: usize) -> Vec<Probe
             let (chi2, dof) = wald(&f, &cols);
             ProbeTry {
                 probe: e,
-                fit: f,
                 chi2,
                 dof,
                 score: score(chi2, dof, n),
@@ -175,6 +173,54 @@ fn mimics(data: &Data, terms: &Terms, e: usize, probes: &[usize], a: f64, a_prob
         );
     }
     p_value(c1, d1) >= a && probe_left
+}
+
+/// Why the winner `e` (fitted in `fit_e`) is not to be reported, if it is not: physics held
+/// to physics (a fit outside the plausible range is not that effect), and a probe that
+/// explains what the winner explains, and more, takes precedence (the strongest probes on
+/// its sensors, tried together).
+fn refusal(
+    data: &Data,
+    terms: &Terms,
+    n: usize,
+    e: usize,
+    fit_e: &Fit,
+    a: f64,
+    alpha: f64,
+) -> Option<String> {
+    if let Err(why) = plausible(data, fit_e, e) {
+        return Some(why);
+    }
+    let lay = &data.layout;
+    let work = data.working();
+    let probes = try_probes(data, terms, &work, n);
+    let a_probe = alpha / data.probes.len().max(1) as f64;
+    let sensors = lay.effects[e].sensors();
+    let rivals: Vec<usize> = probes
+        .iter()
+        .filter(|pt| {
+            pt.dof > 0
+                && p_value(pt.chi2, pt.dof) < a_probe
+                && lay.effects[pt.probe]
+                    .sensors()
+                    .iter()
+                    .any(|s| sensors.contains(s))
+        })
+        .take(3)
+        .map(|pt| pt.probe)
+        .collect();
+    if rivals.is_empty() || !mimics(data, terms, e, &rivals, a, a_probe) {
+        return None;
+    }
+    let strongest = rivals[0];
+    let expr = data
+        .probe(strongest)
+        .map(|q| q.expression(0))
+        .unwrap_or_default();
+    Some(format!(
+        "a form outside the registry ({expr}, on the {}) explains the same residual and more",
+        lay.effects[strongest].sensors()[0].name()
+    ))
 }
 
 /// The result of the selection.
@@ -302,61 +348,8 @@ pub(crate) fn forward(data: &Data, start: &Terms, alpha: f64, without: &[String]
         }
         let e = tried[b].0;
         let id = lay.effects[e].id().to_string();
-        // Physics held to physics: a fit outside the plausible range is not that effect.
-        if let Err(why) = plausible(data, &tried[b].1, e) {
-            refused.push(Refused {
-                effect: id.clone(),
-                reason: why,
-            });
-            candidates.retain(|x| *x != e);
-            base_cache = Some((base, base_hold));
-            if candidates.is_empty() {
-                break;
-            }
-            continue;
-        }
-        // A probe that explains what the candidate explains, and more, takes precedence:
-        // the strongest probes on the candidate's sensors, tried together.
-        let probes = try_probes(data, &terms, &work, n);
-        let a_probe = alpha / data.probes.len().max(1) as f64;
-        let sensors = lay.effects[e].sensors();
-        let rivals: Vec<&ProbeTry> = probes
-            .iter()
-            .filter(|pt| {
-                pt.dof > 0
-                    && p_value(pt.chi2, pt.dof) < a_probe
-                    && lay.effects[pt.probe]
-                        .sensors()
-                        .iter()
-                        .any(|s| sensors.contains(s))
-            })
-            .take(3)
-            .collect();
-        let mimicked = (!rivals.is_empty()
-            && mimics(
-                data,
-                &terms,
-                e,
-                &rivals.iter().map(|r| r.probe).collect::<Vec<_>>(),
-                a,
-                a_probe,
-            ))
-        .then(|| rivals[0]);
-        if let Some(pt) = mimicked {
-            let expr = data
-                .probes
-                .iter()
-                .find(|q| q.0 == pt.probe)
-                .map(|q| q.1.expression(0))
-                .unwrap_or_default();
-            refused.push(Refused {
-                effect: id.clone(),
-                reason: format!(
-                    "a form outside the registry ({expr}, on the {}) explains the same residual and more",
-                    lay.effects[pt.probe].sensors()[0].name()
-                ),
-            });
-            let _ = &pt.fit;
+        if let Some(reason) = refusal(data, &terms, n, e, &tried[b].1, a, alpha) {
+            refused.push(Refused { effect: id, reason });
             candidates.retain(|x| *x != e);
             base_cache = Some((base, base_hold));
             if candidates.is_empty() {

@@ -117,8 +117,9 @@ pub(crate) fn leftover(m: &Manifest, data: &Data, terms: &Terms, alpha: f64) -> 
                 continue;
             }
             for (t, d) in drops {
-                let probe = data.probes.iter().find(|q| q.0 == t.probe).map(|q| q.1);
-                let Some(probe) = probe else { continue };
+                let Some(probe) = data.probe(t.probe) else {
+                    continue;
+                };
                 let share = (d / top).clamp(0.0, 1.0);
                 if share < 0.05 {
                     continue;
@@ -147,7 +148,7 @@ pub(crate) fn leftover(m: &Manifest, data: &Data, terms: &Terms, alpha: f64) -> 
             .expect("non-empty");
         let bf = &fits[best.fit];
         let mut segs: Vec<(f64, String)> = Vec::new();
-        for (i, acc) in data.accs.iter().enumerate() {
+        for acc in &data.accs {
             let mut d = 0.0;
             for &c in &channels {
                 let sigma = base.noise[c].sigma.max(1e-300);
@@ -155,7 +156,6 @@ pub(crate) fn leftover(m: &Manifest, data: &Data, terms: &Terms, alpha: f64) -> 
                     / (sigma * sigma);
             }
             if d >= 9.0 {
-                let _ = i;
                 segs.push((d, m.segments[acc.seg].id.clone()));
             }
         }
