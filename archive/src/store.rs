@@ -160,11 +160,12 @@ fn abandoned(path: &Path) -> bool {
     old || gone
 }
 
-/// Writes into `tmp/`, syncs, then renames into place: the name appears only when whole.
-fn put_file(root: &Path, sha: &str, bytes: &[u8]) -> Result<()> {
+/// Where a file of hash `sha` goes and the `tmp/` name to write it under first; `None`
+/// when the store holds it already.
+fn staging(root: &Path, sha: &str) -> Result<Option<(PathBuf, PathBuf)>> {
     let dest = Store::path(root, sha);
     if dest.is_file() {
-        return Ok(());
+        return Ok(None);
     }
     let tmp_dir = root.join(TMP);
     let io = |p: &Path, e| ArchiveError::io(p, e);
@@ -175,6 +176,15 @@ fn put_file(root: &Path, sha: &str, bytes: &[u8]) -> Result<()> {
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0, |d| d.subsec_nanos());
     let tmp = tmp_dir.join(format!("{sha}.{}.{nanos}", std::process::id()));
+    Ok(Some((dest, tmp)))
+}
+
+/// Writes into `tmp/`, syncs, then renames into place: the name appears only when whole.
+fn put_file(root: &Path, sha: &str, bytes: &[u8]) -> Result<()> {
+    let Some((dest, tmp)) = staging(root, sha)? else {
+        return Ok(());
+    };
+    let io = |p: &Path, e| ArchiveError::io(p, e);
     let mut f = std::fs::File::create(&tmp).map_err(|e| io(&tmp, e))?;
     f.write_all(bytes).map_err(|e| io(&tmp, e))?;
     f.sync_all().map_err(|e| io(&tmp, e))?;
@@ -187,19 +197,10 @@ fn put_file(root: &Path, sha: &str, bytes: &[u8]) -> Result<()> {
 fn copy_file(root: &Path, sha: &str, src: &Path) -> Result<bool> {
     use sha2::{Digest, Sha256};
     use std::io::Read;
-    let dest = Store::path(root, sha);
-    if dest.is_file() {
+    let Some((dest, tmp)) = staging(root, sha)? else {
         return Ok(true);
-    }
-    let tmp_dir = root.join(TMP);
+    };
     let io = |p: &Path, e| ArchiveError::io(p, e);
-    std::fs::create_dir_all(&tmp_dir).map_err(|e| io(&tmp_dir, e))?;
-    let parent = dest.parent().unwrap_or(root);
-    std::fs::create_dir_all(parent).map_err(|e| io(parent, e))?;
-    let nanos = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.subsec_nanos());
-    let tmp = tmp_dir.join(format!("{sha}.{}.{nanos}", std::process::id()));
     ratecal_engine::recording::regular(src).map_err(|e| io(src, e))?;
     let mut from = std::fs::File::open(src).map_err(|e| io(src, e))?;
     let mut to = std::fs::File::create(&tmp).map_err(|e| io(&tmp, e))?;
