@@ -72,20 +72,25 @@ struct Seen {
     analyze_code: i32,
 }
 
-fn run_scenario(name: &'static str, faults: &str, pty: bool, interrupt_at: Option<f64>) -> Seen {
-    let tmp = tempfile::tempdir().unwrap();
-    let (_emu, conn) = emulate(tmp.path(), faults, pty);
-    let out = tmp.path().join("run");
-    let child = Command::new(BIN)
+/// `ratecal run procedures/station-check --station CONN --out OUT`, its output piped.
+fn spawn_station_check(conn: &Path, out: &Path) -> Child {
+    Command::new(BIN)
         .args(["run", "procedures/station-check", "--station"])
-        .arg(&conn)
+        .arg(conn)
         .arg("--out")
-        .arg(&out)
+        .arg(out)
         .current_dir(repo())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
-        .unwrap();
+        .unwrap()
+}
+
+fn run_scenario(name: &'static str, faults: &str, pty: bool, interrupt_at: Option<f64>) -> Seen {
+    let tmp = tempfile::tempdir().unwrap();
+    let (_emu, conn) = emulate(tmp.path(), faults, pty);
+    let out = tmp.path().join("run");
+    let child = spawn_station_check(&conn, &out);
     if let Some(t) = interrupt_at {
         std::thread::sleep(Duration::from_secs_f64(t));
         // Twice: the second Ctrl-C must not skip the safe stop, nor change the exit code.
@@ -326,16 +331,7 @@ fn a_refused_safe_stop_is_counted_and_printed_last() {
     let tmp = tempfile::tempdir().unwrap();
     let (emu, conn) = emulate(tmp.path(), "  []", false);
     let out = tmp.path().join("run");
-    let child = Command::new(BIN)
-        .args(["run", "procedures/station-check", "--station"])
-        .arg(&conn)
-        .arg("--out")
-        .arg(&out)
-        .current_dir(repo())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let child = spawn_station_check(&conn, &out);
     std::thread::sleep(Duration::from_secs(3));
     drop(emu); // killed: nothing answers any more
     let o = child.wait_with_output().unwrap();
