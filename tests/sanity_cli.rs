@@ -336,13 +336,7 @@ fn a_station_check_run_is_not_judged() {
 #[test]
 fn the_terminal_results_and_report_agree_on_the_warnings() {
     let tmp = tempfile::tempdir().unwrap();
-    // Asking 200 Hz of a 100 Hz IMU is a run-time warning.
-    let fast = MINI.replace(
-        "acquire gyro, table for 10 s at 100 Hz",
-        "acquire gyro, table for 10 s at 200 Hz",
-    );
-    std::fs::write(tmp.path().join("p.rcal"), fast).unwrap();
-    let o = ratecal(&["run", "p.rcal", "--dry-run", "--out", "r"], tmp.path());
+    let o = mini_too_fast_run(tmp.path(), "r");
     assert_eq!(code(&o), 0, "{}", text(&o));
     let dir = tmp.path().join("r");
     let warnings: Vec<String> = json(&dir.join("results.json"))["warnings"]

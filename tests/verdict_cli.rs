@@ -63,12 +63,7 @@ fn a_run_analysed_with_the_wrong_procedure_is_incomplete() {
 #[test]
 fn run_time_warnings_reach_the_terminal_and_the_report() {
     let tmp = tempfile::tempdir().unwrap();
-    let fast = MINI.replace(
-        "acquire gyro, table for 10 s at 100 Hz",
-        "acquire gyro, table for 10 s at 200 Hz",
-    );
-    std::fs::write(tmp.path().join("p.rcal"), fast).unwrap();
-    let o = ratecal(&["run", "p.rcal", "--dry-run", "--out", "r"], tmp.path());
+    let o = mini_too_fast_run(tmp.path(), "r");
     let journal = std::fs::read_to_string(tmp.path().join("r/journal.jsonl")).unwrap();
     let rule = journal
         .lines()

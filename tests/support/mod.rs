@@ -93,6 +93,17 @@ pub fn mini_run(dir: &Path, out: &str, extra: &[&str]) -> Output {
     ratecal(&args, dir)
 }
 
+/// Dry-runs MINI into `dir/out` with its acquisition asking 200 Hz of the 100 Hz IMU: a
+/// run-time warning.
+pub fn mini_too_fast_run(dir: &Path, out: &str) -> Output {
+    let fast = MINI.replace(
+        "acquire gyro, table for 10 s at 100 Hz",
+        "acquire gyro, table for 10 s at 200 Hz",
+    );
+    std::fs::write(dir.join("p.rcal"), fast).unwrap();
+    ratecal(&["run", "p.rcal", "--dry-run", "--out", out], dir)
+}
+
 /// `../shared/examples/<name>`, or `None` with a "skipped" line when this machine lacks it.
 pub fn shared_example(name: &str) -> Option<PathBuf> {
     shared::shared_example(name)
