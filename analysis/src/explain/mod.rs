@@ -264,18 +264,8 @@ fn finding(
         };
         parameters.insert(p.name.to_string(), out);
     }
-    if step.effect == data.earth {
-        // Replaced by the held Earth's parameters (earth::Held::parameters).
-    } else if let Some((lat, ulat)) = model::latitude(data, last, step.effect) {
-        parameters.insert(
-            "latitude_deg".into(),
-            ParamOut::Estimate {
-                value: lat,
-                u: ulat,
-                unit: "deg".into(),
-            },
-        );
-    }
+    // The Earth's rate is the only candidate with a latitude, and it is held: its
+    // parameters are replaced by the held ones (earth::Held::parameters).
     let all: Vec<usize> = (0..data.accs.len()).collect();
     let evidence = Evidence {
         chi2: step.chi2,

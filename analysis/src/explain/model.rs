@@ -3,7 +3,7 @@
 
 use super::data::Data;
 pub(crate) use crate::fit::joint::Terms;
-use crate::fit::joint::{Fit, fit_terms_merged, latitude_of, rss_on};
+use crate::fit::joint::{Fit, fit_terms_merged, rss_on};
 use crate::plan::Plan;
 use crate::recording::{Manifest, SegmentKind};
 use ratecal_physics::effects::EarthRate;
@@ -137,10 +137,4 @@ pub(crate) fn seed_segments(m: &Manifest, data: &Data) -> (Vec<usize>, Vec<usize
         .filter(|&i| kind(i) == SegmentKind::Rate || Some(i) == longest)
         .collect();
     (accel, gyro)
-}
-
-/// The latitude (deg, with its u) that a fit's Earth-rate components give, when the layout
-/// effect `e` is `earth_rate` and both components were estimated.
-pub(crate) fn latitude(data: &Data, fit: &Fit, e: usize) -> Option<(f64, f64)> {
-    latitude_of(&data.layout, fit, e)
 }
