@@ -47,6 +47,11 @@ pub struct Args {
     /// ratecal run folder they are written beside explain.json in any case).
     #[arg(long, value_name = "DIR")]
     plots: Option<PathBuf>,
+    /// Write each discovered finding as a draft effect file `DIR/<effect>.effect`, which
+    /// `--effects` reads unchanged (in a ratecal run folder they are written beside
+    /// explain.json in any case).
+    #[arg(long, value_name = "DIR")]
+    draft_effects: Option<PathBuf>,
 }
 
 /// The effect files named by `--effects` and `RATECAL_EFFECTS`: files as given, folders
@@ -174,7 +179,7 @@ pub fn main(args: Args) -> ExitCode {
     let ids: Vec<String> = x
         .findings
         .iter()
-        .filter(|f| f.defined_in.is_none())
+        .filter(|f| f.defined_in.is_none() && !f.discovered)
         .map(|f| f.effect.clone())
         .collect();
     if let Some(p) = &args.procedure
@@ -197,6 +202,27 @@ pub fn main(args: Args) -> ExitCode {
             )),
         }
     }
+    let in_run = rec.manifest().run.is_some();
+    let drafts: Vec<(String, String)> = x
+        .findings
+        .iter()
+        .filter_map(|f| {
+            let text = explain::draft::effect_file(f, &args.run.display().to_string())?;
+            Some((explain::draft::file_name(f), text))
+        })
+        .collect();
+    let draft_dir = args
+        .draft_effects
+        .clone()
+        .or(in_run.then(|| args.run.clone()));
+    if let Some(dir) = &draft_dir {
+        for (f, (name, _)) in x.findings.iter().filter(|f| f.discovered).zip(&drafts) {
+            x.draft_effects.push(explain::UserEffectOut {
+                effect: f.effect.clone(),
+                file: dir.join(name).display().to_string(),
+            });
+        }
+    }
     let json = serde_json::to_string_pretty(&x).expect("plain data serializes");
     let figures: Vec<(String, String)> =
         render::explain_figures(&serde_json::to_value(&x).expect("plain data serializes"))
@@ -204,9 +230,9 @@ pub fn main(args: Args) -> ExitCode {
             .filter_map(|(effect, svg)| Some((format!("explain-{effect}.svg"), svg?)))
             .collect();
     // Kept in a ratecal run folder (not in another system's recording): its report shows it.
-    let in_run = rec.manifest().run.is_some();
     if in_run {
         let mut files = vec![("explain.json".to_string(), format!("{json}\n"))];
+        files.extend(drafts.iter().cloned());
         files.extend(
             figures
                 .iter()
@@ -231,6 +257,21 @@ pub fn main(args: Args) -> ExitCode {
         }
         for (name, _) in &files {
             eprintln!("figure: {}", dir.join(name).display());
+        }
+    }
+    if let Some(dir) = &args.draft_effects
+        && !(in_run && same_dir(dir, &args.run))
+        && !drafts.is_empty()
+    {
+        if let Err(e) = write(dir, &drafts, false) {
+            eprintln!(
+                "error: cannot write the draft effect files into {}: {e}",
+                dir.display()
+            );
+            return ExitCode::from(2);
+        }
+        for (name, _) in &drafts {
+            eprintln!("draft effect: {}", dir.join(name).display());
         }
     }
     let out = match args.format {

@@ -58,7 +58,8 @@ impl Data {
         let earth = effects.len();
         candidates.push(earth);
         effects.push(&EARTH_HELD);
-        let sampled = probe::sampled(t0);
+        let t1 = segs.iter().map(|s| s.t_end).fold(t0, f64::max);
+        let sampled = probe::sampled(t0, t1 - t0);
         let mut probes: Vec<(usize, &'static Probe)> = Vec::new();
         for p in sampled {
             probes.push((effects.len(), p));
@@ -70,7 +71,8 @@ impl Data {
             .iter()
             .map(|a| (segs[a.seg].t_start, segs[a.seg].t_end))
             .collect();
-        probes.extend(probe::add_steps(&mut layout, &mut accs, &spans));
+        let g = src.manifest().station.site.gravity_mps2;
+        probes.extend(probe::add_steps(&mut layout, &mut accs, &spans, g));
         let longest = accs
             .iter()
             .enumerate()

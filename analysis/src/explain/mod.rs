@@ -13,6 +13,9 @@
 
 mod adopt;
 pub(crate) mod data;
+mod discover;
+mod discovered;
+pub mod draft;
 mod earth;
 mod locate;
 pub(crate) mod model;
@@ -28,7 +31,7 @@ pub use adopt::{AdoptTarget, Adoption, adoption, next_version};
 pub use model::NominalModel;
 pub use output::{
     Evidence, Explanation, FORMAT, Final, Finding, Located, Nominal, ParamOut, RefusedOut, Rms,
-    SegmentRms, Signature, Unexplained, UserEffectOut,
+    SegmentRms, Signature, Term, Unexplained, UserEffectOut,
 };
 pub use text::render_text;
 pub use user::UserEffect;
@@ -154,9 +157,35 @@ pub fn explain_source<S: Source>(
         terms.effects.push(step.effect);
     }
     let latitude = m.station.site.latitude_deg;
-    let held = earth::hold(&data, &mut terms, latitude);
+    let free_earth = terms.clone();
+    let mut held = earth::hold(&data, &mut terms, latitude);
+    // What the registry left: forms of the probe library, found one at a time.
+    let registry_terms = terms.clone();
+    let discoveries = discover::discover(&data, &mut terms, opts.alpha);
+    if held.is_some() && !discoveries.is_empty() {
+        // The Earth's rate held again beside what was found: a scale that looked off (the
+        // gyros' g^2 sensitivity follows the attitude too) may have been the discovery's.
+        let mut t = free_earth;
+        t.effects.extend(
+            terms
+                .effects
+                .iter()
+                .filter(|e| !registry_terms.effects.contains(e)),
+        );
+        t.skip.extend(
+            terms
+                .skip
+                .iter()
+                .filter(|g| !registry_terms.skip.contains(g)),
+        );
+        held = earth::hold(&data, &mut t, latitude);
+        terms = t;
+    }
+    if debug {
+        eprintln!("discovered in {:?}", clock.elapsed());
+    }
     let whole = fit(&data, &terms, &all, &all);
-    let findings: Vec<Finding> = steps
+    let mut findings: Vec<Finding> = steps
         .iter()
         .map(|step| {
             let mut f = finding(m, &data, step, &terms, &whole);
@@ -173,6 +202,12 @@ pub fn explain_source<S: Source>(
             f
         })
         .collect();
+    findings.extend(
+        discoveries
+            .iter()
+            .map(|d| discovered::finding(m, &data, d, &registry_terms, &whole.0)),
+    );
+    let last = discoveries.last().map_or(last, |d| d.step.after.clone());
     let mut unexplained = unexplained::leftover(m, &data, &terms, opts.alpha);
     if debug {
         eprintln!("leftover tested in {:?}", clock.elapsed());
@@ -196,7 +231,7 @@ pub fn explain_source<S: Source>(
     // Only the registry's effects can be declared in a procedure.
     let ids: Vec<&str> = findings
         .iter()
-        .filter(|f| f.defined_in.is_none())
+        .filter(|f| f.defined_in.is_none() && !f.discovered)
         .map(|f| f.effect.as_str())
         .collect();
     let adopt = (!ids.is_empty()).then(|| format!("with {}", ids.join(", ")));
@@ -223,6 +258,7 @@ pub fn explain_source<S: Source>(
         unexplained,
         adopt,
         adopt_diff: None,
+        draft_effects: Vec::new(),
         user_effects: opts
             .user
             .iter()
@@ -291,6 +327,8 @@ fn finding(
             .map(|&e| lay.effects[e].id().to_string())
             .collect(),
         station_side: fx.station_side(),
+        discovered: false,
+        terms: Vec::new(),
         separate_by: (!step.alternatives.is_empty()).then(|| {
             step.alternatives
                 .iter()

@@ -137,6 +137,30 @@ pub struct Finding {
     /// An error of the station (the table's encoders), not of the IMU.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub station_side: bool,
+    /// Whether the form was discovered in the probe library rather than taken from the
+    /// registry or an effect file.
+    #[serde(default)]
+    pub discovered: bool,
+    /// A discovered finding's terms, one per channel, in the user-effect language.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub terms: Vec<Term>,
+}
+
+/// One term of a discovered finding: `channel += value * expression`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Term {
+    /// Output channel (`ax` .. `gz`).
+    pub channel: String,
+    /// The regressor, in the user-effect expression language (docs/user-effects.md).
+    pub expression: String,
+    /// The coefficient.
+    pub value: f64,
+    /// Its standard uncertainty.
+    pub u: f64,
+    /// Its unit.
+    pub unit: String,
+    /// The motion that excites it.
+    pub needs: String,
 }
 
 /// One form a leftover follows.
@@ -240,6 +264,9 @@ pub struct Explanation {
     /// User effects tried besides the registry's.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub user_effects: Vec<UserEffectOut>,
+    /// Draft effect files of the discovered findings (`effect`, `file`), once written.
+    #[serde(default)]
+    pub draft_effects: Vec<UserEffectOut>,
     /// What could not be done as asked.
     pub warnings: Vec<String>,
 }
