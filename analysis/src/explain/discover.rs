@@ -12,8 +12,8 @@
 use super::data::Data;
 use super::model::{Terms, fit};
 use super::probe::{Form, Probe};
-use super::select::{Step, holdout_score, p_value, score, wald};
-use crate::fit::joint::{Fit, channel};
+use super::select::{Step, p_value, wald};
+use crate::fit::joint::{Fit, channel, seg_rss};
 use ratecal_physics::effects::Sensor;
 
 /// Most terms discovered in one recording.
@@ -56,100 +56,182 @@ pub(crate) fn live_columns(data: &Data) -> usize {
         .max(1)
 }
 
-/// A probe tried beside the model.
+/// A probe tried beside the model: each channel column's Wald statistic (is it there?)
+/// and the misfit it removes (how well does it explain?).
 struct Try {
     e: usize,
-    keep: Vec<usize>,
-    drop: Vec<usize>,
-    fit: Fit,
-    chi2: f64,
-    hold: f64,
+    /// (column, Wald chi2, drop of the channel's misfit in units of its white noise) of
+    /// every estimated column.
+    cols: Vec<(usize, f64, f64)>,
 }
 
-/// The significant columns of probe `e` beside `terms`, the refit with only those, and
-/// its held-out misfit; `None` when no column passes `a` (the per-test threshold).
-fn try_probe(data: &Data, terms: &Terms, e: usize, a: f64, base: &Fit) -> Option<Try> {
+/// Misfit of the held-out segments on `channels` under `f`, in units of `base`'s noise.
+fn held_misfit(data: &Data, f: &Fit, base: &Fit, channels: &[usize]) -> f64 {
+    channels
+        .iter()
+        .map(|&c| misfit(data, f, c, &data.held, base.noise[c].sigma))
+        .sum()
+}
+
+/// Misfit of channel `c` over `segs` under `f`, in units of the white noise `sigma`.
+fn misfit(data: &Data, f: &Fit, c: usize, segs: &[usize], sigma: f64) -> f64 {
+    let sigma = sigma.max(1e-300);
+    segs.iter()
+        .map(|&i| seg_rss(&data.accs[i], &data.layout, c, &f.theta))
+        .sum::<f64>()
+        / (sigma * sigma)
+}
+
+/// Probe `e` added to `terms` with all its channel columns (the channels' fits are
+/// separate, so each column's statistic is the one it has alone).
+fn try_probe(data: &Data, terms: &Terms, e: usize, base: &Fit) -> Try {
     let work = data.working();
     let mut t = terms.clone();
     t.effects.push(e);
     let (f, _) = fit(data, &t, &work, &work);
-    let (keep, drop): (Vec<usize>, Vec<usize>) = data
+    let cols = data
         .layout
         .columns_of(e)
-        .partition(|&g| f.estimated.contains(&g) && p_value(wald(&f, &[g]).0, 1) < a);
-    if keep.is_empty() {
-        return None;
-    }
-    t.skip.extend(drop.iter().copied());
-    let (f, _) = fit(data, &t, &work, &work);
-    let (chi2, _) = wald(&f, &keep);
-    let hold = holdout_score(data, &f, base);
-    Some(Try {
-        e,
-        keep,
-        drop,
-        fit: f,
-        chi2,
-        hold,
-    })
+        .filter(|g| f.estimated.contains(g))
+        .map(|g| {
+            let c = channel_of(data, g);
+            let sigma = base.noise[c].sigma;
+            let drop = misfit(data, base, c, &work, sigma) - misfit(data, &f, c, &work, sigma);
+            (g, wald(&f, &[g]).0, drop)
+        })
+        .collect();
+    Try { e, cols }
 }
+
+/// A channel cannot tell two forms apart when the misfits they leave differ by less than
+/// this (in units of the white noise): it then takes the form the strongest channel chose.
+const TIE: f64 = 10.0;
 
 /// Forward selection over the probe library from `terms` (the registry's final model),
 /// which grows by what is found; `alpha` is the family-wise threshold over the library.
+///
+/// Each round takes the (probe, channel) pair that removes most misfit among the
+/// significant ones; the same form joins
+/// it on every other channel where it is significant and removes as much as that channel's best
+/// form (within [`TIE`]), so a form the data cannot tell from another on some channel is
+/// not split across two readings.
 pub(crate) fn discover(data: &Data, terms: &mut Terms, alpha: f64) -> Vec<Discovery> {
     use rayon::prelude::*;
     let work = data.working();
     let n: usize = work.iter().map(|&i| 6 * data.accs[i].n).sum();
     let m = live_columns(data) as f64;
     let a = alpha / m;
+    let debug = std::env::var_os("RATECAL_EXPLAIN_DEBUG").is_some();
     let mut out: Vec<Discovery> = Vec::new();
     while out.len() < MOST {
         let (base, _) = fit(data, terms, &work, &work);
-        let base_hold = holdout_score(data, &base, &base);
         let short = super::probe::screen(data, terms, &work, SHORTLIST);
         let tries: Vec<Try> = short
             .par_iter()
-            .filter_map(|&e| try_probe(data, terms, e, a, &base))
-            .filter(|t| data.held.is_empty() || t.hold < base_hold)
+            .map(|&e| try_probe(data, terms, e, &base))
             .collect();
-        let Some(best) = tries.into_iter().max_by(|x, y| {
-            score(x.chi2, x.keep.len(), n).total_cmp(&score(y.chi2, y.keep.len(), n))
-        }) else {
+        let sig = |chi2: f64| p_value(chi2, 1) < a;
+        // Each channel's largest misfit drop by a significant column.
+        let mut best_of = [0.0f64; 6];
+        for t in &tries {
+            for &(g, chi2, drop) in &t.cols {
+                let c = channel_of(data, g);
+                if sig(chi2) {
+                    best_of[c] = best_of[c].max(drop);
+                }
+            }
+        }
+        // Candidates in order of the largest drop of a significant column.
+        let mut order: Vec<(usize, f64)> = tries
+            .iter()
+            .enumerate()
+            .filter_map(|(k, t)| {
+                t.cols
+                    .iter()
+                    .filter(|c| sig(c.1))
+                    .map(|c| c.2)
+                    .fold(None, |m: Option<f64>, d| Some(m.map_or(d, |m| m.max(d))))
+                    .map(|d| (k, d))
+            })
+            .collect();
+        order.sort_by(|x, y| y.1.total_cmp(&x.1));
+        let mut accepted = None;
+        for (k, _) in order {
+            let t = &tries[k];
+            let (keep, drop): (Vec<usize>, Vec<usize>) =
+                data.layout.columns_of(t.e).partition(|&g| {
+                    t.cols.iter().any(|&(h, chi2, drop)| {
+                        h == g && sig(chi2) && drop >= best_of[channel_of(data, g)] - TIE
+                    })
+                });
+            if keep.is_empty() {
+                continue;
+            }
+            let mut tt = terms.clone();
+            tt.effects.push(t.e);
+            tt.skip.extend(drop.iter().copied());
+            let (f, _) = fit(data, &tt, &work, &work);
+            let chans: Vec<usize> = keep.iter().map(|&g| channel_of(data, g)).collect();
+            let hold = held_misfit(data, &f, &base, &chans);
+            let base_hold = held_misfit(data, &base, &base, &chans);
+            if debug {
+                let p = data.probe(t.e).map(|p| p.expression(0)).unwrap_or_default();
+                eprintln!(
+                    "discover {}: {p} on {keep:?}: chi2 {:?} hold {hold:.1} (base {base_hold:.1})",
+                    out.len(),
+                    t.cols
+                );
+            }
+            if !data.held.is_empty() && hold >= base_hold {
+                continue;
+            }
+            let (chi2, _) = wald(&f, &keep);
+            accepted = Some((t.e, keep, drop, f, chi2));
+            break;
+        }
+        let Some((e, keep, drop, after, chi2)) = accepted else {
             break;
         };
-        let probe = data.probe(best.e).expect("a probe");
-        terms.effects.push(best.e);
-        terms.skip.extend(best.drop.iter().copied());
+        let _ = n;
+        let probe = data.probe(e).expect("a probe");
+        terms.effects.push(e);
+        terms.skip.extend(drop.iter().copied());
         let tau = match probe.form {
-            Form::Decay { .. } => refine_tau(data, terms, &best, probe),
+            Form::Decay { .. } => refine_tau(data, terms, e, &keep, probe),
             _ => None,
         };
-        let dof = best.keep.len();
+        let dof = keep.len();
         out.push(Discovery {
             step: Step {
-                effect: best.e,
+                effect: e,
                 before: base,
-                after: best.fit,
-                chi2: best.chi2,
+                after,
+                chi2,
                 dof,
                 // Corrected for every column of the library.
-                p: (p_value(best.chi2, dof) * m).min(1.0),
+                p: (p_value(chi2, dof) * m).min(1.0),
                 alpha,
                 alternatives: Vec::new(),
             },
             probe,
-            columns: best.keep,
+            columns: keep,
             tau,
         });
     }
     out
 }
 
-/// A decay found at a grid time constant: the same channels tried with each of the
-/// sensor's decays in place of it; the Wald statistic's parabola in `ln tau` through the
-/// best and its neighbours gives the time constant (its vertex) and its uncertainty (where
-/// the statistic has dropped by one).
-fn refine_tau(data: &Data, terms: &Terms, best: &Try, probe: &Probe) -> Option<Refined> {
+/// A decay found at a grid time constant: the same channels tried with its neighbours on
+/// the grid in place of it; the misfit's parabola in `ln tau` through the three gives the
+/// time constant (its vertex) and its uncertainty (where the misfit has risen by one,
+/// scaled from white noise to the honest noise model).
+fn refine_tau(
+    data: &Data,
+    terms: &Terms,
+    best: usize,
+    keep: &[usize],
+    probe: &Probe,
+) -> Option<Refined> {
     let work = data.working();
     let lay = &data.layout;
     let mut grid: Vec<(f64, usize)> = data
@@ -162,16 +244,17 @@ fn refine_tau(data: &Data, terms: &Terms, best: &Try, probe: &Probe) -> Option<R
         })
         .collect();
     grid.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let k = grid.iter().position(|g| g.1 == best.e)?;
+    let k = grid.iter().position(|g| g.1 == best)?;
     if k == 0 || k + 1 >= grid.len() {
         return None;
     }
-    let axes: Vec<usize> = best.keep.iter().map(|&g| local_axis(data, g)).collect();
-    // Statistic and amplitudes with decay `e` in place of the best one.
-    let with = |e: usize| -> (f64, Vec<(f64, f64)>) {
+    let axes: Vec<usize> = keep.iter().map(|&g| local_axis(data, g)).collect();
+    // The misfit of the kept channels (in units of their white noise, negated: a peak)
+    // and the amplitudes with decay `e` in place of the best one.
+    let swap = |e: usize| -> (Terms, Vec<usize>) {
         let mut t = terms.clone();
-        t.effects.retain(|&x| x != best.e);
-        t.skip.retain(|g| !lay.columns_of(best.e).contains(g));
+        t.effects.retain(|&x| x != best);
+        t.skip.retain(|g| !lay.columns_of(best).contains(g));
         t.effects.push(e);
         let keep: Vec<usize> = lay
             .columns_of(e)
@@ -179,9 +262,35 @@ fn refine_tau(data: &Data, terms: &Terms, best: &Try, probe: &Probe) -> Option<R
             .collect();
         t.skip
             .extend(lay.columns_of(e).filter(|g| !keep.contains(g)));
+        (t, keep)
+    };
+    // One noise scale for the three fits: the model's with the best decay.
+    let (center, _) = fit(data, terms, &work, &work);
+    let with = |e: usize| -> (f64, Vec<(f64, f64)>) {
+        let (t, keep) = swap(e);
         let (f, _) = fit(data, &t, &work, &work);
+        let total: f64 = keep
+            .iter()
+            .map(|&g| {
+                let c = channel_of(data, g);
+                misfit(data, &f, c, &work, center.noise[c].sigma)
+            })
+            .sum();
         let amps = keep.iter().map(|&g| (f.theta[g], f.u(g))).collect();
-        (wald(&f, &keep).0, amps)
+        (-total, amps)
+    };
+    // The white curvature understates the uncertainty where the bias wanders: scaled by
+    // the amplitude's honest-to-white ratio at the best grid point.
+    let inflation = {
+        let (t, keep) = swap(best);
+        let (honest, _) = fit(data, &t, &work, &work);
+        let (white, _) = super::model::fit_with(data, &t, &work, &work, true);
+        let g = keep[0];
+        if white.u(g) > 0.0 {
+            (honest.u(g) / white.u(g)).max(1.0)
+        } else {
+            1.0
+        }
     };
     let pts: Vec<(f64, f64, Vec<(f64, f64)>)> = [grid[k - 1], grid[k], grid[k + 1]]
         .iter()
@@ -200,7 +309,7 @@ fn refine_tau(data: &Data, terms: &Terms, best: &Try, probe: &Probe) -> Option<R
         return None;
     }
     let xv = (-p1 / (2.0 * p2)).clamp(x0, x2);
-    let sx = (-1.0 / p2).sqrt();
+    let sx = (-1.0 / p2).sqrt() * inflation;
     // Amplitudes interpolated linearly in ln tau between the two grid points around xv.
     let (lo, hi) = if xv <= x1 { (0, 1) } else { (1, 2) };
     let w = (xv - pts[lo].0) / (pts[hi].0 - pts[lo].0);

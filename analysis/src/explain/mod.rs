@@ -142,12 +142,8 @@ pub fn explain_source<S: Source>(
     if debug {
         eprintln!("selected in {:?}", clock.elapsed());
     }
-    let (steps, rejected) = (sel.steps, sel.last_p);
+    let (mut steps, mut rejected, mut refused) = (sel.steps, sel.last_p, sel.refused);
     let work = data.working();
-    let last = match steps.last() {
-        Some(s) => s.after.clone(),
-        None => fit(&data, &start, &work, &work).0,
-    };
     // Each finding's parameters come from the final model, every finding in it, refitted
     // on every segment once the held-out ones have confirmed it: an effect found early was
     // fitted without those found after it (which its estimate may have partly absorbed),
@@ -157,30 +153,37 @@ pub fn explain_source<S: Source>(
         terms.effects.push(step.effect);
     }
     let latitude = m.station.site.latitude_deg;
-    let free_earth = terms.clone();
     let mut held = earth::hold(&data, &mut terms, latitude);
     // What the registry left: forms of the probe library, found one at a time.
     let registry_terms = terms.clone();
-    let discoveries = discover::discover(&data, &mut terms, opts.alpha);
-    if held.is_some() && !discoveries.is_empty() {
-        // The Earth's rate held again beside what was found: a scale that looked off (the
-        // gyros' g^2 sensitivity follows the attitude too) may have been the discovery's.
-        let mut t = free_earth;
-        t.effects.extend(
+    let mut discoveries = discover::discover(&data, &mut terms, opts.alpha);
+    if !discoveries.is_empty() {
+        // The registry's selection again beside what was found: a strong unlisted form can
+        // hide the Earth's rate (or a registry effect) from the held-out segments, and a
+        // free Earth scale that looked off may have been the discovery's.
+        let mut again = start.clone();
+        again.effects.extend(
             terms
                 .effects
                 .iter()
                 .filter(|e| !registry_terms.effects.contains(e)),
         );
-        t.skip.extend(
+        again.skip.extend(
             terms
                 .skip
                 .iter()
                 .filter(|g| !registry_terms.skip.contains(g)),
         );
-        held = earth::hold(&data, &mut t, latitude);
-        terms = t;
+        let sel = select::forward(&data, &again, opts.alpha, &opts.without);
+        (steps, rejected, refused) = (sel.steps, sel.last_p, sel.refused);
+        for step in &steps {
+            again.effects.push(step.effect);
+        }
+        held = earth::hold(&data, &mut again, latitude);
+        discoveries.extend(discover::discover(&data, &mut again, opts.alpha));
+        terms = again;
     }
+    let last = fit(&data, &terms, &work, &work).0;
     if debug {
         eprintln!("discovered in {:?}", clock.elapsed());
     }
@@ -207,7 +210,6 @@ pub fn explain_source<S: Source>(
             .iter()
             .map(|d| discovered::finding(m, &data, d, &registry_terms, &whole.0)),
     );
-    let last = discoveries.last().map_or(last, |d| d.step.after.clone());
     let mut unexplained = unexplained::leftover(m, &data, &terms, opts.alpha);
     if debug {
         eprintln!("leftover tested in {:?}", clock.elapsed());
@@ -247,8 +249,7 @@ pub fn explain_source<S: Source>(
             .map(|&i| m.segments[data.accs[i].seg].id.clone())
             .collect(),
         rejected,
-        refused: sel
-            .refused
+        refused: refused
             .into_iter()
             .map(|r| RefusedOut {
                 effect: r.effect,

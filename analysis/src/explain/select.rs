@@ -191,6 +191,11 @@ fn refusal(
     if let Err(why) = plausible(data, fit_e, e) {
         return Some(why);
     }
+    // The Earth's rate is physics every recording holds, at a known value: probes do not
+    // replace it (a rate that only mimics it is caught by its free scale, earth::Held).
+    if e == data.earth {
+        return None;
+    }
     let lay = &data.layout;
     let work = data.working();
     let probes = try_probes(data, terms, &work, n);

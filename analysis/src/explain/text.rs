@@ -34,7 +34,9 @@ pub fn render_text(x: &Explanation) -> String {
             .as_ref()
             .map(|file| format!(" (user effect, {file})"))
             .unwrap_or_else(|| {
-                if f.station_side {
+                if f.discovered {
+                    " (discovered: a form outside the registry)".into()
+                } else if f.station_side {
                     " (a station error: the table, not the IMU)".into()
                 } else {
                     String::new()
@@ -70,6 +72,15 @@ pub fn render_text(x: &Explanation) -> String {
                 l.rms_before,
                 l.rms_after,
                 l.correlates_with
+            );
+        }
+        for t in &f.terms {
+            let _ = writeln!(
+                s,
+                "   {} += ({}) * {}",
+                t.channel,
+                format_measured(t.value, t.u, &t.unit),
+                t.expression
             );
         }
         for (name, p) in &f.parameters {
@@ -158,6 +169,13 @@ pub fn render_text(x: &Explanation) -> String {
             s,
             "user effects ({}) cannot be declared in a procedure: add them to the effect registry (docs/effects.md) to calibrate them",
             user.join(", ")
+        );
+    }
+    for d in &x.draft_effects {
+        let _ = writeln!(
+            s,
+            "draft effect file for {}: {} (confirm it with --effects, rename it, adopt it)",
+            d.effect, d.file
         );
     }
     for w in &x.warnings {
