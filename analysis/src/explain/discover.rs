@@ -155,8 +155,17 @@ pub(crate) fn discover(data: &Data, terms: &mut Terms, alpha: f64) -> Vec<Discov
             })
             .collect();
         order.sort_by(|x, y| y.1.total_cmp(&x.1));
-        let mut accepted = None;
-        for (k, _) in order {
+        // The first candidate that the held-out segments confirm; among candidates the
+        // fitted segments cannot tell apart (a drop within TIE of it: two instants of a
+        // step with only a held-out segment between them), the held-out ones choose.
+        let mut accepted: Option<(f64, (usize, Vec<usize>, Vec<usize>, Fit, f64))> = None;
+        let mut lead: Option<f64> = None;
+        for (k, top) in order {
+            if let Some(l) = lead
+                && top < l - TIE
+            {
+                break;
+            }
             let t = &tries[k];
             let (keep, drop): (Vec<usize>, Vec<usize>) =
                 data.layout.columns_of(t.e).partition(|&g| {
@@ -185,10 +194,14 @@ pub(crate) fn discover(data: &Data, terms: &mut Terms, alpha: f64) -> Vec<Discov
             if !data.held.is_empty() && hold >= base_hold {
                 continue;
             }
-            let (chi2, _) = wald(&f, &keep);
-            accepted = Some((t.e, keep, drop, f, chi2));
-            break;
+            lead = lead.or(Some(top));
+            let gain = hold - base_hold;
+            if accepted.as_ref().is_none_or(|a| gain < a.0) {
+                let (chi2, _) = wald(&f, &keep);
+                accepted = Some((gain, (t.e, keep, drop, f, chi2)));
+            }
         }
+        let accepted = accepted.map(|a| a.1);
         let Some((e, keep, drop, after, chi2)) = accepted else {
             break;
         };
