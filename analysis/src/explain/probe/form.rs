@@ -22,7 +22,8 @@ pub(crate) enum Form {
     ForceAbs,
     /// `f_i^3` (accel): odd third-order nonlinearity (K3).
     ForceCube,
-    /// `f_i |w_b|^2` (accel): a timing error's second order, or a rate-dependent scale.
+    /// `f_i |w_b|^2 - w_i (w_b . f)`, i.e. `-(w x (w x f))_i` (accel): the specific force's
+    /// second derivative under rotation, what a timing error leaves at second order.
     ForceRateSquare,
     /// `|w_i|` (gyro): scale asymmetry.
     RateAbs,
@@ -82,7 +83,9 @@ impl Form {
             Form::ForceAbs if gyro => format!("abs(f_b.{a}) / g / 3600"),
             Form::ForceAbs => format!("1e-6 * abs(f_b.{a})"),
             Form::ForceCube => format!("1e-6 * f_b.{a}^3 / g^2"),
-            Form::ForceRateSquare => format!("1e-6 * f_b.{a} * (w_b.x^2 + w_b.y^2 + w_b.z^2)"),
+            Form::ForceRateSquare => format!(
+                "1e-6 * (f_b.{a} * (w_b.x^2 + w_b.y^2 + w_b.z^2) - w_b.{a} * (w_b.x * f_b.x + w_b.y * f_b.y + w_b.z * f_b.z))"
+            ),
             Form::RateAbs => format!("1e-6 * abs(w_ib.{a} / deg)"),
             Form::RateSquare => format!("1e-6 * (w_ib.{a} / deg)^2"),
             Form::RateCube => format!("1e-6 * (w_ib.{a} / deg)^3"),
@@ -112,7 +115,9 @@ impl Form {
             Form::ForceAbs if gyro => f[i].abs() / g / 3600.0,
             Form::ForceAbs => 1e-6 * f[i].abs(),
             Form::ForceCube => 1e-6 * f[i].powi(3) / (g * g),
-            Form::ForceRateSquare => 1e-6 * f[i] * s.w_b.norm_squared(),
+            Form::ForceRateSquare => {
+                1e-6 * (f[i] * s.w_b.norm_squared() - s.w_b[i] * s.w_b.dot(&f))
+            }
             Form::RateAbs => 1e-6 * w[i].abs(),
             Form::RateSquare => 1e-6 * w[i] * w[i],
             Form::RateCube => 1e-6 * w[i].powi(3),
@@ -217,7 +222,7 @@ impl Form {
                 "output grows with the cube of the specific force along its own axis: an odd third-order nonlinearity (IEEE 1293 K3)"
             }
             Form::ForceRateSquare => {
-                "the output follows the specific force times the rate squared: a timing error's second order, or a scale that changes with the rate"
+                "the output follows the second derivative of the specific force under rotation (-w x (w x f)): a timing error's second order (coefficient -tau^2/2)"
             }
             Form::RateAbs => "the output depends on the sign of the rate: scale asymmetry",
             Form::RateSquare => "the output grows with the square of the rate, whatever its sign",
