@@ -56,6 +56,12 @@ pub(crate) fn live_columns(data: &Data) -> usize {
         .max(1)
 }
 
+/// A round's winner: probe, kept and dropped columns, the fit with it, its Wald statistic.
+type Accepted = (usize, Vec<usize>, Vec<usize>, Fit, f64);
+
+/// A decay grid point: `ln tau`, the negated misfit, the amplitudes (value, u).
+type GridPoint = (f64, f64, Vec<(f64, f64)>);
+
 /// A probe tried beside the model: each channel column's Wald statistic (is it there?)
 /// and the misfit it removes (how well does it explain?).
 struct Try {
@@ -158,7 +164,7 @@ pub(crate) fn discover(data: &Data, terms: &mut Terms, alpha: f64) -> Vec<Discov
         // The first candidate that the held-out segments confirm; among candidates the
         // fitted segments cannot tell apart (a drop within TIE of it: two instants of a
         // step with only a held-out segment between them), the held-out ones choose.
-        let mut accepted: Option<(f64, (usize, Vec<usize>, Vec<usize>, Fit, f64))> = None;
+        let mut accepted: Option<(f64, Accepted)> = None;
         let mut lead: Option<f64> = None;
         for (k, top) in order {
             if let Some(l) = lead
@@ -305,7 +311,7 @@ fn refine_tau(
             1.0
         }
     };
-    let pts: Vec<(f64, f64, Vec<(f64, f64)>)> = [grid[k - 1], grid[k], grid[k + 1]]
+    let pts: Vec<GridPoint> = [grid[k - 1], grid[k], grid[k + 1]]
         .iter()
         .map(|&(tau, e)| {
             let (c, a) = with(e);
