@@ -83,6 +83,8 @@ pub(crate) struct Prepared {
     writer: RecordingWriter,
     opts: RunOptions,
     seed: u64,
+    /// The writer appends to staged copies (a sealed run resumed), committed at the end.
+    staged: bool,
 }
 
 fn run(args: Args) -> Result<ExitCode, Report> {
@@ -94,15 +96,33 @@ fn run(args: Args) -> Result<ExitCode, Report> {
         .transpose()?;
     // The folder's lock is held to the end, the failure record and the seal included.
     let (prep, _lock) = match &args.resume {
-        Some(dir) => resume::prepare(dir)?,
+        Some(dir) => match resume::prepare(dir)? {
+            (resume::Resume::Run(prep), lock) => (*prep, lock),
+            (resume::Resume::Seal { plan, status }, _lock) => {
+                let code = finish::seal_recorded(dir, &plan, &status, key.as_ref(), args.archive.as_deref());
+                super::archive::after_run(args.archive.as_deref(), dir);
+                return Ok(code);
+            }
+        },
         None => prepare_new(&args)?,
     };
     let dir = prep.dir.clone();
+    let staged = prep.staged;
     match execute_prepared(prep, key.as_ref(), args.archive.as_deref()) {
         Ok(code) => {
             // Archived once sealed; a failure to archive is a warning, never the run's fate.
             super::archive::after_run(args.archive.as_deref(), &dir);
             Ok(code)
+        }
+        Err(report) if staged && ratecal_engine::recording::commit::pending_intent(&dir).is_none() => {
+            // The rest of a sealed run failed before it was committed: the sealed run
+            // stands as it was.
+            resume::drop_staged(&dir);
+            errln!(
+                "{}: the resumed part was not kept; the folder is as it was sealed",
+                dir.display()
+            );
+            Err(report)
         }
         Err(report) => {
             // The folder exists: it must not be left saying `running`.
@@ -126,6 +146,7 @@ fn execute_prepared(
         mut writer,
         mut opts,
         seed,
+        staged,
     } = prep;
     let simulated = station.describe().simulated;
     if let Some(t) = link_timeout_s(&station) {
@@ -178,6 +199,16 @@ fn execute_prepared(
     let wall = wall.elapsed().as_secs_f64();
     let outcome = outcome
         .map_err(|e| miette::miette!("cannot close the recording in {}: {e}", dir.display()))?;
+    if staged {
+        // The rest is recorded and closed: it replaces the sealed files in one change.
+        resume::commit_staged(&dir).map_err(|e| {
+            miette::miette!(
+                help = format!("`ratecal run --resume {}` finishes the change", dir.display()),
+                "cannot commit the resumed run in {}: {e}",
+                dir.display()
+            )
+        })?;
+    }
     let end = finish::End {
         dir: &dir,
         plan: &plan,
@@ -255,6 +286,7 @@ fn prepare_new(args: &Args) -> Result<(Prepared, FolderLock), Report> {
         writer,
         opts: RunOptions::default(),
         seed: args.seed,
+        staged: false,
     };
     Ok((prep, lock))
 }

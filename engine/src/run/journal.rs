@@ -106,6 +106,18 @@ pub enum JournalEvent {
         /// Whether the table was seen at rest.
         at_rest: bool,
     },
+    /// A block of a stream was written: the stream's running hash after it
+    /// (`ratecal_recording::chain`), written by the recording writer.
+    Block {
+        /// The stream's file (`imu.csv`).
+        stream: String,
+        /// First byte of the block.
+        offset: u64,
+        /// Bytes in it.
+        len: u64,
+        /// The chain value after it, hex.
+        chain: String,
+    },
     /// The run ended.
     End {
         /// `completed` or `aborted`.
