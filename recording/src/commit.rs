@@ -72,6 +72,10 @@ pub fn write_atomic(dir: &Path, name: &str, bytes: &[u8]) -> io::Result<()> {
         .map_err(|e| io::Error::new(e.kind(), format!("{}: {e}", tmp.display())))?;
     crash_point(&format!("before-rename-{name}"));
     std::fs::rename(&tmp, dir.join(name))?;
+    if tmp_dir != dir {
+        // Left only when empty: a staged change may be in it.
+        let _ = std::fs::remove_dir(&tmp_dir);
+    }
     sync_dir(dir)
 }
 
@@ -133,9 +137,17 @@ pub fn recover(dir: &Path) -> io::Result<Recovered> {
             Ok(Recovered::RolledForward(intent))
         }
         None => {
+            // Only the temporary file of a single replacement (never renamed): nothing to tell.
+            let staged = std::fs::read_dir(&pending)?
+                .filter_map(Result::ok)
+                .any(|e| !e.file_name().to_string_lossy().ends_with(".tmp"));
             std::fs::remove_dir_all(&pending)?;
             sync_dir(dir)?;
-            Ok(Recovered::RolledBack)
+            Ok(if staged {
+                Recovered::RolledBack
+            } else {
+                Recovered::Clean
+            })
         }
     }
 }

@@ -66,12 +66,34 @@ pub fn station_file(path: &Path) -> Result<setup::LoadedStation, Report> {
 
 /// Runs the subcommand.
 pub fn main(args: Args) -> ExitCode {
+    survive_file_size_limit();
     match run(args) {
         Ok(code) => code,
         Err(report) => {
             errln!("{report:?}");
             ExitCode::from(1)
         }
+    }
+}
+
+/// A file-size limit (`ulimit -f`) stops a write with SIGXFSZ, whose default action kills
+/// the process: with a handler installed the write fails with EFBIG instead, and the run
+/// aborts to its safe state like on a full disk. Installed through tokio's safe signal
+/// API (the handler outlives the small runtime that installs it).
+fn survive_file_size_limit() {
+    #[cfg(any(target_os = "linux", target_os = "macos"))]
+    {
+        const SIGXFSZ: i32 = 25;
+        let Ok(rt) = tokio::runtime::Builder::new_current_thread()
+            .enable_io()
+            .build()
+        else {
+            return;
+        };
+        rt.block_on(async {
+            use tokio::signal::unix::{SignalKind, signal};
+            let _ = signal(SignalKind::from_raw(SIGXFSZ));
+        });
     }
 }
 

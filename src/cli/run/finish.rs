@@ -86,10 +86,27 @@ impl End<'_> {
             } else {
                 "the end of the safe stop's wait"
             };
-            outln!(
-                "the recording holds every sample up to {upto}; continue with `ratecal run --resume {}`",
-                dir.display()
-            );
+            if let Some(f) = write_failure(dir) {
+                outln!(
+                    "a write failed ({}: {}): the recording holds every sample written before it; {}",
+                    f.file,
+                    f.error,
+                    if f.cut_bytes > 0 {
+                        format!("a partial last line ({} bytes) was cut", f.cut_bytes)
+                    } else {
+                        "no partial line was left".to_string()
+                    }
+                );
+                outln!(
+                    "free space (or raise the file-size limit), then continue with `ratecal run --resume {}`",
+                    dir.display()
+                );
+            } else {
+                outln!(
+                    "the recording holds every sample up to {upto}; continue with `ratecal run --resume {}`",
+                    dir.display()
+                );
+            }
         }
         let verdict = analyze(dir, self.plan, self.archive);
         if verdict.is_none() {
@@ -133,6 +150,12 @@ impl End<'_> {
             errln!("{line}");
         }
     }
+}
+
+/// The failed write the manifest records, if any.
+fn write_failure(dir: &Path) -> Option<ratecal_engine::recording::WriteFailure> {
+    let text = std::fs::read_to_string(dir.join("manifest.yaml")).ok()?;
+    parse_manifest("manifest.yaml", &text).ok()?.run?.write_failure
 }
 
 /// A run that ended but was never sealed (a crash after its manifest said so), finished by
