@@ -133,6 +133,16 @@ pub struct StreamCheck {
     pub(crate) covered_hash: Sha256,
 }
 
+impl std::fmt::Debug for StreamCheck {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("StreamCheck")
+            .field("blocks", &self.blocks)
+            .field("covered", &self.covered)
+            .field("size", &self.size)
+            .finish_non_exhaustive()
+    }
+}
+
 impl StreamCheck {
     /// Bytes after the last record (written but never recorded: a crash's tail).
     pub fn tail(&self) -> u64 {

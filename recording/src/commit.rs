@@ -158,14 +158,22 @@ pub fn pending_intent(dir: &Path) -> Option<Intent> {
     serde_json::from_slice(&text).ok()
 }
 
-/// Tests stop the process at named points (`RATECAL_CRASH_AT=after-intent`): it aborts
-/// there at once, as a kill would, leaving the files as they are. Nothing happens without
-/// the variable.
+/// Tests stop the process at named points (`RATECAL_CRASH_AT=after-intent`, or
+/// `after-checkpoint#3` for the third time it is reached): it aborts there at once, as a
+/// kill would, leaving the files as they are. Nothing happens without the variable.
 pub fn crash_point(name: &str) {
-    if let Some(at) = std::env::var_os("RATECAL_CRASH_AT")
-        && at == name
-    {
-        let _ = io::stderr().write_all(format!("crash point {name}\n").as_bytes());
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    static HITS: AtomicUsize = AtomicUsize::new(0);
+    let Some(at) = std::env::var_os("RATECAL_CRASH_AT") else {
+        return;
+    };
+    let at = at.to_string_lossy();
+    let (point, nth) = match at.split_once('#') {
+        Some((p, n)) => (p, n.parse::<usize>().unwrap_or(1)),
+        None => (at.as_ref(), 1),
+    };
+    if point == name && HITS.fetch_add(1, Ordering::SeqCst) + 1 == nth {
+        let _ = io::stderr().write_all(format!("crash point {at}\n").as_bytes());
         std::process::abort();
     }
 }

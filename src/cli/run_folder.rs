@@ -2,7 +2,7 @@
 //! rename, so a crash at any moment leaves one of these, and `run --resume` knows what to do
 //! with each.
 
-use ratecal_engine::audit::seal::SEAL_FILE;
+use ratecal_engine::audit::seal::{SEAL_FILE, SEAL_HASH_FILE};
 use ratecal_engine::recording::commit::pending_intent;
 use ratecal_engine::recording::parse_manifest;
 use std::path::Path;
@@ -49,7 +49,10 @@ pub fn state_of(dir: &Path) -> State {
         .ok()
         .and_then(|t| parse_manifest("manifest.yaml", &t).ok())
         .and_then(|m| m.run.map(|r| r.status));
-    let sealed = std::fs::symlink_metadata(dir.join(SEAL_FILE)).is_ok();
+    // A seal's hash without the seal: the seal was removed (a commit that removes or adds
+    // both is in the committing state until done), which `verify` calls altered.
+    let there = |name: &str| std::fs::symlink_metadata(dir.join(name)).is_ok();
+    let sealed = there(SEAL_FILE) || there(SEAL_HASH_FILE);
     match (status, sealed) {
         (None, _) => State::Other,
         (Some(s), false) if s == "running" => State::Recording,
