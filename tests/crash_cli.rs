@@ -72,7 +72,12 @@ fn finish_and_check(dir: &Path, cwd: &Path, what: &str) {
         .unwrap_or_else(|e| panic!("{what}: sealed but unreadable: {e}"));
     let run = rec.manifest.run.as_ref().unwrap();
     assert_eq!(run.status, "completed", "{what}");
-    let ids: Vec<&str> = rec.manifest.segments.iter().map(|s| s.id.as_str()).collect();
+    let ids: Vec<&str> = rec
+        .manifest
+        .segments
+        .iter()
+        .map(|s| s.id.as_str())
+        .collect();
     assert_eq!(
         ids,
         ["accel_static/1", "accel_static/2", "gyro_scale/outer/+50"],
@@ -103,7 +108,11 @@ fn a_run_stopped_at_any_named_point_is_finished_by_resume() {
     std::fs::write(tmp.path().join("p.rcal"), MINI).unwrap();
     for (k, point) in RUN_POINTS.iter().enumerate() {
         let out = format!("r{k}");
-        let o = crash_at(point, &["run", "p.rcal", "--dry-run", "--out", &out], tmp.path());
+        let o = crash_at(
+            point,
+            &["run", "p.rcal", "--dry-run", "--out", &out],
+            tmp.path(),
+        );
         assert_eq!(o.status.code(), None, "{point}: did not stop\n{}", text(&o));
         let dir = tmp.path().join(&out);
         let state = named_state(&dir, tmp.path(), point);
@@ -190,7 +199,10 @@ fn a_resume_stopped_at_any_named_point_leaves_the_sealed_run_or_the_new_one() {
             // Before the commit the sealed aborted recording is as it was, and verifies.
             assert_eq!(state, Some(0), "{point}");
             assert_eq!(json(&dir.join("seal.json")), original, "{point}");
-            let o = ratecal(&["archive", "add", &out, "--archive", "arc-old"], tmp.path());
+            let o = ratecal(
+                &["archive", "add", &out, "--archive", "arc-old"],
+                tmp.path(),
+            );
             assert_eq!(code(&o), 0, "{point}: {}", text(&o));
         }
         finish_and_check(&dir, tmp.path(), point);
@@ -209,7 +221,11 @@ fn a_second_resume_after_a_crashed_one_and_two_resumes_at_once() {
         let out = format!("c{k}");
         copy_dir(&tmp.path().join("a"), &tmp.path().join(&out));
         kill_after(*ms, &["run", "--resume", &out], tmp.path());
-        named_state(&tmp.path().join(&out), tmp.path(), &format!("killed at {ms} ms"));
+        named_state(
+            &tmp.path().join(&out),
+            tmp.path(),
+            &format!("killed at {ms} ms"),
+        );
         let spawn = || {
             Command::new(env!("CARGO_BIN_EXE_ratecal"))
                 .args(["run", "--resume", &out])
@@ -244,12 +260,23 @@ fn analyze_out_and_archive_add_stopped_leave_a_named_state() {
     let tmp = tempfile::tempdir().unwrap();
     let o = mini_run(tmp.path(), "r", &[]);
     assert!(matches!(code(&o), 0 | 3), "{}", text(&o));
-    for point in ["before-seal-intent", "after-intent", "after-move-again.json"] {
-        let o = crash_at(point, &["analyze", "r", "--out", "r/again.json"], tmp.path());
+    for point in [
+        "before-seal-intent",
+        "after-intent",
+        "after-move-again.json",
+    ] {
+        let o = crash_at(
+            point,
+            &["analyze", "r", "--out", "r/again.json"],
+            tmp.path(),
+        );
         assert_eq!(o.status.code(), None, "{point}: did not stop\n{}", text(&o));
         let state = named_state(&tmp.path().join("r"), tmp.path(), point);
         // Before the intent the addition never happened; after it, resume finishes it.
-        assert_eq!(state, Some(if point == "before-seal-intent" { 0 } else { 4 }));
+        assert_eq!(
+            state,
+            Some(if point == "before-seal-intent" { 0 } else { 4 })
+        );
         let o = ratecal(&["run", "--resume", "r"], tmp.path());
         assert!(text(&o).contains("nothing to resume"), "{}", text(&o));
         let o = ratecal(&["verify", "r"], tmp.path());
@@ -271,7 +298,11 @@ fn analyze_out_and_archive_add_stopped_leave_a_named_state() {
     // archive add stopped between its files and its index, then before a file's rename.
     for point in ["archive-after-files", "archive-before-rename"] {
         let arc = format!("arc-{point}");
-        let o = crash_at(point, &["archive", "add", "r", "--archive", &arc], tmp.path());
+        let o = crash_at(
+            point,
+            &["archive", "add", "r", "--archive", &arc],
+            tmp.path(),
+        );
         assert_eq!(o.status.code(), None, "{point}: did not stop\n{}", text(&o));
         let o = ratecal(&["archive", "check", "--archive", &arc], tmp.path());
         assert_eq!(code(&o), 0, "{point}: {}", text(&o));
@@ -279,8 +310,16 @@ fn analyze_out_and_archive_add_stopped_leave_a_named_state() {
         assert_eq!(code(&o), 0, "{point}: {}", text(&o));
         let o = ratecal(&["archive", "check", "--archive", &arc], tmp.path());
         assert_eq!(code(&o), 0, "{point}: {}", text(&o));
-        assert!(text(&o).contains(" 0 unfinished write(s)"), "{point}: {}", text(&o));
-        assert!(text(&o).contains(" 0 unreferenced"), "{point}: {}", text(&o));
+        assert!(
+            text(&o).contains(" 0 unfinished write(s)"),
+            "{point}: {}",
+            text(&o)
+        );
+        assert!(
+            text(&o).contains(" 0 unreferenced"),
+            "{point}: {}",
+            text(&o)
+        );
     }
 }
 

@@ -38,7 +38,10 @@ fn a_file_size_limit_aborts_the_run_and_what_is_sealed_reads_back() {
         .manifest;
     let run = m.run.as_ref().unwrap();
     assert_eq!(run.status, "aborted");
-    let f = run.write_failure.as_ref().expect("the manifest records the failure");
+    let f = run
+        .write_failure
+        .as_ref()
+        .expect("the manifest records the failure");
     assert_eq!(f.file, "imu.csv");
     assert!(f.error.contains("os error"), "{f:?}");
     // Cut after its last full line, within the limit; every row whole.

@@ -263,7 +263,11 @@ mod tests {
         // Round trip through a journal line.
         let line = records[0].journal_line(0.1);
         let j = tmp.path().join("journal.jsonl");
-        std::fs::write(&j, format!("{{\"t\":0,\"event\":\"start\"}}\n{line}\n{{\"t\":0,")).unwrap();
+        std::fs::write(
+            &j,
+            format!("{{\"t\":0,\"event\":\"start\"}}\n{line}\n{{\"t\":0,"),
+        )
+        .unwrap();
         assert_eq!(journal_blocks(&j).unwrap()["imu.csv"], records[..1]);
     }
 }

@@ -121,7 +121,13 @@ fn run(args: Args) -> Result<ExitCode, Report> {
         Some(dir) => match resume::prepare(dir)? {
             (resume::Resume::Run(prep), lock) => (*prep, lock),
             (resume::Resume::Seal { plan, status }, _lock) => {
-                let code = finish::seal_recorded(dir, &plan, &status, key.as_ref(), args.archive.as_deref());
+                let code = finish::seal_recorded(
+                    dir,
+                    &plan,
+                    &status,
+                    key.as_ref(),
+                    args.archive.as_deref(),
+                );
                 super::archive::after_run(args.archive.as_deref(), dir);
                 return Ok(code);
             }
@@ -136,7 +142,9 @@ fn run(args: Args) -> Result<ExitCode, Report> {
             super::archive::after_run(args.archive.as_deref(), &dir);
             Ok(code)
         }
-        Err(report) if staged && ratecal_engine::recording::commit::pending_intent(&dir).is_none() => {
+        Err(report)
+            if staged && ratecal_engine::recording::commit::pending_intent(&dir).is_none() =>
+        {
             // The rest of a sealed run failed before it was committed: the sealed run
             // stands as it was.
             resume::drop_staged(&dir);
@@ -225,7 +233,10 @@ fn execute_prepared(
         // The rest is recorded and closed: it replaces the sealed files in one change.
         resume::commit_staged(&dir).map_err(|e| {
             miette::miette!(
-                help = format!("`ratecal run --resume {}` finishes the change", dir.display()),
+                help = format!(
+                    "`ratecal run --resume {}` finishes the change",
+                    dir.display()
+                ),
                 "cannot commit the resumed run in {}: {e}",
                 dir.display()
             )

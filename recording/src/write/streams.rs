@@ -286,8 +286,7 @@ fn last_time(file: &mut File, size: u64) -> io::Result<Option<f64>> {
     file.seek(SeekFrom::Start(from))?;
     file.read_exact(&mut b)?;
     Ok(b.split(|&x| x == b'\n')
-        .filter(|l| !l.is_empty())
-        .next_back()
+        .rfind(|l| !l.is_empty())
         .and_then(|l| l.split(|&x| x == b',').next())
         .and_then(|c| std::str::from_utf8(c).ok()?.parse::<f64>().ok()))
 }
@@ -316,7 +315,11 @@ impl Streams {
     /// Records in the journal the blocks due (`force`: every block written so far).
     pub(crate) fn record_blocks(&mut self, force: bool) -> io::Result<()> {
         for k in 0..2 {
-            let s = if k == 0 { &mut self.imu } else { &mut self.table };
+            let s = if k == 0 {
+                &mut self.imu
+            } else {
+                &mut self.table
+            };
             if let Some((r, t)) = s.due_record(force) {
                 self.journal_line(&r.journal_line(t))?;
             }

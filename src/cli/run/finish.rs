@@ -155,7 +155,10 @@ impl End<'_> {
 /// The failed write the manifest records, if any.
 fn write_failure(dir: &Path) -> Option<ratecal_engine::recording::WriteFailure> {
     let text = std::fs::read_to_string(dir.join("manifest.yaml")).ok()?;
-    parse_manifest("manifest.yaml", &text).ok()?.run?.write_failure
+    parse_manifest("manifest.yaml", &text)
+        .ok()?
+        .run?
+        .write_failure
 }
 
 /// A run that ended but was never sealed (a crash after its manifest said so), finished by
@@ -308,7 +311,11 @@ pub fn mark_failed(dir: &Path, why: &str, key: Option<&SigningKey>) -> std::io::
         run.failure = Some(why.to_string());
         run.ended = Some(rfc3339(std::time::SystemTime::now()));
     }
-    ratecal_engine::recording::commit::write_atomic(dir, "manifest.yaml", manifest_yaml(&m)?.as_bytes())?;
+    ratecal_engine::recording::commit::write_atomic(
+        dir,
+        "manifest.yaml",
+        manifest_yaml(&m)?.as_bytes(),
+    )?;
     outln!("FAILED: {why}");
     outln!("the run folder {} records the failure", dir.display());
     crate::cli::seal::write(dir, key)

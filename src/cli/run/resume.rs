@@ -32,7 +32,7 @@ pub enum Resume {
     /// A run that ended but was never sealed: analyse, report and seal it.
     Seal {
         /// The plan it ran.
-        plan: ratecal_engine::plan::Plan,
+        plan: Box<ratecal_engine::plan::Plan>,
         /// Its status (`completed`, `aborted`, `failed`).
         status: String,
     },
@@ -94,7 +94,7 @@ pub fn prepare(dir: &Path) -> Result<(Resume, FolderLock), Report> {
                 dir.display()
             );
             Resume::Seal {
-                plan: pr.plan,
+                plan: Box::new(pr.plan),
                 status,
             }
         }
