@@ -5,7 +5,9 @@ use ed25519_dalek::pkcs8::{DecodePrivateKey, DecodePublicKey};
 use ed25519_dalek::{SigningKey, VerifyingKey};
 use miette::{Report, miette};
 use ratecal_engine::audit::seal::{SEAL_FILE, SEAL_HASH_FILE, Seal, is_unsealed_file};
-use ratecal_engine::recording::commit::{Intent, commit, crash_point, pending_dir, write_synced};
+use ratecal_engine::recording::commit::{
+    Intent, commit, crash_point, pending_dir, recover, write_synced,
+};
 use ratecal_engine::recording::{FileState, hash_folder, rfc3339};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -20,6 +22,7 @@ pub fn folder_files(dir: &Path) -> std::io::Result<BTreeMap<String, FileState>> 
 /// Seals every file of a run folder, signed with `key` if given; written last. Refused
 /// when an entry cannot be read (it could not be shown unaltered later).
 pub fn write(dir: &Path, key: Option<&SigningKey>) -> std::io::Result<()> {
+    recover(dir)?;
     let files = folder_files(dir)?;
     let mut hashes = Vec::with_capacity(files.len());
     for (path, state) in &files {
@@ -81,6 +84,9 @@ pub fn write_files(
     files: &[(String, Vec<u8>)],
     command: &str,
 ) -> std::io::Result<bool> {
+    // A change a crash left unfinished is carried out (or dropped) first: its intent must
+    // not be overwritten by this one.
+    recover(dir)?;
     let Some(mut seal) = sealed(dir) else {
         std::fs::create_dir_all(dir)?;
         for (name, bytes) in files {
