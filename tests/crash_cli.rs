@@ -135,6 +135,50 @@ fn a_run_stopped_at_any_named_point_is_finished_by_resume() {
 }
 
 #[test]
+fn a_tail_written_after_the_last_record_is_cut_by_resume_and_said() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(tmp.path().join("p.rcal"), MINI).unwrap();
+    let o = crash_at(
+        "after-checkpoint#2",
+        &["run", "p.rcal", "--dry-run", "--out", "r"],
+        tmp.path(),
+    );
+    assert_eq!(o.status.code(), None, "{}", text(&o));
+    let o = ratecal(&["verify", "r"], tmp.path());
+    assert_eq!(code(&o), 4, "{}", text(&o));
+    assert!(
+        text(&o).contains("NEVER SEALED r (recording)"),
+        "{}",
+        text(&o)
+    );
+    // Rows the crash wrote after the journal's last block record (a torn one last).
+    let path = tmp.path().join("r/imu.csv");
+    let tail = "9000.000000,0,0,9.8,0,0,0,20.0\n9000.010000,0,0,9.";
+    let mut f = std::fs::OpenOptions::new()
+        .append(true)
+        .open(&path)
+        .unwrap();
+    std::io::Write::write_all(&mut f, tail.as_bytes()).unwrap();
+    drop(f);
+    let o = ratecal(&["verify", "r"], tmp.path());
+    assert_eq!(code(&o), 4, "{}", text(&o));
+    let o = ratecal(&["run", "--resume", "r"], tmp.path());
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let m = ratecal_engine::recording::read(&tmp.path().join("r"))
+        .unwrap()
+        .manifest;
+    let resumes = m.run.unwrap().resumes;
+    assert_eq!(resumes.len(), 1);
+    assert_eq!(resumes[0].interrupted_status, "running");
+    assert_eq!(
+        resumes[0].cut_tail.get("imu.csv"),
+        Some(&(tail.len() as u64))
+    );
+    assert!(!std::fs::read_to_string(&path).unwrap().contains("9000.0"));
+    assert_eq!(code(&ratecal(&["verify", "r"], tmp.path())), 0);
+}
+
+#[test]
 fn an_unsealed_run_whose_stream_was_edited_is_altered_not_sealed() {
     let tmp = tempfile::tempdir().unwrap();
     std::fs::write(tmp.path().join("p.rcal"), MINI).unwrap();
