@@ -118,6 +118,14 @@ pub enum JournalEvent {
         /// The chain value after it, hex.
         chain: String,
     },
+    /// A resumed run's staged files are about to replace the sealed ones (the intent of
+    /// docs/run-folders.md, on record in the journal that replaces the sealed one; `t` 0).
+    Commit {
+        /// Files moved in from the pending folder.
+        moves: Vec<String>,
+        /// Files removed (the old seal).
+        removes: Vec<String>,
+    },
     /// The run ended.
     End {
         /// `completed` or `aborted`.

@@ -19,7 +19,7 @@ use ratecal_engine::recording::commit::{
 use ratecal_engine::recording::{
     Manifest, RecordingWriter, ResumeRecord, parse_manifest, rfc3339, sha256_hex,
 };
-use ratecal_engine::run::{RunOptions, resume_point};
+use ratecal_engine::run::{JournalEntry, JournalEvent, RunOptions, resume_point};
 use std::path::{Path, PathBuf};
 
 /// The files a resumed sealed run continues on staged copies of.
@@ -130,12 +130,15 @@ pub fn commit_staged(dir: &Path) -> std::io::Result<()> {
         removes: vec![SEAL_FILE.into(), SEAL_HASH_FILE.into()],
     };
     // The intent is also on record in the journal that replaces the sealed one.
-    let line = serde_json::json!({
-        "t": 0.0,
-        "event": "commit",
-        "moves": intent.moves,
-        "removes": intent.removes,
-    });
+    let entry = JournalEntry {
+        t: 0.0,
+        step: None,
+        event: JournalEvent::Commit {
+            moves: intent.moves.clone(),
+            removes: intent.removes.clone(),
+        },
+    };
+    let line = serde_json::to_string(&entry).map_err(std::io::Error::other)?;
     let journal = dir.join(PENDING_DIR).join("journal.jsonl");
     let mut f = std::fs::OpenOptions::new().append(true).open(&journal)?;
     std::io::Write::write_all(&mut f, format!("{line}\n").as_bytes())?;
