@@ -2,7 +2,7 @@
 //! index facts (from manifest.yaml and, when present, results.json).
 
 use crate::{ArchiveError, Result};
-use ratecal_engine::audit::seal::LOCK_FILE;
+use ratecal_engine::audit::seal::is_scratch;
 use ratecal_engine::audit::verify::sha256_hex;
 use ratecal_engine::recording::{FileState, Manifest, hash_folder, regular};
 use serde_json::Value;
@@ -131,8 +131,7 @@ pub fn content_id(files: &[(String, String, u64)]) -> String {
 /// Every file of the folder as `verify` sees it (symlinks followed, hashed streaming, the
 /// lock file left out); an entry that cannot be read refuses the folder, named.
 fn walk(root: &Path, out: &mut Vec<(String, String, u64)>) -> Result<()> {
-    let files =
-        hash_folder(root, |name| name == LOCK_FILE).map_err(|e| ArchiveError::io(root, e))?;
+    let files = hash_folder(root, is_scratch).map_err(|e| ArchiveError::io(root, e))?;
     for (name, state) in files {
         match state {
             FileState::Hashed { sha256, size } => out.push((name, sha256, size)),

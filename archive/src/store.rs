@@ -227,6 +227,7 @@ fn copy_file(root: &Path, sha: &str, src: &Path) -> Result<bool> {
         let _ = std::fs::remove_file(&tmp);
         return Ok(false);
     }
+    ratecal_engine::recording::commit::crash_point("archive-before-rename");
     std::fs::rename(&tmp, &dest).map_err(|e| io(&dest, e))?;
     Ok(true)
 }

@@ -49,6 +49,7 @@ fn manifest(files: &[(&str, &str)]) -> Manifest {
             resumes: Vec::new(),
             changed_after_release: None,
             sync: None,
+            write_failure: None,
         }),
     }
 }

@@ -443,7 +443,7 @@ async fn resume_continues_after_the_last_completed_step() {
         (point.next_step, point.segments, point.completed),
         (1, 2, false)
     );
-    let (mut w, last_t) = RecordingWriter::append(dir.path()).unwrap();
+    let (mut w, last_t) = RecordingWriter::append(dir.path(), false).unwrap();
     let last_t = last_t.unwrap();
     w.manifest_mut().segments.truncate(point.segments);
     w.manifest_mut().run.as_mut().unwrap().status = "running".into();

@@ -39,6 +39,8 @@
 //! ```
 
 pub mod cadence;
+pub mod chain;
+pub mod commit;
 mod data;
 mod error;
 mod excerpt;
@@ -54,7 +56,7 @@ pub use excerpt::Excerpt;
 pub use files::{FileState, hash_folder, regular, sha256_file};
 pub use manifest::{
     AbortRecord, EnvironmentRecord, FORMAT, LinkRecord, Manifest, ManifestStation, Mount,
-    ProcedureRef, ResumeRecord, RunInfo, Segment, SegmentKind, SyncRecord, TableAxes,
+    ProcedureRef, ResumeRecord, RunInfo, Segment, SegmentKind, SyncRecord, TableAxes, WriteFailure,
 };
 pub use read::{OpenRecording, SpanRows, parse_manifest, read, read_imu, read_table};
 pub use write::{

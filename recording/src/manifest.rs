@@ -182,6 +182,21 @@ pub struct RunInfo {
     /// How hardware links delivered their samples, and the table-to-IMU synchronisation.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sync: Option<SyncRecord>,
+    /// A write that failed (a full disk, a file-size limit): the run aborted there and the
+    /// stream was cut after its last full line.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub write_failure: Option<WriteFailure>,
+}
+
+/// A stream write that failed, and what was cut so that the stream reads back.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct WriteFailure {
+    /// The file (`imu.csv`).
+    pub file: String,
+    /// The operating system's error, with its number (`File too large (os error 27)`).
+    pub error: String,
+    /// Bytes of a partial last line cut from the file.
+    pub cut_bytes: u64,
 }
 
 /// Where a run was interrupted and when it resumed.
@@ -206,6 +221,10 @@ pub struct ResumeRecord {
     pub resumed: String,
     /// Index of the first step the resumed part ran.
     pub from_step: usize,
+    /// Bytes cut from each stream's end when it resumed: written after the journal last
+    /// recorded its running hash (a crash's tail), never part of a segment.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub cut_tail: BTreeMap<String, u64>,
 }
 
 /// `run.sync`: each hardware link's delivery and the table-to-IMU clock skew estimate.

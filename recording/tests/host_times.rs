@@ -147,7 +147,7 @@ fn a_continued_recording_keeps_its_arrival_column() {
     w.write_table(&table[..20]).unwrap();
     w.finish().unwrap();
     w.close();
-    let (mut w, last) = RecordingWriter::append(tmp.path()).unwrap();
+    let (mut w, last) = RecordingWriter::append(tmp.path(), false).unwrap();
     assert_eq!(w.columns(), columns);
     assert_eq!(last, Some(table[19].t));
     w.write_imu(&imu[20..]).unwrap();

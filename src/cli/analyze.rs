@@ -89,13 +89,11 @@ pub fn main(args: Args) -> ExitCode {
     let json = results.to_json();
     match &args.out {
         Some(path) => {
-            if let Err(e) = std::fs::write(path, json + "\n") {
+            // A file ratecal writes into a sealed run folder joins the seal, with the
+            // command, in one committed change.
+            let bytes = (json + "\n").into_bytes();
+            if let Err(e) = super::seal::write_file(path, bytes, &super::seal::command_line()) {
                 errln!("error: cannot write {}: {e}", path.display());
-                return ExitCode::from(1);
-            }
-            // A file ratecal writes into a sealed run folder joins the seal, with the command.
-            if let Err(e) = super::seal::record_addition(path, &super::seal::command_line()) {
-                errln!("error: cannot add {} to the seal: {e}", path.display());
                 return ExitCode::from(1);
             }
         }

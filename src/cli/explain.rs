@@ -290,14 +290,17 @@ pub fn main(args: Args) -> ExitCode {
 /// one addition to its seal.
 fn write(dir: &Path, files: &[(String, String)], seal: bool) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;
-    let paths: Vec<std::path::PathBuf> = files.iter().map(|(n, _)| dir.join(n)).collect();
-    for (path, (_, text)) in paths.iter().zip(files) {
-        std::fs::write(path, text)?;
+    if !seal {
+        for (name, text) in files {
+            std::fs::write(dir.join(name), text)?;
+        }
+        return Ok(());
     }
-    if seal && !paths.is_empty() {
-        let refs: Vec<&Path> = paths.iter().map(|p| p.as_path()).collect();
-        super::seal::record_additions(&refs, &super::seal::command_line())?;
-    }
+    let bytes: Vec<(String, Vec<u8>)> = files
+        .iter()
+        .map(|(n, t)| (n.clone(), t.clone().into_bytes()))
+        .collect();
+    super::seal::write_files(dir, &bytes, &super::seal::command_line())?;
     Ok(())
 }
 

@@ -14,5 +14,6 @@ pub mod log;
 pub mod procedure;
 pub mod report;
 pub mod run;
+pub mod run_folder;
 pub mod seal;
 pub mod verify;

@@ -110,11 +110,10 @@ fn report(args: &Args) -> miette::Result<()> {
     let text = render::render_template(&input, &templates, &name)?;
     match &args.out {
         Some(out) => {
-            std::fs::write(out, text)
+            // A report written into a sealed run folder joins the seal, with the command,
+            // in one committed change.
+            super::seal::write_file(out, text.into_bytes(), &super::seal::command_line())
                 .map_err(|e| io(out, e, "check that the folder exists and is writable"))?;
-            // A report written into a sealed run folder joins the seal, with the command.
-            super::seal::record_addition(out, &super::seal::command_line())
-                .map_err(|e| io(out, e, "check that the run folder is writable"))?;
         }
         None => out!("{text}"),
     }

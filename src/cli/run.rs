@@ -66,12 +66,34 @@ pub fn station_file(path: &Path) -> Result<setup::LoadedStation, Report> {
 
 /// Runs the subcommand.
 pub fn main(args: Args) -> ExitCode {
+    survive_file_size_limit();
     match run(args) {
         Ok(code) => code,
         Err(report) => {
             errln!("{report:?}");
             ExitCode::from(1)
         }
+    }
+}
+
+/// A file-size limit (`ulimit -f`) stops a write with SIGXFSZ, whose default action kills
+/// the process: with a handler installed the write fails with EFBIG instead, and the run
+/// aborts to its safe state like on a full disk. Installed through tokio's safe signal
+/// API (the handler outlives the small runtime that installs it).
+fn survive_file_size_limit() {
+    #[cfg(any(target_os = "linux", target_os = "macos"))]
+    {
+        const SIGXFSZ: i32 = 25;
+        let Ok(rt) = tokio::runtime::Builder::new_current_thread()
+            .enable_io()
+            .build()
+        else {
+            return;
+        };
+        rt.block_on(async {
+            use tokio::signal::unix::{SignalKind, signal};
+            let _ = signal(SignalKind::from_raw(SIGXFSZ));
+        });
     }
 }
 
@@ -83,6 +105,8 @@ pub(crate) struct Prepared {
     writer: RecordingWriter,
     opts: RunOptions,
     seed: u64,
+    /// The writer appends to staged copies (a sealed run resumed), committed at the end.
+    staged: bool,
 }
 
 fn run(args: Args) -> Result<ExitCode, Report> {
@@ -94,15 +118,41 @@ fn run(args: Args) -> Result<ExitCode, Report> {
         .transpose()?;
     // The folder's lock is held to the end, the failure record and the seal included.
     let (prep, _lock) = match &args.resume {
-        Some(dir) => resume::prepare(dir)?,
+        Some(dir) => match resume::prepare(dir)? {
+            (resume::Resume::Run(prep), lock) => (*prep, lock),
+            (resume::Resume::Seal { plan, status }, _lock) => {
+                let code = finish::seal_recorded(
+                    dir,
+                    &plan,
+                    &status,
+                    key.as_ref(),
+                    args.archive.as_deref(),
+                );
+                super::archive::after_run(args.archive.as_deref(), dir);
+                return Ok(code);
+            }
+        },
         None => prepare_new(&args)?,
     };
     let dir = prep.dir.clone();
+    let staged = prep.staged;
     match execute_prepared(prep, key.as_ref(), args.archive.as_deref()) {
         Ok(code) => {
             // Archived once sealed; a failure to archive is a warning, never the run's fate.
             super::archive::after_run(args.archive.as_deref(), &dir);
             Ok(code)
+        }
+        Err(report)
+            if staged && ratecal_engine::recording::commit::pending_intent(&dir).is_none() =>
+        {
+            // The rest of a sealed run failed before it was committed: the sealed run
+            // stands as it was.
+            resume::drop_staged(&dir);
+            errln!(
+                "{}: the resumed part was not kept; the folder is as it was sealed",
+                dir.display()
+            );
+            Err(report)
         }
         Err(report) => {
             // The folder exists: it must not be left saying `running`.
@@ -126,6 +176,7 @@ fn execute_prepared(
         mut writer,
         mut opts,
         seed,
+        staged,
     } = prep;
     let simulated = station.describe().simulated;
     if let Some(t) = link_timeout_s(&station) {
@@ -178,6 +229,19 @@ fn execute_prepared(
     let wall = wall.elapsed().as_secs_f64();
     let outcome = outcome
         .map_err(|e| miette::miette!("cannot close the recording in {}: {e}", dir.display()))?;
+    if staged {
+        // The rest is recorded and closed: it replaces the sealed files in one change.
+        resume::commit_staged(&dir).map_err(|e| {
+            miette::miette!(
+                help = format!(
+                    "`ratecal run --resume {}` finishes the change",
+                    dir.display()
+                ),
+                "cannot commit the resumed run in {}: {e}",
+                dir.display()
+            )
+        })?;
+    }
     let end = finish::End {
         dir: &dir,
         plan: &plan,
@@ -255,6 +319,7 @@ fn prepare_new(args: &Args) -> Result<(Prepared, FolderLock), Report> {
         writer,
         opts: RunOptions::default(),
         seed: args.seed,
+        staged: false,
     };
     Ok((prep, lock))
 }

@@ -5,7 +5,10 @@ use ed25519_dalek::pkcs8::{DecodePrivateKey, DecodePublicKey};
 use ed25519_dalek::{SigningKey, VerifyingKey};
 use miette::{Report, miette};
 use ratecal_engine::audit::seal::{SEAL_FILE, SEAL_HASH_FILE, Seal, is_unsealed_file};
-use ratecal_engine::recording::{FileState, hash_folder, rfc3339, sha256_file};
+use ratecal_engine::recording::commit::{
+    Intent, commit, crash_point, pending_dir, recover, write_synced,
+};
+use ratecal_engine::recording::{FileState, hash_folder, rfc3339};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -19,6 +22,7 @@ pub fn folder_files(dir: &Path) -> std::io::Result<BTreeMap<String, FileState>> 
 /// Seals every file of a run folder, signed with `key` if given; written last. Refused
 /// when an entry cannot be read (it could not be shown unaltered later).
 pub fn write(dir: &Path, key: Option<&SigningKey>) -> std::io::Result<()> {
+    recover(dir)?;
     let files = folder_files(dir)?;
     let mut hashes = Vec::with_capacity(files.len());
     for (path, state) in &files {
@@ -36,55 +40,86 @@ pub fn write(dir: &Path, key: Option<&SigningKey>) -> std::io::Result<()> {
     if let Some(k) = key {
         seal.sign(k);
     }
-    save(dir, &seal)
+    save(dir, &seal, &[])
 }
 
-fn save(dir: &Path, seal: &Seal) -> std::io::Result<()> {
+/// Replaces the seal, together with `files` (name, bytes) written into the folder, as one
+/// change: all staged under the pending folder, then committed (`ratecal_recording::commit`):
+/// a crash leaves the old seal and files or the new ones, never a mix that reads altered.
+fn save(dir: &Path, seal: &Seal, files: &[(String, Vec<u8>)]) -> std::io::Result<()> {
+    let pending = pending_dir(dir)?;
     let json = seal.to_json();
-    std::fs::write(dir.join(SEAL_FILE), &json)?;
-    std::fs::write(dir.join(SEAL_HASH_FILE), Seal::hash_line(&json))
-}
-
-/// After writing `file`: if it lies in a sealed run folder, adds it to that seal with the
-/// time and `command` (the seal is left alone when it no longer parses: `verify` says so).
-pub fn record_addition(file: &Path, command: &str) -> std::io::Result<bool> {
-    record_additions(&[file], command)
-}
-
-/// After writing `files`, all in one folder: if it is a sealed run folder, adds them to its
-/// seal as one addition with the time and `command`.
-pub fn record_additions(files: &[&Path], command: &str) -> std::io::Result<bool> {
-    let Some(dir) = files.first().and_then(|f| f.parent()).map(|p| {
-        if p.as_os_str().is_empty() {
-            Path::new(".")
-        } else {
-            p
-        }
-    }) else {
-        return Ok(false);
-    };
-    let Ok(text) = std::fs::read_to_string(dir.join(SEAL_FILE)) else {
-        return Ok(false);
-    };
-    let Ok(mut seal) = serde_json::from_str::<Seal>(&text) else {
-        return Ok(false);
-    };
-    let mut named = Vec::with_capacity(files.len());
-    for file in files {
-        let name = file
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        named.push((name, sha256_file(file)?.0));
+    let mut moves = Vec::with_capacity(files.len() + 2);
+    for (name, bytes) in files {
+        write_synced(&pending.join(name), bytes)?;
+        moves.push(name.clone());
     }
-    let borrowed: Vec<(&str, &str)> = named
+    write_synced(&pending.join(SEAL_FILE), json.as_bytes())?;
+    write_synced(
+        &pending.join(SEAL_HASH_FILE),
+        Seal::hash_line(&json).as_bytes(),
+    )?;
+    moves.extend([SEAL_FILE.to_string(), SEAL_HASH_FILE.to_string()]);
+    crash_point("before-seal-intent");
+    commit(
+        dir,
+        &Intent {
+            moves,
+            removes: Vec::new(),
+        },
+    )
+}
+
+/// The seal of `dir` when it is a sealed run folder whose seal parses.
+fn sealed(dir: &Path) -> Option<Seal> {
+    let text = std::fs::read_to_string(dir.join(SEAL_FILE)).ok()?;
+    serde_json::from_str::<Seal>(&text).ok()
+}
+
+/// Writes `files` (name, bytes) into `dir`. In a sealed run folder they join its seal as one
+/// addition with the time and `command`, files and seal replaced in one committed change;
+/// elsewhere each file is simply written. Returns whether they joined a seal.
+pub fn write_files(
+    dir: &Path,
+    files: &[(String, Vec<u8>)],
+    command: &str,
+) -> std::io::Result<bool> {
+    // A change a crash left unfinished is carried out (or dropped) first: its intent must
+    // not be overwritten by this one.
+    recover(dir)?;
+    let Some(mut seal) = sealed(dir) else {
+        std::fs::create_dir_all(dir)?;
+        for (name, bytes) in files {
+            std::fs::write(dir.join(name), bytes)?;
+        }
+        return Ok(false);
+    };
+    let hashes: Vec<(String, String)> = files
+        .iter()
+        .map(|(n, b)| (n.clone(), ratecal_engine::recording::sha256_hex(b)))
+        .collect();
+    let borrowed: Vec<(&str, &str)> = hashes
         .iter()
         .map(|(n, h)| (n.as_str(), h.as_str()))
         .collect();
     let now = rfc3339(std::time::SystemTime::now());
     seal.add_hashes(&now, command, &borrowed);
-    save(dir, &seal)?;
+    save(dir, &seal, files)?;
     Ok(true)
+}
+
+/// [`write_files`] of one file given by its path.
+pub fn write_file(path: &Path, bytes: Vec<u8>, command: &str) -> std::io::Result<bool> {
+    let dir = match path.parent() {
+        Some(p) if p.as_os_str().is_empty() => Path::new("."),
+        Some(p) => p,
+        None => Path::new("."),
+    };
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .ok_or_else(|| std::io::Error::other(format!("{} names no file", path.display())))?;
+    write_files(dir, &[(name, bytes)], command)
 }
 
 /// The command line as run, for the seal's record of additions.

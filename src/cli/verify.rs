@@ -1,8 +1,11 @@
 //! `ratecal verify RUN_DIR [--key lab.pub]`: checks every file of a run folder against the
 //! seal the run wrote last (`seal.json`, whose own hash is in `seal.sha256`): each file
 //! altered, missing or unknown to the seal is named. With `--key`, the seal must also be
-//! signed by that key. Exit 0 intact, 1 altered, unknown files, a missing or malformed seal,
-//! or not signed by the key; 2 error (no such run folder, unreadable key).
+//! signed by that key. A ratecal run folder that was never sealed (a crash before its seal,
+//! docs/run-folders.md) is told apart from an altered one: its streams are checked against
+//! the journal's running hash. Exit 0 intact; 1 altered, unknown files, a malformed seal, or
+//! not signed by the key; 4 never sealed (or a change left unfinished by a crash); 2 error
+//! (no such run folder, unreadable key).
 
 use ed25519_dalek::VerifyingKey;
 use ratecal_engine::audit::seal::{SEAL_FILE, SEAL_HASH_FILE, verify_hashes};
@@ -97,6 +100,68 @@ pub fn require_intact(dir: &Path, command: &str) -> Result<(), miette::Report> {
     ))
 }
 
+/// A ratecal run folder without a seal, or with a change a crash left unfinished: named with
+/// its state (exit 4), or altered when its streams no longer match the journal (exit 1).
+/// `None` for every other folder.
+fn unsealed(dir: &Path) -> Option<ExitCode> {
+    use super::run_folder::{State, state_of};
+    let state = state_of(dir);
+    let help = format!(
+        "help: `ratecal run --resume {}` finishes it and seals it",
+        dir.display()
+    );
+    let tail_ok = match &state {
+        State::Committing => {
+            outln!(
+                "UNFINISHED {}: a change was committed but not carried out (a crash); \
+                 its seal is not yet in place",
+                dir.display()
+            );
+            errln!("{help}");
+            return Some(ExitCode::from(4));
+        }
+        State::Recording => true,
+        State::RecordedUnsealed(_) => false,
+        _ => return None,
+    };
+    let check = if tail_ok {
+        streams_match(dir)
+    } else {
+        ratecal_engine::recording::chain::check_folder(dir).unwrap_or_else(|e| Err(e.to_string()))
+    };
+    if let Err(why) = check {
+        outln!(
+            "ALTERED since it was recorded: {why} ({} was never sealed)",
+            dir.display()
+        );
+        return Some(ExitCode::from(1));
+    }
+    let what = match &state {
+        State::Recording => "it stopped while recording (or is recording now)".to_string(),
+        State::RecordedUnsealed(s) => format!("the run ended ({s}) but its seal was never written"),
+        _ => unreachable!("handled above"),
+    };
+    outln!(
+        "NEVER SEALED {} ({}): {what}; its streams match the journal's running hash",
+        dir.display(),
+        state.name()
+    );
+    errln!("{help}");
+    Some(ExitCode::from(4))
+}
+
+/// A run still recording: every block the journal recorded is as written (a tail after the
+/// last record is allowed: `--resume` cuts it).
+fn streams_match(dir: &Path) -> Result<(), String> {
+    use ratecal_engine::recording::chain::{check_stream, journal_blocks};
+    let blocks = journal_blocks(&dir.join("journal.jsonl")).map_err(|e| e.to_string())?;
+    for name in ["imu.csv", "table.csv"] {
+        let records = blocks.get(name).map(Vec::as_slice).unwrap_or_default();
+        check_stream(&dir.join(name), records).map_err(|e| format!("{name}: {e}"))??;
+    }
+    Ok(())
+}
+
 /// Runs the subcommand.
 pub fn main(args: Args) -> ExitCode {
     let dir = &args.run_dir;
@@ -112,6 +177,9 @@ pub fn main(args: Args) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    if let Some(code) = unsealed(dir) {
+        return code;
+    }
     let report = match verify_folder(dir, key.as_ref()) {
         Ok(r) => r,
         Err(e) => {

@@ -64,9 +64,16 @@ pub fn is_seal_file(path: &str) -> bool {
     path == SEAL_FILE || path == SEAL_HASH_FILE
 }
 
-/// Whether a path is outside what a seal covers: the seal's own files and the lock file.
+/// Whether a path is outside what a seal covers: the seal's own files, the lock file and
+/// the pending folder of an unfinished change.
 pub fn is_unsealed_file(path: &str) -> bool {
-    is_seal_file(path) || path == LOCK_FILE
+    is_seal_file(path) || is_scratch(path)
+}
+
+/// Whether a path is a run folder's scratch, never part of its content: the lock file and
+/// the pending folder (`ratecal_recording::commit`).
+pub fn is_scratch(path: &str) -> bool {
+    path == LOCK_FILE || crate::recording::commit::is_pending(path)
 }
 
 impl Seal {

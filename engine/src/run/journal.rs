@@ -106,6 +106,26 @@ pub enum JournalEvent {
         /// Whether the table was seen at rest.
         at_rest: bool,
     },
+    /// A block of a stream was written: the stream's running hash after it
+    /// (`ratecal_recording::chain`), written by the recording writer.
+    Block {
+        /// The stream's file (`imu.csv`).
+        stream: String,
+        /// First byte of the block.
+        offset: u64,
+        /// Bytes in it.
+        len: u64,
+        /// The chain value after it, hex.
+        chain: String,
+    },
+    /// A resumed run's staged files are about to replace the sealed ones (the intent of
+    /// docs/run-folders.md, on record in the journal that replaces the sealed one; `t` 0).
+    Commit {
+        /// Files moved in from the pending folder.
+        moves: Vec<String>,
+        /// Files removed (the old seal).
+        removes: Vec<String>,
+    },
     /// The run ended.
     End {
         /// `completed` or `aborted`.

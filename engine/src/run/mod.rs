@@ -168,7 +168,12 @@ impl RunSink for RecordingWriter {
 
     fn segment(&mut self, segment: Segment) -> io::Result<()> {
         self.manifest_mut().segments.push(segment);
-        self.checkpoint()
+        let r = self.checkpoint();
+        if r.is_err() {
+            // Its data may not all be written: the segment is not the recording's.
+            self.manifest_mut().segments.pop();
+        }
+        r
     }
 
     fn flush(&mut self) -> io::Result<()> {

@@ -363,6 +363,7 @@ pub fn manifest(name: &str) -> Manifest {
             resumes: Vec::new(),
             changed_after_release: None,
             sync: None,
+            write_failure: None,
         }),
     }
 }

@@ -12,10 +12,12 @@ mod streams;
 pub use fixed::push_fixed;
 pub use streams::Columns;
 
-use crate::{FORMAT, ImuSample, Manifest, TableSample};
+use crate::commit::crash_point;
+use crate::{FORMAT, ImuSample, Manifest, TableSample, WriteFailure};
 use sha2::{Digest, Sha256};
+use std::collections::BTreeMap;
 use std::fs::{File, OpenOptions};
-use std::io::{self, Write};
+use std::io;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 use streams::{Stream, Streams};
@@ -24,11 +26,18 @@ use streams::{Stream, Streams};
 enum Msg {
     Imu(Vec<ImuSample>),
     Table(Vec<TableSample>),
-    /// Flush both streams to the OS; reply with the first error so far.
-    Sync(mpsc::Sender<io::Result<()>>),
-    /// Flush and reply with the files' SHA-256 (imu, table).
-    Hashes(mpsc::Sender<io::Result<(String, String)>>),
+    /// One journal line (written in order with the streams' block records).
+    Journal(String),
+    /// Flush both streams to the OS (`true`: to the disk, with every block recorded); reply
+    /// with the first error so far.
+    Sync(bool, mpsc::Sender<io::Result<()>>),
+    /// Flush to the disk and reply with the files' SHA-256 (imu, table) and the failed
+    /// write, if one failed (the streams are then cut after their last full line).
+    Hashes(mpsc::Sender<io::Result<Hashes>>),
 }
+
+/// The streams' SHA-256 at the end, and the write that failed, if one did.
+type Hashes = (String, String, Option<WriteFailure>);
 
 /// Batches in flight before `write_*` waits: bounds memory if the disk is slow.
 const QUEUE: usize = 64;
@@ -43,17 +52,23 @@ const BATCH_TABLE: usize = 64;
 /// dropped and counted: a time that does not strictly increase, or a non-finite value (a
 /// faulty IMU's NaN output; the format refuses non-numeric cells).
 ///
-/// The streams are formatted, hashed and written on a writer thread; an IO error there
-/// surfaces at the next [`RecordingWriter::checkpoint`] (every segment end) or write.
+/// The streams are formatted, hashed and written on a writer thread, which also writes the
+/// journal: the run's events and, as blocks of each stream are written, their running hash
+/// (`block` lines, [`crate::chain`]). An IO error there surfaces at the next
+/// [`RecordingWriter::checkpoint`] (every segment end) or [`RecordingWriter::sync`].
 pub struct RecordingWriter {
     dir: PathBuf,
     tx: Option<mpsc::SyncSender<Msg>>,
     thread: Option<std::thread::JoinHandle<u64>>,
-    journal: File,
     columns: Columns,
     manifest: Manifest,
     pending_imu: Vec<ImuSample>,
     pending_table: Vec<TableSample>,
+    cut: BTreeMap<String, u64>,
+}
+
+fn copy_err(e: &io::Error) -> io::Error {
+    io::Error::new(e.kind(), e.to_string())
 }
 
 fn writer_thread(mut st: Streams, rx: mpsc::Receiver<Msg>) -> u64 {
@@ -65,26 +80,40 @@ fn writer_thread(mut st: Streams, rx: mpsc::Receiver<Msg>) -> u64 {
     };
     for msg in rx {
         match msg {
-            Msg::Imu(v) if failed.is_none() => keep(st.write_imu(&v), &mut failed),
-            Msg::Table(v) if failed.is_none() => keep(st.write_table(&v), &mut failed),
+            Msg::Imu(v) if failed.is_none() => {
+                let r = st.write_imu(&v).and_then(|()| st.record_blocks(false));
+                keep(r, &mut failed);
+            }
+            Msg::Table(v) if failed.is_none() => {
+                let r = st.write_table(&v).and_then(|()| st.record_blocks(false));
+                keep(r, &mut failed);
+            }
             Msg::Imu(_) | Msg::Table(_) => {}
-            Msg::Sync(reply) => {
+            Msg::Journal(line) => {
+                // The journal goes on after a stream failed: the abort is recorded.
+                let r = st.journal_line(&line);
+                keep(r, &mut failed);
+            }
+            Msg::Sync(durable, reply) => {
                 if failed.is_none() {
-                    keep(st.imu.sync().and_then(|()| st.table.sync()), &mut failed);
+                    keep(st.sync(durable), &mut failed);
+                } else {
+                    let _ = st.record_blocks(true).and_then(|()| st.journal.sync_data());
                 }
-                let _ = reply.send(
-                    failed
-                        .as_ref()
-                        .map_or(Ok(()), |e| Err(io::Error::new(e.kind(), e.to_string()))),
-                );
+                let _ = reply.send(failed.as_ref().map_or(Ok(()), |e| Err(copy_err(e))));
             }
             Msg::Hashes(reply) => {
                 if failed.is_none() {
-                    keep(st.imu.sync().and_then(|()| st.table.sync()), &mut failed);
+                    keep(st.sync(true), &mut failed);
+                } else {
+                    let _ = st.record_blocks(true).and_then(|()| st.journal.sync_data());
                 }
-                let r = match &failed {
-                    Some(e) => Err(io::Error::new(e.kind(), e.to_string())),
-                    None => Ok((st.imu.sha256(), st.table.sha256())),
+                // A failed stream write is recorded and sealed as cut; any other failure
+                // (the journal, an fsync) leaves the recording unfinished.
+                let r = match (&failed, st.failure()) {
+                    (Some(_), Some(f)) => Ok((st.imu.sha256(), st.table.sha256(), Some(f.clone()))),
+                    (Some(e), None) => Err(copy_err(e)),
+                    (None, _) => Ok((st.imu.sha256(), st.table.sha256(), None)),
                 };
                 let _ = reply.send(r);
             }
@@ -98,7 +127,7 @@ fn gone() -> io::Error {
 }
 
 impl RecordingWriter {
-    fn start(dir: &Path, streams: Streams, journal: File, manifest: Manifest) -> io::Result<Self> {
+    fn start(dir: &Path, streams: Streams, manifest: Manifest) -> io::Result<Self> {
         let columns = streams.columns;
         let (tx, rx) = mpsc::sync_channel(QUEUE);
         let thread = std::thread::Builder::new()
@@ -108,11 +137,11 @@ impl RecordingWriter {
             dir: dir.to_path_buf(),
             tx: Some(tx),
             thread: Some(thread),
-            journal,
             columns,
             manifest,
             pending_imu: Vec::with_capacity(BATCH_IMU),
             pending_table: Vec::with_capacity(BATCH_TABLE),
+            cut: BTreeMap::new(),
         })
     }
 
@@ -124,31 +153,37 @@ impl RecordingWriter {
         let journal = File::create(dir.join("journal.jsonl"))?;
         let mut manifest = manifest;
         manifest.format = FORMAT.to_string();
-        let mut w = Self::start(
-            dir,
-            Streams {
-                imu,
-                table,
-                columns,
-                dropped: 0,
-            },
+        let streams = Streams {
+            imu,
+            table,
+            columns,
+            dropped: 0,
             journal,
-            manifest,
-        )?;
+        };
+        let mut w = Self::start(dir, streams, manifest)?;
         w.checkpoint()?;
+        crash_point("after-create");
         Ok(w)
     }
 
     /// Reopens an interrupted recording to continue it (`run --resume`): streams and journal
-    /// are appended to, the manifest is read back. Returns the writer and the last time
-    /// stamp found in either stream (`None` when both are empty).
-    pub fn append(dir: &Path) -> io::Result<(Self, Option<f64>)> {
+    /// are appended to, the manifest is read back. Each stream is read (streaming) against
+    /// the running hash the journal recorded: refused when it no longer matches; the bytes
+    /// written after the last record (a crash's tail, never part of a segment) are cut,
+    /// unless `sealed` (the folder's seal vouches for them). Returns the writer and the
+    /// last time stamp found in either stream (`None` when both are empty).
+    pub fn append(dir: &Path, sealed: bool) -> io::Result<(Self, Option<f64>)> {
         let text = std::fs::read_to_string(dir.join("manifest.yaml"))?;
         // The reader's manifest parser, so a resumed run accepts exactly what analysis reads.
         let manifest = crate::parse_manifest("manifest.yaml", &text)
             .map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e.to_string()))?;
-        let (imu, imu_header) = Stream::append(&dir.join("imu.csv"))?;
-        let (table, table_header) = Stream::append(&dir.join("table.csv"))?;
+        let blocks = crate::chain::journal_blocks(&dir.join("journal.jsonl"))?;
+        let open = |name: &str| {
+            let records = blocks.get(name).map(Vec::as_slice);
+            Stream::append(&dir.join(name), records, sealed)
+        };
+        let (imu, imu_header, imu_cut) = open("imu.csv")?;
+        let (table, table_header, table_cut) = open("table.csv")?;
         let columns = Columns::of_headers(&imu_header, &table_header);
         let journal = OpenOptions::new()
             .append(true)
@@ -158,18 +193,26 @@ impl RecordingWriter {
             (Some(a), Some(b)) => Some(a.max(b)),
             (a, b) => a.or(b),
         };
-        let w = Self::start(
-            dir,
-            Streams {
-                imu,
-                table,
-                columns,
-                dropped: 0,
-            },
+        let streams = Streams {
+            imu,
+            table,
+            columns,
+            dropped: 0,
             journal,
-            manifest,
-        )?;
+        };
+        let mut w = Self::start(dir, streams, manifest)?;
+        for (name, n) in [("imu.csv", imu_cut), ("table.csv", table_cut)] {
+            if n > 0 {
+                w.cut.insert(name.into(), n);
+            }
+        }
         Ok((w, last))
+    }
+
+    /// Bytes [`RecordingWriter::append`] cut from each stream (the unrecorded tail of a
+    /// crash), by file name.
+    pub fn cut_tails(&self) -> &BTreeMap<String, u64> {
+        &self.cut
     }
 
     /// The folder being written.
@@ -239,51 +282,58 @@ impl RecordingWriter {
         self.thread.take().and_then(|t| t.join().ok()).unwrap_or(0)
     }
 
-    /// Appends one line to `journal.jsonl` (written through at once: the journal is what
-    /// `--resume` trusts).
+    /// Appends one line to `journal.jsonl` (through the writer thread, in order with the
+    /// streams' block records; the journal is what `--resume` trusts).
     pub fn write_journal_line(&mut self, line: &str) -> io::Result<()> {
-        let mut l = String::with_capacity(line.len() + 1);
-        l.push_str(line);
-        l.push('\n');
-        self.journal.write_all(l.as_bytes())
+        self.send(Msg::Journal(line.to_string()))
+    }
+
+    fn sync_streams(&mut self, durable: bool) -> io::Result<()> {
+        self.send_pending()?;
+        let (tx, rx) = mpsc::channel();
+        self.send(Msg::Sync(durable, tx))?;
+        rx.recv().map_err(|_| gone())?
     }
 
     /// Flushes the journal and both streams to the OS (without rewriting the manifest).
     pub fn sync(&mut self) -> io::Result<()> {
-        self.journal.flush()?;
-        self.send_pending()?;
-        let (tx, rx) = mpsc::channel();
-        self.send(Msg::Sync(tx))?;
-        rx.recv().map_err(|_| gone())?
+        self.sync_streams(false)
     }
 
-    /// Flushes both streams to the OS and rewrites the manifest atomically
-    /// (`manifest.yaml.tmp` then rename).
+    /// Flushes both streams to the disk, records their blocks in the journal, and replaces
+    /// the manifest atomically (written whole and fsynced, then renamed).
     pub fn checkpoint(&mut self) -> io::Result<()> {
-        self.send_pending()?;
-        let (tx, rx) = mpsc::channel();
-        self.send(Msg::Sync(tx))?;
-        rx.recv().map_err(|_| gone())??;
+        self.sync_streams(true)?;
+        self.write_manifest()?;
+        crash_point("after-checkpoint");
+        Ok(())
+    }
+
+    fn write_manifest(&self) -> io::Result<()> {
         let yaml = manifest_yaml(&self.manifest)?;
-        let tmp = self.dir.join("manifest.yaml.tmp");
-        std::fs::write(&tmp, yaml)?;
-        std::fs::rename(&tmp, self.dir.join("manifest.yaml"))
+        crate::commit::write_atomic(&self.dir, "manifest.yaml", yaml.as_bytes())
+            .map_err(|e| io::Error::new(e.kind(), format!("manifest.yaml: {e}")))
     }
 
     /// Ends the recording: records the SHA-256 of each data file in `run.files_sha256`,
-    /// sets `run.ended`, and writes the final manifest.
+    /// sets `run.ended`, and writes the final manifest. After a failed write the streams
+    /// end cut after their last full line and the manifest says so (`run.write_failure`).
     pub fn finish(&mut self) -> io::Result<()> {
-        self.journal.flush()?;
         self.send_pending()?;
         let (tx, rx) = mpsc::channel();
         self.send(Msg::Hashes(tx))?;
-        let (imu, table) = rx.recv().map_err(|_| gone())??;
+        let (imu, table, failure) = rx.recv().map_err(|_| gone())??;
         if let Some(run) = self.manifest.run.as_mut() {
             run.files_sha256.insert("imu.csv".into(), imu);
             run.files_sha256.insert("table.csv".into(), table);
             run.ended = Some(rfc3339(std::time::SystemTime::now()));
+            if failure.is_some() {
+                run.write_failure = failure;
+            }
         }
-        self.checkpoint()
+        self.write_manifest()?;
+        crash_point("after-manifest");
+        Ok(())
     }
 }
 

@@ -3,7 +3,8 @@
 //! sample batches over.
 
 use super::fixed::Line;
-use crate::{ImuSample, TableSample};
+use crate::chain::{BlockRecord, CHAIN_START, Chain, check_stream};
+use crate::{ImuSample, TableSample, WriteFailure};
 use sha2::{Digest, Sha256};
 use std::fs::{File, OpenOptions};
 use std::io::{self, Read, Seek, SeekFrom, Write};
@@ -82,56 +83,87 @@ fn t_host_cell(l: &mut Line, t_host: Option<f64>) {
     }
 }
 
-/// One CSV stream: an append-only file, a byte buffer, and the running hash of the file.
+/// One CSV stream: an append-only file, a byte buffer, the running hash of the file and its
+/// chain of blocks (recorded in the journal).
 pub(crate) struct Stream {
+    name: String,
     file: File,
     buf: Vec<u8>,
     hash: Sha256,
+    chain: Chain,
+    written: u64,
     pub(crate) last_t: Option<f64>,
+    /// The first write that failed: the stream takes no more.
+    pub(crate) failure: Option<WriteFailure>,
 }
 
 impl Stream {
-    pub(crate) fn create(path: &Path, header: &str) -> io::Result<Self> {
-        let file = File::create(path)?;
-        let mut s = Stream {
-            file,
-            buf: Vec::with_capacity(CHUNK + 512),
-            hash: Sha256::new(),
-            last_t: None,
-        };
-        s.buf.extend_from_slice(header.as_bytes());
-        s.buf.push(b'\n');
-        Ok(s)
-    }
-
-    /// Reopens a stream for appending: drops a torn last line (a crash mid-write), hashes
-    /// what is kept, and finds the last time stamp.
-    pub(crate) fn append(path: &Path) -> io::Result<(Self, String)> {
-        let mut file = OpenOptions::new().read(true).write(true).open(path)?;
-        let mut text = Vec::new();
-        file.read_to_end(&mut text)?;
-        let keep = text.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
-        text.truncate(keep);
-        file.set_len(keep as u64)?;
-        file.seek(SeekFrom::End(0))?;
-        let header = text.split(|&b| b == b'\n').next().unwrap_or_default();
-        let header = String::from_utf8_lossy(header).into_owned();
-        let last_t = text
-            .split(|&b| b == b'\n')
-            .filter(|l| !l.is_empty())
-            .skip(1)
-            .last()
-            .and_then(|l| l.split(|&b| b == b',').next())
-            .and_then(|c| std::str::from_utf8(c).ok()?.parse::<f64>().ok());
-        let mut hash = Sha256::new();
-        hash.update(&text);
-        let s = Stream {
+    fn new(path: &Path, file: File, hash: Sha256, chain: Chain, written: u64) -> Self {
+        Stream {
+            name: file_name(path),
             file,
             buf: Vec::with_capacity(CHUNK + 512),
             hash,
-            last_t,
+            chain,
+            written,
+            last_t: None,
+            failure: None,
+        }
+    }
+
+    pub(crate) fn create(path: &Path, header: &str) -> io::Result<Self> {
+        let file = File::create(path)?;
+        let mut s = Self::new(path, file, Sha256::new(), Chain::new(CHAIN_START, 0), 0);
+        s.buf.extend_from_slice(header.as_bytes());
+        s.buf.push(b'\n');
+        s.flush()?;
+        Ok(s)
+    }
+
+    /// Reopens a stream for appending (`run --resume`), read streaming against its block
+    /// records: refused when a recorded block is not as written; the bytes after the last
+    /// record (a crash's unrecorded tail) are kept when `keep_tail` (a sealed folder vouches
+    /// for them) and cut otherwise. A stream without records (an older ratecal's) keeps what
+    /// it holds up to its last full line. Returns the stream, its header and the bytes cut.
+    pub(crate) fn append(
+        path: &Path,
+        records: Option<&[BlockRecord]>,
+        keep_tail: bool,
+    ) -> io::Result<(Self, String, u64)> {
+        let check = check_stream(path, records.unwrap_or_default())?
+            .map_err(|why| io::Error::new(io::ErrorKind::InvalidData, why))?;
+        let mut file = OpenOptions::new().read(true).write(true).open(path)?;
+        let header = first_line(&mut file)?;
+        let (keep, cut) = if keep_tail {
+            (check.size, 0)
+        } else if records.is_none() {
+            let end = last_newline_end(&mut file, check.size)?;
+            (end, check.size - end)
+        } else {
+            (check.covered, check.tail())
         };
-        Ok((s, header))
+        if cut > 0 {
+            file.set_len(keep)?;
+            file.sync_all()?;
+        }
+        let (mut hash, mut chain) = (check.covered_hash, Chain::new(check.chain, check.covered));
+        // What is kept beyond the records joins the file's hash and the open block.
+        file.seek(SeekFrom::Start(check.covered))?;
+        let mut rest = (&mut file).take(keep - check.covered);
+        let mut b = vec![0u8; 1 << 16];
+        loop {
+            let n = rest.read(&mut b)?;
+            if n == 0 {
+                break;
+            }
+            hash.update(&b[..n]);
+            chain.update(&b[..n]);
+        }
+        let last_t = last_time(&mut file, keep)?;
+        file.seek(SeekFrom::End(0))?;
+        let mut s = Self::new(path, file, hash, chain, keep);
+        s.last_t = last_t;
+        Ok((s, header, cut))
     }
 
     fn end_row(&mut self) -> io::Result<()> {
@@ -142,23 +174,121 @@ impl Stream {
         Ok(())
     }
 
+    /// Writes the buffer. A write that fails (a full disk, a file-size limit) leaves the
+    /// file cut after its last full line, the failure kept, and the stream closed.
     fn flush(&mut self) -> io::Result<()> {
-        if !self.buf.is_empty() {
-            self.hash.update(&self.buf);
-            self.file.write_all(&self.buf)?;
-            self.buf.clear();
+        if let Some(f) = &self.failure {
+            return Err(io::Error::other(format!("{}: {}", f.file, f.error)));
+        }
+        if self.buf.is_empty() {
+            return Ok(());
+        }
+        let mut done = 0;
+        let failed = loop {
+            if done == self.buf.len() {
+                break None;
+            }
+            match self.file.write(&self.buf[done..]) {
+                Ok(0) => break Some(io::Error::from(io::ErrorKind::WriteZero)),
+                Ok(n) => done += n,
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
+                Err(e) => break Some(e),
+            }
+        };
+        // The buffer always starts on a row: cut back to the last full row written.
+        let keep = match failed {
+            None => done,
+            Some(_) => self.buf[..done]
+                .iter()
+                .rposition(|&b| b == b'\n')
+                .map_or(0, |i| i + 1),
+        };
+        self.hash.update(&self.buf[..keep]);
+        self.chain.update(&self.buf[..keep]);
+        self.written += keep as u64;
+        self.buf.clear();
+        let Some(e) = failed else {
+            return Ok(());
+        };
+        let cut = (done - keep) as u64;
+        if cut > 0 {
+            // Shrinking is allowed under a file-size limit and on a full disk.
+            let _ = self.file.set_len(self.written);
+        }
+        let f = WriteFailure {
+            file: self.name.clone(),
+            error: e.to_string(),
+            cut_bytes: cut,
+        };
+        let err = io::Error::new(e.kind(), format!("{}: {e}", f.file));
+        self.failure = Some(f);
+        Err(err)
+    }
+
+    /// Flushes to the OS; `durable`: also to the disk.
+    pub(crate) fn sync(&mut self, durable: bool) -> io::Result<()> {
+        self.flush()?;
+        if durable {
+            self.file.sync_data()?;
         }
         Ok(())
     }
 
-    pub(crate) fn sync(&mut self) -> io::Result<()> {
-        self.flush()?;
-        self.file.flush()
+    /// The block written since the last record, when it is due (a full chunk, or `force`).
+    pub(crate) fn due_record(&mut self, force: bool) -> Option<(BlockRecord, f64)> {
+        if !force && self.chain.open_len() < CHUNK as u64 {
+            return None;
+        }
+        let t = self.last_t.unwrap_or(0.0);
+        self.chain.record(&self.name).map(|r| (r, t))
     }
 
     pub(crate) fn sha256(&self) -> String {
         hex::encode(self.hash.clone().finalize())
     }
+}
+
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+/// The first line of a file (at most 64 KiB of it), without its newline.
+fn first_line(file: &mut File) -> io::Result<String> {
+    file.seek(SeekFrom::Start(0))?;
+    let mut head = Vec::new();
+    file.take(1 << 16).read_to_end(&mut head)?;
+    let end = head.iter().position(|&b| b == b'\n').unwrap_or(head.len());
+    Ok(String::from_utf8_lossy(&head[..end]).into_owned())
+}
+
+/// The end of the last full line within the first `size` bytes.
+fn last_newline_end(file: &mut File, size: u64) -> io::Result<u64> {
+    let mut end = size;
+    while end > 0 {
+        let from = end.saturating_sub(1 << 16);
+        let mut b = vec![0u8; (end - from) as usize];
+        file.seek(SeekFrom::Start(from))?;
+        file.read_exact(&mut b)?;
+        if let Some(i) = b.iter().rposition(|&x| x == b'\n') {
+            return Ok(from + i as u64 + 1);
+        }
+        end = from;
+    }
+    Ok(0)
+}
+
+/// The time stamp of the last data row within the first `size` bytes (read from the end).
+fn last_time(file: &mut File, size: u64) -> io::Result<Option<f64>> {
+    let from = size.saturating_sub(1 << 16);
+    let mut b = vec![0u8; (size - from) as usize];
+    file.seek(SeekFrom::Start(from))?;
+    file.read_exact(&mut b)?;
+    Ok(b.split(|&x| x == b'\n')
+        .rfind(|l| !l.is_empty())
+        .and_then(|l| l.split(|&x| x == b',').next())
+        .and_then(|c| std::str::from_utf8(c).ok()?.parse::<f64>().ok()))
 }
 
 /// Both streams and the count of samples the format could not hold.
@@ -167,9 +297,54 @@ pub(crate) struct Streams {
     pub table: Stream,
     pub columns: Columns,
     pub dropped: u64,
+    /// `journal.jsonl`: the run's events and the streams' block records, in order.
+    pub journal: File,
 }
 
 impl Streams {
+    /// Appends one line to the journal.
+    pub(crate) fn journal_line(&mut self, line: &str) -> io::Result<()> {
+        let mut l = Vec::with_capacity(line.len() + 1);
+        l.extend_from_slice(line.as_bytes());
+        l.push(b'\n');
+        self.journal
+            .write_all(&l)
+            .map_err(|e| io::Error::new(e.kind(), format!("journal.jsonl: {e}")))
+    }
+
+    /// Records in the journal the blocks due (`force`: every block written so far).
+    pub(crate) fn record_blocks(&mut self, force: bool) -> io::Result<()> {
+        for k in 0..2 {
+            let s = if k == 0 {
+                &mut self.imu
+            } else {
+                &mut self.table
+            };
+            if let Some((r, t)) = s.due_record(force) {
+                self.journal_line(&r.journal_line(t))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Flushes both streams and records their blocks; `durable`: the streams reach the
+    /// disk before the records that vouch for them, and the journal after.
+    pub(crate) fn sync(&mut self, durable: bool) -> io::Result<()> {
+        let streams = self.imu.sync(durable).and(self.table.sync(durable));
+        // Blocks written before a failure are recorded all the same.
+        self.record_blocks(durable || streams.is_err())?;
+        streams?;
+        if durable {
+            self.journal.sync_data()?;
+        }
+        Ok(())
+    }
+
+    /// The first failed write of either stream.
+    pub(crate) fn failure(&self) -> Option<&WriteFailure> {
+        self.imu.failure.as_ref().or(self.table.failure.as_ref())
+    }
+
     /// Appends IMU samples (times on the recording clock).
     pub(crate) fn write_imu(&mut self, samples: &[ImuSample]) -> io::Result<()> {
         for s in samples {

@@ -86,10 +86,27 @@ impl End<'_> {
             } else {
                 "the end of the safe stop's wait"
             };
-            outln!(
-                "the recording holds every sample up to {upto}; continue with `ratecal run --resume {}`",
-                dir.display()
-            );
+            if let Some(f) = write_failure(dir) {
+                outln!(
+                    "a write failed ({}: {}): the recording holds every sample written before it; {}",
+                    f.file,
+                    f.error,
+                    if f.cut_bytes > 0 {
+                        format!("a partial last line ({} bytes) was cut", f.cut_bytes)
+                    } else {
+                        "no partial line was left".to_string()
+                    }
+                );
+                outln!(
+                    "free space (or raise the file-size limit), then continue with `ratecal run --resume {}`",
+                    dir.display()
+                );
+            } else {
+                outln!(
+                    "the recording holds every sample up to {upto}; continue with `ratecal run --resume {}`",
+                    dir.display()
+                );
+            }
         }
         let verdict = analyze(dir, self.plan, self.archive);
         if verdict.is_none() {
@@ -132,6 +149,58 @@ impl End<'_> {
             outln!("{line}");
             errln!("{line}");
         }
+    }
+}
+
+/// The failed write the manifest records, if any.
+fn write_failure(dir: &Path) -> Option<ratecal_engine::recording::WriteFailure> {
+    let text = std::fs::read_to_string(dir.join("manifest.yaml")).ok()?;
+    parse_manifest("manifest.yaml", &text)
+        .ok()?
+        .run?
+        .write_failure
+}
+
+/// A run that ended but was never sealed (a crash after its manifest said so), finished by
+/// `run --resume`: analysed, reported and sealed. Exit codes as `run`'s.
+pub fn seal_recorded(
+    dir: &Path,
+    plan: &Plan,
+    status: &str,
+    key: Option<&SigningKey>,
+    archive: Option<&str>,
+) -> ExitCode {
+    let verdict = analyze(dir, plan, archive);
+    let warnings = journal_warnings(dir);
+    if verdict.is_none() {
+        outln!("warnings: {}", warnings.len());
+        for w in &warnings {
+            outln!("  warning: {w}");
+        }
+    }
+    if let Err(e) = crate::cli::seal::write(dir, key) {
+        errln!("cannot seal {}: {e}", dir.display());
+        return ExitCode::from(1);
+    }
+    outln!("sealed: {}", dir.join("seal.json").display());
+    if status != "completed" {
+        outln!(
+            "the run {status} before its end; continue it with `ratecal run --resume {}`",
+            dir.display()
+        );
+    }
+    if warnings
+        .iter()
+        .any(|w| w.ends_with(ratecal_engine::run::NOT_AT_REST))
+    {
+        let line = format!("WARNING: {}", ratecal_engine::run::NOT_AT_REST);
+        outln!("{line}");
+        errln!("{line}");
+    }
+    match verdict {
+        _ if status != "completed" => ExitCode::from(4),
+        Some(v) => crate::cli::analyze::exit_code(v),
+        None => ExitCode::from(1),
     }
 }
 
@@ -178,6 +247,7 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
         errln!("cannot write results.json: {e}");
         return None;
     }
+    ratecal_engine::recording::commit::crash_point("after-results");
     if !results.acceptance.is_empty() {
         outln!("acceptance (value ± expanded uncertainty U, k = 2):");
     }
@@ -225,6 +295,7 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
             return None;
         }
     }
+    ratecal_engine::recording::commit::crash_point("after-reports");
     Some(results.verdict)
 }
 
@@ -240,7 +311,11 @@ pub fn mark_failed(dir: &Path, why: &str, key: Option<&SigningKey>) -> std::io::
         run.failure = Some(why.to_string());
         run.ended = Some(rfc3339(std::time::SystemTime::now()));
     }
-    std::fs::write(&path, manifest_yaml(&m)?)?;
+    ratecal_engine::recording::commit::write_atomic(
+        dir,
+        "manifest.yaml",
+        manifest_yaml(&m)?.as_bytes(),
+    )?;
     outln!("FAILED: {why}");
     outln!("the run folder {} records the failure", dir.display());
     crate::cli::seal::write(dir, key)

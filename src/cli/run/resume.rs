@@ -1,20 +1,45 @@
-//! `ratecal run --resume RUN_DIR`: continues an interrupted run from its last completed step,
-//! with the copies the run folder keeps. Refused when a copy (procedure, station file, an
-//! import) no longer has the hash the run recorded, or when the folder no longer matches its
-//! seal: the rest of a run must follow what its start followed.
+//! `ratecal run --resume RUN_DIR`: finishes whatever state an interruption left
+//! (docs/run-folders.md). A run stopped while recording continues in place from its last
+//! completed step; a run that ended but was never sealed is analysed, reported and sealed
+//! when its streams still match the journal's running hash; a sealed aborted run continues
+//! on staged copies of its files, committed over the sealed ones only when the rest has been
+//! recorded, so that a crash meanwhile leaves the sealed recording as it was. Refused when a
+//! copy (procedure, station file, an import) no longer has the hash the run recorded, or
+//! when the folder no longer matches its seal: the rest of a run must follow what its start
+//! followed.
 
 use super::{Prepared, imports, setup};
 use crate::cli::lock::FolderLock;
+use crate::cli::run_folder::{State, state_of};
 use miette::{Report, miette};
 use ratecal_engine::audit::seal::{SEAL_FILE, SEAL_HASH_FILE, verify_hashes};
+use ratecal_engine::recording::commit::{
+    Intent, PENDING_DIR, Recovered, commit, crash_point, pending_dir, recover, sync_dir,
+};
 use ratecal_engine::recording::{
     Manifest, RecordingWriter, ResumeRecord, parse_manifest, rfc3339, sha256_hex,
 };
-use ratecal_engine::run::{RunOptions, resume_point};
-use std::path::Path;
+use ratecal_engine::run::{JournalEntry, JournalEvent, RunOptions, resume_point};
+use std::path::{Path, PathBuf};
 
-/// Prepares the rest of an interrupted run, holding the folder's lock.
-pub fn prepare(dir: &Path) -> Result<(Prepared, FolderLock), Report> {
+/// The files a resumed sealed run continues on staged copies of.
+const STAGED: [&str; 4] = ["imu.csv", "table.csv", "journal.jsonl", "manifest.yaml"];
+
+/// What `--resume` does with a folder.
+pub enum Resume {
+    /// Record the rest of the run.
+    Run(Box<Prepared>),
+    /// A run that ended but was never sealed: analyse, report and seal it.
+    Seal {
+        /// The plan it ran.
+        plan: Box<ratecal_engine::plan::Plan>,
+        /// Its status (`completed`, `aborted`, `failed`).
+        status: String,
+    },
+}
+
+/// Finishes an interrupted change, then says what to do with the folder, holding its lock.
+pub fn prepare(dir: &Path) -> Result<(Resume, FolderLock), Report> {
     let io = |e: std::io::Error| {
         miette!(
             help = "--resume takes a run folder written by `ratecal run`",
@@ -27,20 +52,124 @@ pub fn prepare(dir: &Path) -> Result<(Prepared, FolderLock), Report> {
     }
     // Taken before the folder's state is read: a second resume is refused, not interleaved.
     let lock = crate::cli::lock::acquire(dir, &crate::cli::seal::command_line())?;
-    let journal = std::fs::read_to_string(dir.join("journal.jsonl")).map_err(io)?;
-    let point = resume_point(&journal);
-    if point.completed {
-        return Err(miette!(
-            "{} is a completed run: nothing to resume",
+    match recover(dir).map_err(io)? {
+        Recovered::Clean => {}
+        Recovered::RolledBack => outln!(
+            "{}: an interrupted resume left staged files; dropped (the sealed run is as it was)",
             dir.display()
-        ));
+        ),
+        Recovered::RolledForward(i) => outln!(
+            "{}: finished an interrupted change ({})",
+            dir.display(),
+            i.moves.join(", ")
+        ),
     }
-    unaltered(dir)?;
+    let state = state_of(dir);
+    let resume = match state {
+        State::Sealed => {
+            return Err(miette!(
+                help = format!("`ratecal verify {}` checks it", dir.display()),
+                "{} is a completed run, sealed: nothing to resume",
+                dir.display()
+            ));
+        }
+        State::Other | State::Committing => {
+            return Err(io(std::io::Error::other(format!(
+                "{} is not a run ratecal recorded ({})",
+                dir.display(),
+                state.name()
+            ))));
+        }
+        State::RecordedUnsealed(status) => {
+            unaltered_streams(dir)?;
+            let text = std::fs::read_to_string(dir.join("manifest.yaml")).map_err(io)?;
+            let manifest = parse_manifest("manifest.yaml", &text).map_err(Report::new)?;
+            same_inputs(dir, &manifest)?;
+            let dry_run = manifest.run.as_ref().is_some_and(|r| r.dry_run);
+            let st = setup::station(Some(&dir.join("station.yaml")), dry_run)?;
+            let pr = setup::procedure(&dir.join("procedure.rcal"), &st.station, Some(dir))?;
+            outln!(
+                "{}: a run that ended ({status}) but was never sealed; its streams match the \
+                 journal's running hash: analysing, reporting and sealing it",
+                dir.display()
+            );
+            Resume::Seal {
+                plan: Box::new(pr.plan),
+                status,
+            }
+        }
+        State::Recording => Resume::Run(Box::new(continue_run(dir, None)?)),
+        State::AbortedSealed(_) => {
+            unaltered(dir)?;
+            let stage = stage(dir).map_err(io)?;
+            Resume::Run(Box::new(continue_run(dir, Some(stage))?))
+        }
+    };
+    Ok((resume, lock))
+}
+
+/// Copies the files a resume appends to into the pending folder (the sealed ones stay as
+/// they are until the commit).
+fn stage(dir: &Path) -> std::io::Result<PathBuf> {
+    let pending = pending_dir(dir)?;
+    for name in STAGED {
+        let to = pending.join(name);
+        std::fs::copy(dir.join(name), &to)?;
+        std::fs::File::open(&to)?.sync_all()?;
+    }
+    sync_dir(&pending)?;
+    crash_point("after-stage");
+    Ok(pending)
+}
+
+/// Replaces the sealed files by the staged ones (the resumed run recorded and closed): one
+/// committed change that also removes the old seal, which no longer covers them.
+pub fn commit_staged(dir: &Path) -> std::io::Result<()> {
+    let intent = Intent {
+        moves: STAGED.iter().map(|s| s.to_string()).collect(),
+        removes: vec![SEAL_FILE.into(), SEAL_HASH_FILE.into()],
+    };
+    // The intent is also on record in the journal that replaces the sealed one.
+    let entry = JournalEntry {
+        t: 0.0,
+        step: None,
+        event: JournalEvent::Commit {
+            moves: intent.moves.clone(),
+            removes: intent.removes.clone(),
+        },
+    };
+    let line = serde_json::to_string(&entry).map_err(std::io::Error::other)?;
+    let journal = dir.join(PENDING_DIR).join("journal.jsonl");
+    let mut f = std::fs::OpenOptions::new().append(true).open(&journal)?;
+    std::io::Write::write_all(&mut f, format!("{line}\n").as_bytes())?;
+    f.sync_all()?;
+    commit(dir, &intent)
+}
+
+/// Drops a staged resume (it failed): the sealed run stays as it was.
+pub fn drop_staged(dir: &Path) {
+    let _ = std::fs::remove_dir_all(dir.join(PENDING_DIR));
+}
+
+/// Opens the rest of a run from its last completed step: in place (`stage` `None`: a run
+/// stopped while recording, never sealed) or on the staged copies.
+fn continue_run(dir: &Path, stage: Option<PathBuf>) -> Result<Prepared, Report> {
+    let io = |e: std::io::Error| {
+        miette!(
+            help = "--resume takes a run folder written by `ratecal run`",
+            "cannot resume {}: {e}",
+            dir.display()
+        )
+    };
+    let write_dir = stage.clone().unwrap_or_else(|| dir.to_path_buf());
+    let journal = std::fs::read_to_string(write_dir.join("journal.jsonl")).map_err(io)?;
+    let point = resume_point(&journal);
     // Checked before anything in the folder is opened for writing.
-    let text = std::fs::read_to_string(dir.join("manifest.yaml")).map_err(io)?;
+    let text = std::fs::read_to_string(write_dir.join("manifest.yaml")).map_err(io)?;
     let manifest = parse_manifest("manifest.yaml", &text).map_err(Report::new)?;
     same_inputs(dir, &manifest)?;
-    let (mut writer, last_t) = RecordingWriter::append(dir).map_err(io)?;
+    let (mut writer, last_t) = RecordingWriter::append(&write_dir, stage.is_some())
+        .map_err(|e| altered_stream(dir, &e.to_string()))?;
     let dry_run = writer.manifest().run.as_ref().is_some_and(|r| r.dry_run);
     let seed = writer
         .manifest()
@@ -50,6 +179,7 @@ pub fn prepare(dir: &Path) -> Result<(Prepared, FolderLock), Report> {
         .unwrap_or(1);
     let st = setup::station(Some(&dir.join("station.yaml")), dry_run)?;
     let pr = setup::procedure(&dir.join("procedure.rcal"), &st.station, Some(dir))?;
+    let cut_tail = writer.cut_tails().clone();
     let m = writer.manifest_mut();
     m.segments.truncate(point.segments);
     if let Some(run) = m.run.as_mut() {
@@ -66,6 +196,7 @@ pub fn prepare(dir: &Path) -> Result<(Prepared, FolderLock), Report> {
             ended: run.ended.clone(),
             resumed: rfc3339(std::time::SystemTime::now()),
             from_step: point.next_step,
+            cut_tail,
         };
         outln!(
             "resuming {} from step {} (interrupted: {}{})",
@@ -82,6 +213,7 @@ pub fn prepare(dir: &Path) -> Result<(Prepared, FolderLock), Report> {
         run.status = "running".into();
         run.abort = None;
         run.failure = None;
+        run.write_failure = None;
         run.ended = None;
         // The data files are hashed again when the run ends; the import copies stand.
         run.files_sha256
@@ -95,15 +227,35 @@ pub fn prepare(dir: &Path) -> Result<(Prepared, FolderLock), Report> {
         t_offset: last_t.map_or(0.0, |t| t + 1.0),
         ..RunOptions::default()
     };
-    let prep = Prepared {
+    Ok(Prepared {
         dir: dir.to_path_buf(),
         plan: pr.plan,
         station: st.station,
         writer,
         opts,
         seed,
-    };
-    Ok((prep, lock))
+        staged: stage.is_some(),
+    })
+}
+
+/// A stream that no longer matches the journal's running hash: altered, not continued or
+/// sealed.
+fn altered_stream(dir: &Path, why: &str) -> Report {
+    miette!(
+        code = "run::resume_altered",
+        help = "the streams are not as they were recorded; nothing was sealed: start a new run",
+        "{} was altered since it was recorded ({why}): not resumed",
+        dir.display()
+    )
+}
+
+/// A run that ended without a seal is sealed only when its streams are as recorded.
+fn unaltered_streams(dir: &Path) -> Result<(), Report> {
+    match ratecal_engine::recording::chain::check_folder(dir) {
+        Ok(Ok(())) => Ok(()),
+        Ok(Err(why)) => Err(altered_stream(dir, &why)),
+        Err(e) => Err(altered_stream(dir, &e.to_string())),
+    }
 }
 
 /// A sealed folder (an aborted run is sealed) must still match its seal.

@@ -219,6 +219,7 @@ pub fn manifest(st: &LoadedStation, proc_: &LoadedProcedure, facts: &RunFacts) -
             resumes: Vec::new(),
             changed_after_release: facts.changed_after_release.clone(),
             sync: None,
+            write_failure: None,
         }),
     }
 }
