@@ -283,6 +283,15 @@ fn a_second_resume_after_a_crashed_one_and_two_resumes_at_once() {
         let (a, b) = (a.wait_with_output().unwrap(), b.wait_with_output().unwrap());
         // One finishes it; the other is refused (in use, or nothing left to resume).
         let codes = [code(&a), code(&b)];
+        // The killed resume may have finished before the kill landed (a fast machine):
+        // then one is told there is nothing to resume and the other that, or that the
+        // folder is in use by the first.
+        let done = |o: &std::process::Output| code(o) == 1 && text(o).contains("nothing to resume");
+        let busy = |o: &std::process::Output| code(o) == 1 && text(o).contains("is in use by");
+        if (done(&a) && (done(&b) || busy(&b))) || (done(&b) && busy(&a)) {
+            finish_and_check(&tmp.path().join(&out), tmp.path(), &format!("c{k}"));
+            continue;
+        }
         assert!(codes.contains(&0), "{}\n{}", text(&a), text(&b));
         assert!(codes.contains(&1), "{}\n{}", text(&a), text(&b));
         let refused = if code(&a) == 1 { &a } else { &b };
