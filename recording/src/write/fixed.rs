@@ -76,6 +76,19 @@ impl Line {
         }
     }
 
+    /// Appends `x` in its shortest form that reads back to the same `f64` (ryu): values
+    /// copied from another system's file, kept exactly.
+    pub(crate) fn shortest(&mut self, x: f64) {
+        if !x.is_finite() {
+            self.fixed::<0>(x);
+            return;
+        }
+        let mut rb = ryu::Buffer::new();
+        let s = rb.format_finite(x);
+        let s = s.strip_suffix(".0").unwrap_or(s);
+        self.bytes(s.as_bytes());
+    }
+
     /// Appends `x` with exactly `DEC` (<= 12) decimals; `DEC` is a constant so that the
     /// divisions below compile to multiplications.
     #[inline(always)]
