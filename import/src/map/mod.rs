@@ -210,6 +210,17 @@ impl Up {
     }
 }
 
+impl RateAxis {
+    /// `x`, `-y`, `outer`, `inner`.
+    pub fn name(self) -> String {
+        match self {
+            RateAxis::Body(i, s) => format!("{}{}", if s < 0.0 { "-" } else { "" }, AXES[i]),
+            RateAxis::Outer => "outer".into(),
+            RateAxis::Inner => "inner".into(),
+        }
+    }
+}
+
 /// Body axis names.
 pub const AXES: [char; 3] = ['x', 'y', 'z'];
 

@@ -266,17 +266,13 @@ fn poses(kept: &[Found]) -> (Vec<Pose>, Vec<Segment>) {
             mount: None,
         };
         let pose = match (f.up, f.rate) {
-            (Some(Up::Axis(k, s)), _) => {
-                last = face_up(k, s);
-                Pose {
-                    t0,
-                    t1,
-                    att: last,
-                    turn: None,
-                }
-            }
-            (_, Some((axis, rate))) => {
-                let (att, outer, r) = turn(axis, rate, last);
+            (up, Some((axis, rate))) => {
+                // A turn starts from its own `up` when the map gives one.
+                let from = match up {
+                    Some(Up::Axis(k, s)) => face_up(k, s),
+                    _ => last,
+                };
+                let (att, outer, r) = turn(axis, rate, from);
                 seg.axis = Some(if outer { "outer" } else { "inner" }.into());
                 seg.rate_dps = Some(r);
                 Pose {
@@ -284,6 +280,15 @@ fn poses(kept: &[Found]) -> (Vec<Pose>, Vec<Segment>) {
                     t1,
                     att,
                     turn: Some((outer, r)),
+                }
+            }
+            (Some(Up::Axis(k, s)), None) => {
+                last = face_up(k, s);
+                Pose {
+                    t0,
+                    t1,
+                    att: last,
+                    turn: None,
                 }
             }
             _ => Pose {
