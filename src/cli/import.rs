@@ -84,7 +84,9 @@ fn print_summary(map: &ImportMap, s: &Summary) {
         "up / axis",
         "|f| m/s^2"
     );
-    for f in s.segments.iter().chain(&s.oblique) {
+    let mut all: Vec<_> = s.segments.iter().chain(&s.oblique).collect();
+    all.sort_by(|a, b| a.stretch.t.0.total_cmp(&b.stretch.t.0));
+    for f in all {
         let st = &f.stretch;
         let what = match (f.kind, f.up, f.rate) {
             (SegmentKind::Static, Some(u), _) => u.name(),
