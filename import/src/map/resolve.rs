@@ -189,15 +189,24 @@ impl Resolver<'_> {
         };
         let encoding = match &s.encoding {
             None => encoding_rs::UTF_8,
-            Some(e) => encoding_rs::Encoding::for_label(e.value.trim().as_bytes()).ok_or_else(
-                || {
-                    self.err(
-                        self.at(&e.referenced),
-                        &format!("unknown encoding `{}`", e.value),
-                        "use a WHATWG encoding label: utf-8, latin-1, windows-1252, utf-16le...",
-                    )
-                },
-            )?,
+            Some(e) => {
+                // WHATWG labels, plus the spelling people write (`latin-1` for `latin1`).
+                let label = e.value.trim();
+                let found = encoding_rs::Encoding::for_label(label.as_bytes()).or_else(|| {
+                    encoding_rs::Encoding::for_label(label.replace('-', "").as_bytes())
+                });
+                match found {
+                    Some(enc) if enc.is_ascii_compatible() => enc,
+                    _ => {
+                        return Err(self.err(
+                            self.at(&e.referenced),
+                            &format!("unknown or unsupported encoding `{}`", e.value),
+                            "an ASCII-compatible WHATWG label: utf-8, latin-1, windows-1252, \
+                             shift_jis...",
+                        ));
+                    }
+                }
+            }
         };
         let header = match &s.header {
             None => true,
