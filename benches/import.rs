@@ -18,12 +18,19 @@ fn generate(dir: &Path, minutes: usize) -> (PathBuf, PathBuf) {
     let csv = dir.join(format!("daq-{minutes}.csv"));
     let mut w = BufWriter::with_capacity(1 << 20, std::fs::File::create(&csv).unwrap());
     writeln!(w, "acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z").unwrap();
-    let faces = [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0]];
+    let faces = [
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, -1.0],
+    ];
     let mut x = 12345u64;
     for i in 0..minutes * 60 * HZ {
         let f = faces[(i / (60 * HZ)) % faces.len()];
         let mut n = || {
-            x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             ((x >> 40) as f64 / (1u64 << 24) as f64 - 0.5) * 2e-3
         };
         writeln!(
@@ -78,7 +85,12 @@ fn import(csv: &Path, map: &Path, out: &Path) -> Option<u64> {
     ];
     let timed = Path::new("/usr/bin/time").exists();
     let o = if timed {
-        Command::new("/usr/bin/time").arg("-f").arg("maxrss_kb=%M").arg(bin).args(args).output()
+        Command::new("/usr/bin/time")
+            .arg("-f")
+            .arg("maxrss_kb=%M")
+            .arg(bin)
+            .args(args)
+            .output()
     } else {
         Command::new(bin).args(args).output()
     }

@@ -26,14 +26,21 @@ fn shared(rel: &str) -> Option<PathBuf> {
 }
 
 fn example_map(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/examples/import").join(name)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("docs/examples/import")
+        .join(name)
 }
 
 /// Rows of a CSV file (after its header) as numbers.
 fn rows(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
     let text = std::fs::read_to_string(path).unwrap();
     let mut lines = text.lines();
-    let header = lines.next().unwrap().split(',').map(str::to_string).collect();
+    let header = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_string)
+        .collect();
     let rows = lines
         .filter(|l| !l.is_empty())
         .map(|l| l.split(',').map(|c| c.parse().unwrap()).collect())
@@ -59,7 +66,14 @@ fn ferraris_session_is_the_hand_converted_example() {
     let cwd = tmp.path();
     let map = example_map("ferraris.yaml");
     let o = ratecal(
-        &["import", src.to_str().unwrap(), "--map", map.to_str().unwrap(), "--out", "run"],
+        &[
+            "import",
+            src.to_str().unwrap(),
+            "--map",
+            map.to_str().unwrap(),
+            "--out",
+            "run",
+        ],
         cwd,
     );
     assert_eq!(code(&o), 0, "{}", text(&o));
@@ -72,7 +86,18 @@ fn ferraris_session_is_the_hand_converted_example() {
     let (h, imp) = rows(&run.join("imu.csv"));
     assert_eq!(h, ["t", "ax", "ay", "az", "gx", "gy", "gz"]);
     let (sh, source) = rows(&src);
-    assert_eq!(sh, ["n_samples", "gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z"]);
+    assert_eq!(
+        sh,
+        [
+            "n_samples",
+            "gyr_x",
+            "gyr_y",
+            "gyr_z",
+            "acc_x",
+            "acc_y",
+            "acc_z"
+        ]
+    );
     assert_eq!(imp.len(), source.len());
     for (i, (a, s)) in imp.iter().zip(&source).enumerate() {
         assert_eq!(a[0], i as f64 / 102.4, "t of sample {i}");
@@ -85,7 +110,10 @@ fn ferraris_session_is_the_hand_converted_example() {
     assert_eq!(ex.len(), imp.len());
     for (a, e) in imp.iter().zip(&ex) {
         for k in 0..7 {
-            assert!((a[k] - e[k]).abs() <= 5e-8 + 1e-9 * e[k].abs(), "{a:?} vs {e:?}");
+            assert!(
+                (a[k] - e[k]).abs() <= 5e-8 + 1e-9 * e[k].abs(),
+                "{a:?} vs {e:?}"
+            );
         }
     }
 
@@ -100,14 +128,23 @@ fn ferraris_session_is_the_hand_converted_example() {
     // by hand: a sample at each edge may differ).
     let o = ratecal(&["analyze", "run", "--out", "imp.json"], cwd);
     assert_eq!(code(&o), 0, "{}", text(&o));
-    let o = ratecal(&["analyze", example.to_str().unwrap(), "--out", "ex.json"], cwd);
+    let o = ratecal(
+        &["analyze", example.to_str().unwrap(), "--out", "ex.json"],
+        cwd,
+    );
     assert_eq!(code(&o), 0, "{}", text(&o));
     let (a, e) = (json(&cwd.join("imp.json")), json(&cwd.join("ex.json")));
     for ax in ["x", "y", "z"] {
         let d = |n: &str| (param(&a, n) - param(&e, n)).abs();
         assert!(d(&format!("accel.bias.{ax}")) < 1e-4, "accel.bias.{ax}");
-        assert!(d(&format!("accel.scale.{ax}")) < 10.0, "accel.scale.{ax} (ppm)");
-        assert!(d(&format!("gyro.bias.{ax}")) < 2e-3, "gyro.bias.{ax} (deg/s)");
+        assert!(
+            d(&format!("accel.scale.{ax}")) < 10.0,
+            "accel.scale.{ax} (ppm)"
+        );
+        assert!(
+            d(&format!("gyro.bias.{ax}")) < 2e-3,
+            "gyro.bias.{ax} (deg/s)"
+        );
     }
 
     // explain reads it (0 nothing found, 1 findings); verify and archive add accept it.
@@ -155,7 +192,10 @@ fn import(data: &str, map: &str) -> (i32, String, Vec<String>) {
     let tmp = tempfile::tempdir().unwrap();
     std::fs::write(tmp.path().join("data.csv"), data).unwrap();
     std::fs::write(tmp.path().join("map.yaml"), map).unwrap();
-    let o = ratecal(&["import", "data.csv", "--map", "map.yaml", "--out", "run"], tmp.path());
+    let o = ratecal(
+        &["import", "data.csv", "--map", "map.yaml", "--out", "run"],
+        tmp.path(),
+    );
     let mut left: Vec<String> = std::fs::read_dir(tmp.path())
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
@@ -199,10 +239,19 @@ fn accelerometers_in_the_wrong_unit_are_refused_at_units_accel() {
         &session(|_, _| {}),
         &m,
         "map.yaml:5:19",
-        &["look like g, not m/s^2: set units.accel", "z_up", "data.csv lines 22-281"],
+        &[
+            "look like g, not m/s^2: set units.accel",
+            "z_up",
+            "data.csv lines 22-281",
+        ],
     );
     let m = MAP.replace("accel: g", "accel: mg");
-    refused(&session(|_, _| {}), &m, "map.yaml:5:19", &["look like g, not mg"]);
+    refused(
+        &session(|_, _| {}),
+        &m,
+        "map.yaml:5:19",
+        &["look like g, not mg"],
+    );
     let data = session(|_, r| {
         for v in &mut r[..3] {
             *v *= 9.80665;
@@ -219,10 +268,20 @@ fn gyros_that_do_not_fit_their_unit_are_refused() {
             *v = v.to_radians();
         }
     });
-    refused(&data, MAP, "map.yaml:9:5", &["look like rad/s, not deg/s", "turn"]);
+    refused(
+        &data,
+        MAP,
+        "map.yaml:9:5",
+        &["look like rad/s, not deg/s", "turn"],
+    );
     // Unsigned counts without their zero: a gyro at rest reading thousands.
     let data = session(|_, r| r[3] += 32768.0);
-    refused(&data, MAP, "map.yaml:5:28", &["not a plausible bias", "zero.gyro"]);
+    refused(
+        &data,
+        MAP,
+        "map.yaml:5:28",
+        &["not a plausible bias", "zero.gyro"],
+    );
 }
 
 #[test]
@@ -240,7 +299,11 @@ fn bad_cells_and_clocks_are_located_in_the_source() {
     let timed = |bad: usize, dt: f64| {
         let mut s = String::from("t,ax,ay,az,gx,gy,gz\n");
         for i in 0..300 {
-            let t = if i == bad { (i as f64 - dt) * 0.01 } else { i as f64 * 0.01 };
+            let t = if i == bad {
+                (i as f64 - dt) * 0.01
+            } else {
+                i as f64 * 0.01
+            };
             s.push_str(&format!("{t},0,0,1,0,0,0\n"));
         }
         s
@@ -252,18 +315,38 @@ imu:
   units: { accel: g, gyro: deg/s }
 site: { latitude_deg: 49.57, gravity_mps2: 9.8096 }
 ";
-    refused(&timed(100, 2.0), map, "data.csv:102:1", &["time goes backwards"]);
+    refused(
+        &timed(100, 2.0),
+        map,
+        "data.csv:102:1",
+        &["time goes backwards"],
+    );
     refused(&timed(100, 1.0), map, "data.csv:102:1", &["time repeats"]);
 }
 
 #[test]
 fn segments_outside_the_data_overlapping_or_contradicted_are_refused() {
     let m = MAP.replace("samples: [620, 880]", "samples: [620, 980]");
-    refused(&session(|_, _| {}), &m, "map.yaml:9:", &["outside the data", "samples 0..900"]);
+    refused(
+        &session(|_, _| {}),
+        &m,
+        "map.yaml:9:",
+        &["outside the data", "samples 0..900"],
+    );
     let m = MAP.replace("samples: [320, 580]", "samples: [250, 580]");
-    refused(&session(|_, _| {}), &m, "map.yaml:8:", &["overlapping or out of order"]);
+    refused(
+        &session(|_, _| {}),
+        &m,
+        "map.yaml:8:",
+        &["overlapping or out of order"],
+    );
     let m = MAP.replace("up: +x", "up: -y");
-    refused(&session(|_, _| {}), &m, "map.yaml:8:", &["`up: -y` is", "gravity says +x is up"]);
+    refused(
+        &session(|_, _| {}),
+        &m,
+        "map.yaml:8:",
+        &["`up: -y` is", "gravity says +x is up"],
+    );
 }
 
 #[test]
@@ -271,7 +354,17 @@ fn map_mistakes_are_located_in_the_map() {
     let m = MAP.replace("units: {", "unit: {");
     refused(&session(|_, _| {}), &m, "map.yaml:5:", &["unknown field"]);
     let m = MAP.replace("gyro: deg/s", "gyro: g");
-    refused(&session(|_, _| {}), &m, "map.yaml:5:", &["is a unit of acceleration"]);
+    refused(
+        &session(|_, _| {}),
+        &m,
+        "map.yaml:5:",
+        &["is a unit of acceleration"],
+    );
     let m = MAP.replace("az: acc_z", "az: acc_zz");
-    refused(&session(|_, _| {}), &m, "map.yaml:4:", &["no column `acc_zz`", "acc_z"]);
+    refused(
+        &session(|_, _| {}),
+        &m,
+        "map.yaml:4:",
+        &["no column `acc_zz`", "acc_z"],
+    );
 }

@@ -23,7 +23,9 @@ fn shared(rel: &str) -> Option<PathBuf> {
 }
 
 fn map(name: &str) -> String {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/examples/import").join(name);
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("docs/examples/import")
+        .join(name);
     p.to_str().unwrap().to_string()
 }
 
@@ -51,11 +53,19 @@ fn intervals(run: &Path) -> Vec<(f64, f64, Option<String>)> {
     let mut v: Vec<(f64, f64, Option<String>)> = Vec::new();
     for s in m["segments"].as_array().unwrap() {
         assert_eq!(s["kind"], "static");
-        v.push((s["t_start"].as_f64().unwrap(), s["t_end"].as_f64().unwrap(), None));
+        v.push((
+            s["t_start"].as_f64().unwrap(),
+            s["t_end"].as_f64().unwrap(),
+            None,
+        ));
     }
     if let Some(o) = m["provenance"]["oblique_static"].as_array() {
         for s in o {
-            v.push((s["t_start"].as_f64().unwrap(), s["t_end"].as_f64().unwrap(), Some("oblique".into())));
+            v.push((
+                s["t_start"].as_f64().unwrap(),
+                s["t_end"].as_f64().unwrap(),
+                Some("oblique".into()),
+            ));
         }
     }
     v.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -72,15 +82,31 @@ fn imu_tk_xsens_poses_are_found_and_static_by_the_factory_calibration() {
     };
     let tmp = tempfile::tempdir().unwrap();
     let o = ratecal(
-        &["import", acc.to_str().unwrap(), gyr.to_str().unwrap(), "--map", &map("imu_tk-xsens.yaml"), "--out", "run"],
+        &[
+            "import",
+            acc.to_str().unwrap(),
+            gyr.to_str().unwrap(),
+            "--map",
+            &map("imu_tk-xsens.yaml"),
+            "--out",
+            "run",
+        ],
         tmp.path(),
     );
     assert_eq!(code(&o), 0, "{}", text(&o));
-    assert!(text(&o).contains("detected from the signal"), "{}", text(&o));
+    assert!(
+        text(&o).contains("detected from the signal"),
+        "{}",
+        text(&o)
+    );
     let run = tmp.path().join("run");
     let found = intervals(&run);
     // About 50 s at rest, then about 37 poses (the source's README).
-    assert!((35..=42).contains(&found.len()), "{} intervals", found.len());
+    assert!(
+        (35..=42).contains(&found.len()),
+        "{} intervals",
+        found.len()
+    );
     assert!(found[0].0 < 0.1 && found[0].1 > 45.0, "{:?}", found[0]);
 
     // The time column is the source's, exactly; the gyro file's columns follow the accel's.
@@ -89,7 +115,9 @@ fn imu_tk_xsens_poses_are_found_and_static_by_the_factory_calibration() {
     assert_eq!(imu.len(), a.len());
     for i in [0, 1000, a.len() - 1] {
         assert_eq!(imu[i][0], a[i][0]);
-        assert!((imu[i][4] - (g[i][1] - 32768.0) / 4767.0 * 180.0 / std::f64::consts::PI).abs() < 1e-9);
+        assert!(
+            (imu[i][4] - (g[i][1] - 32768.0) / 4767.0 * 180.0 / std::f64::consts::PI).abs() < 1e-9
+        );
     }
 
     // Each interval, averaged from the source's raw counts and calibrated with the factory
@@ -112,7 +140,10 @@ fn imu_tk_xsens_poses_are_found_and_static_by_the_factory_calibration() {
             });
         }
         let norm = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
-        assert!((norm - 9.803).abs() < 0.05, "interval {t0}..{t1}: |a| = {norm}");
+        assert!(
+            (norm - 9.803).abs() < 0.05,
+            "interval {t0}..{t1}: |a| = {norm}"
+        );
     }
 }
 
@@ -123,14 +154,25 @@ fn mpu6050_start_up_rest_and_poses_are_found() {
     };
     let tmp = tempfile::tempdir().unwrap();
     let o = ratecal(
-        &["import", src.to_str().unwrap(), "--map", &map("mpu6050.yaml"), "--out", "run"],
+        &[
+            "import",
+            src.to_str().unwrap(),
+            "--map",
+            &map("mpu6050.yaml"),
+            "--out",
+            "run",
+        ],
         tmp.path(),
     );
     assert_eq!(code(&o), 0, "{}", text(&o));
     let run = tmp.path().join("run");
     let found = intervals(&run);
     // The logger's own header: "Initialization time,36.5" (s at rest, z up).
-    assert!(found[0].0 == 0.0 && (35.0..38.0).contains(&found[0].1), "{:?}", found[0]);
+    assert!(
+        found[0].0 == 0.0 && (35.0..38.0).contains(&found[0].1),
+        "{:?}",
+        found[0]
+    );
     assert!(found.len() >= 6, "{found:?}");
     // Every interval reads one g within the part's tolerances, from the raw registers.
     let raw = numbers(&src, 5);

@@ -110,13 +110,8 @@ impl ImportError {
         let (start, end) = (range.start, range.end);
         let start = start.min(line_text.len());
         let end = end.clamp(start, line_text.len()).max(start + 1);
-        let (src, span) = Excerpt::around_at(
-            file,
-            line_text,
-            line.saturating_sub(1) as usize,
-            start,
-            end,
-        );
+        let (src, span) =
+            Excerpt::around_at(file, line_text, line.saturating_sub(1) as usize, start, end);
         let column = String::from_utf8_lossy(&line_text[..start]).chars().count() + 1;
         Box::new(ImportError {
             kind,

@@ -55,7 +55,10 @@ fn located(e: &ImportError, file: &str) {
         assert!(e.column.is_some() && e.span.is_some(), "{e:?}");
     } else {
         // Whole-file problems (too short, ragged sources) name the file.
-        assert!(matches!(e.kind, ErrorKind::Cell | ErrorKind::Io | ErrorKind::Format), "{e:?}");
+        assert!(
+            matches!(e.kind, ErrorKind::Cell | ErrorKind::Io | ErrorKind::Format),
+            "{e:?}"
+        );
     }
     let _ = rendered(e);
 }

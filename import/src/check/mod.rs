@@ -51,7 +51,13 @@ pub fn check(map: &ImportMap, found: &[Found], source: &str) -> Result<(), Box<I
                                  and the columns"
                             .into(),
                     };
-                    return Err(at_map(map, map.accel.at.clone(), ErrorKind::Units, &what, &help));
+                    return Err(at_map(
+                        map,
+                        map.accel.at.clone(),
+                        ErrorKind::Units,
+                        &what,
+                        &help,
+                    ));
                 }
                 let wm = s.mag_w.median();
                 if wm > GYRO_REST_MAX_DPS {
@@ -66,7 +72,13 @@ pub fn check(map: &ImportMap, found: &[Found], source: &str) -> Result<(), Box<I
                          need their zero)",
                         map.gyro.unit
                     );
-                    return Err(at_map(map, map.gyro.at.clone(), ErrorKind::Units, &what, &help));
+                    return Err(at_map(
+                        map,
+                        map.gyro.at.clone(),
+                        ErrorKind::Units,
+                        &what,
+                        &help,
+                    ));
                 }
                 if let (Some(Up::Axis(k, sign)), Some(d)) = (f.up, decl(f)) {
                     check_up(map, d, f, k, sign, &lines)?;
@@ -84,7 +96,8 @@ pub fn check(map: &ImportMap, found: &[Found], source: &str) -> Result<(), Box<I
                          its axis, the map declares {rate} deg/s",
                         f.id
                     );
-                    let looks = likely_unit(measured.abs() / map.gyro.factor, rate.abs(), Dim::Rate);
+                    let looks =
+                        likely_unit(measured.abs() / map.gyro.factor, rate.abs(), Dim::Rate);
                     let help = match looks {
                         Some(u) if u != map.gyro.unit => format!(
                             "the gyro columns look like {u}, not {}: set units.gyro",

@@ -231,6 +231,8 @@ pub fn signed_axis(text: &str) -> Option<(usize, f64)> {
         Some(n) => (-1.0, n),
         None => (1.0, t.strip_prefix('+').unwrap_or(t)),
     };
-    let i = AXES.iter().position(|c| name.len() == 1 && name.starts_with(*c))?;
+    let i = AXES
+        .iter()
+        .position(|c| name.len() == 1 && name.starts_with(*c))?;
     Some((i, sign))
 }

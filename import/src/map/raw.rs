@@ -1,8 +1,8 @@
 //! The import map as written (YAML keys, with the location of every value a later check may
 //! refuse); `resolve.rs` turns it into an [`crate::ImportMap`].
 
-use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::Deserialize;
+use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde_saphyr::Spanned;
 use std::collections::BTreeMap;
 use std::fmt;

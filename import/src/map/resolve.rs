@@ -106,8 +106,16 @@ impl Resolver<'_> {
             }
         }
         let zero = raw.imu.zero.as_ref();
-        let accel = self.scale(&raw.imu.units.accel, Dim::Accel, zero.and_then(|z| z.accel.clone()))?;
-        let gyro = self.scale(&raw.imu.units.gyro, Dim::Rate, zero.and_then(|z| z.gyro.clone()))?;
+        let accel = self.scale(
+            &raw.imu.units.accel,
+            Dim::Accel,
+            zero.and_then(|z| z.accel.clone()),
+        )?;
+        let gyro = self.scale(
+            &raw.imu.units.gyro,
+            Dim::Rate,
+            zero.and_then(|z| z.gyro.clone()),
+        )?;
         let axes = self.axes(raw.imu.axes.as_ref())?;
         let site = self.site(&raw)?;
         if let Some(t) = &raw.table
@@ -171,13 +179,17 @@ impl Resolver<'_> {
         let format = match s.format.value.as_str() {
             "csv" => Format::Csv,
             "mat" => Format::Mat {
-                variable: s.variable.as_ref().map(|v| v.value.clone()).ok_or_else(|| {
-                    self.err(
-                        self.at(&s.format.referenced),
-                        "a MATLAB source needs `variable:` (the matrix to read)",
-                        "write `source: { format: mat, variable: cal_data }`",
-                    )
-                })?,
+                variable: s
+                    .variable
+                    .as_ref()
+                    .map(|v| v.value.clone())
+                    .ok_or_else(|| {
+                        self.err(
+                            self.at(&s.format.referenced),
+                            "a MATLAB source needs `variable:` (the matrix to read)",
+                            "write `source: { format: mat, variable: cal_data }`",
+                        )
+                    })?,
             },
             other => {
                 return Err(self.err(
@@ -229,7 +241,10 @@ impl Resolver<'_> {
                 Delimiter::Byte(d.as_bytes()[0])
             }
             Some(d) => {
-                let at = s.delimiter.as_ref().map_or(0..0, |d| self.at(&d.referenced));
+                let at = s
+                    .delimiter
+                    .as_ref()
+                    .map_or(0..0, |d| self.at(&d.referenced));
                 return Err(self.err(
                     at,
                     &format!("delimiter `{d}`"),
@@ -419,7 +434,10 @@ impl Resolver<'_> {
             _ => {
                 return Err(self.err(
                     at,
-                    &format!("segment `{}` needs `samples` or `time` (one of them)", v.id.value),
+                    &format!(
+                        "segment `{}` needs `samples` or `time` (one of them)",
+                        v.id.value
+                    ),
                     "samples: [from, to) (0-based, to excluded) or time: [t0, t1) in seconds",
                 ));
             }
@@ -428,15 +446,17 @@ impl Resolver<'_> {
         let up = match &v.up {
             None => None,
             Some(u) if u.value == "oblique" => Some(Up::Oblique),
-            Some(u) => Some(signed_axis(&u.value).map(|(i, s)| Up::Axis(i, s)).ok_or_else(
-                || {
-                    self.err(
-                        up_at.clone(),
-                        &format!("`{}` is not an axis", u.value),
-                        "up is a body axis with its sign (+x, -z...) or `oblique`",
-                    )
-                },
-            )?),
+            Some(u) => Some(
+                signed_axis(&u.value)
+                    .map(|(i, s)| Up::Axis(i, s))
+                    .ok_or_else(|| {
+                        self.err(
+                            up_at.clone(),
+                            &format!("`{}` is not an axis", u.value),
+                            "up is a body axis with its sign (+x, -z...) or `oblique`",
+                        )
+                    })?,
+            ),
         };
         let rate = match kind {
             SegmentKind::Static => {
@@ -502,7 +522,10 @@ fn yaml_error(err: &serde_saphyr::Error, text: &str, file: &str) -> Box<ImportEr
     let first = msg.lines().next().unwrap_or("").trim();
     let what = first.find(" at line ").map_or(first, |i| &first[..i]);
     let help = if what.contains("unknown field") {
-        format!("{}; {HELP}", what.split_once("expected ").map_or("", |x| x.1))
+        format!(
+            "{}; {HELP}",
+            what.split_once("expected ").map_or("", |x| x.1)
+        )
     } else {
         HELP.to_string()
     };

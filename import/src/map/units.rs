@@ -12,7 +12,10 @@ pub fn scale_of(text: &str, dim: Dim) -> Result<f64, String> {
     let t = text.trim();
     let (got, factor) = if let Some((d, f)) = unit(t) {
         (d, f)
-    } else if let Some(body) = COUNT.iter().find_map(|c| t.strip_suffix(&format!("/{c}")[..])) {
+    } else if let Some(body) = COUNT
+        .iter()
+        .find_map(|c| t.strip_suffix(&format!("/{c}")[..]))
+    {
         // `0.000488 g/count`: one count is that quantity.
         parse_quantity(body).ok_or_else(|| not_a_unit(t, dim))?
     } else if let Some((n, u)) = COUNT
@@ -37,7 +40,9 @@ pub fn scale_of(text: &str, dim: Dim) -> Result<f64, String> {
         ));
     }
     if !factor.is_finite() || factor == 0.0 {
-        return Err(format!("`{t}` is not a usable scale (zero or out of range)"));
+        return Err(format!(
+            "`{t}` is not a usable scale (zero or out of range)"
+        ));
     }
     Ok(factor)
 }
@@ -74,7 +79,11 @@ mod tests {
         assert_eq!(scale_of("131 LSB/deg/s", Dim::Rate), Ok(1.0 / 131.0));
         let rad = scale_of("rad/s", Dim::Rate).unwrap();
         assert!((rad - 57.29577951308232).abs() < 1e-12);
-        assert!(scale_of("deg/s", Dim::Accel).unwrap_err().contains("angular rate"));
+        assert!(
+            scale_of("deg/s", Dim::Accel)
+                .unwrap_err()
+                .contains("angular rate")
+        );
         assert!(scale_of("furlong", Dim::Accel).is_err());
         assert!(scale_of("0 count/g", Dim::Accel).is_err());
         assert_eq!(seconds_per("ms"), Some(1e-3));

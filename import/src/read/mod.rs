@@ -6,7 +6,7 @@
 mod cells;
 mod mat;
 
-pub use cells::{split_cells, sniff};
+pub use cells::{sniff, split_cells};
 pub use mat::check_mat;
 
 use crate::error::{ErrorKind, ImportError, Say};
@@ -84,7 +84,13 @@ impl LineSource {
         }
     }
 
-    fn error(&self, range: Range<usize>, kind: ErrorKind, what: &str, help: &str) -> Box<ImportError> {
+    fn error(
+        &self,
+        range: Range<usize>,
+        kind: ErrorKind,
+        what: &str,
+        help: &str,
+    ) -> Box<ImportError> {
         ImportError::in_line(
             kind,
             &self.name,
@@ -219,10 +225,7 @@ impl Rows {
         let local = slots
             .iter()
             .map(|&g| {
-                let k = sources
-                    .iter()
-                    .rposition(|s| s.offset <= g)
-                    .unwrap_or(0);
+                let k = sources.iter().rposition(|s| s.offset <= g).unwrap_or(0);
                 (k, g - sources[k].offset)
             })
             .collect();
@@ -306,7 +309,13 @@ impl Rows {
     }
 
     /// An error at slot `slot` of the row just read.
-    pub fn cell_error(&self, slot: usize, kind: ErrorKind, what: &str, help: &str) -> Box<ImportError> {
+    pub fn cell_error(
+        &self,
+        slot: usize,
+        kind: ErrorKind,
+        what: &str,
+        help: &str,
+    ) -> Box<ImportError> {
         let (k, c) = self.local[slot];
         let s = &self.sources[k];
         let r = s.cells.get(c).cloned().unwrap_or(0..0);

@@ -76,9 +76,15 @@ mod tests {
     #[test]
     fn turns_about_body_axes() {
         // Body x is the inner axis at every attitude.
-        assert_eq!(turn(RateAxis::Body(0, 1.0), 10.0, (0.0, 0.0)), ((0.0, 0.0), false, 10.0));
+        assert_eq!(
+            turn(RateAxis::Body(0, 1.0), 10.0, (0.0, 0.0)),
+            ((0.0, 0.0), false, 10.0)
+        );
         // Body y is minus the outer axis at inner 0.
-        assert_eq!(turn(RateAxis::Body(1, 1.0), 10.0, (0.0, 0.0)), ((0.0, 0.0), true, -10.0));
+        assert_eq!(
+            turn(RateAxis::Body(1, 1.0), 10.0, (0.0, 0.0)),
+            ((0.0, 0.0), true, -10.0)
+        );
         // Body z: the outer axis once the inner axis stands at 90 deg.
         let (att, outer, r) = turn(RateAxis::Body(2, -1.0), 10.0, (0.0, 0.0));
         assert!(outer && att == (0.0, 90.0), "{att:?} {outer}");

@@ -177,7 +177,15 @@ mod tests {
                 let t = i as f64 / 100.0;
                 let ff = [f[0] + n, f[1] - n, f[2] + n];
                 let ww = [w * (t * 3.0).sin() + n, n, w];
-                b.add(RowAt { sample: i, line: i + 2 }, t, &ff, &ww);
+                b.add(
+                    RowAt {
+                        sample: i,
+                        line: i + 2,
+                    },
+                    t,
+                    &ff,
+                    &ww,
+                );
                 i += 1;
             }
         };

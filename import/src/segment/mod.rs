@@ -90,15 +90,16 @@ impl Tracker {
                 } else {
                     format!(
                         "the data hold samples 0..{} (t = {} to {} s)",
-                        all.n,
-                        all.t.0,
-                        all.t.1
+                        all.n, all.t.0, all.t.1
                     )
                 };
                 let what = if outside {
                     format!("segment `{}` lies outside the data: {data}", d.id)
                 } else {
-                    format!("segment `{}` takes no sample: it overlaps another ({data})", d.id)
+                    format!(
+                        "segment `{}` takes no sample: it overlaps another ({data})",
+                        d.id
+                    )
                 };
                 return Err(seg_error(map, d, &what));
             }

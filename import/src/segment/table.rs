@@ -26,7 +26,11 @@ impl Pose {
         let (mut ro, mut ri) = (0.0, 0.0);
         if let Some((outer, r)) = self.turn {
             let angle = r * (t.clamp(self.t0, self.t1) - self.t0);
-            let rate = if (self.t0..=self.t1).contains(&t) { r } else { 0.0 };
+            let rate = if (self.t0..=self.t1).contains(&t) {
+                r
+            } else {
+                0.0
+            };
             if outer {
                 o += angle;
                 ro = rate;
@@ -78,8 +82,18 @@ mod tests {
     #[test]
     fn holds_attitudes_and_integrates_turns() {
         let poses = [
-            Pose { t0: 1.0, t1: 3.0, att: (90.0, 0.0), turn: None },
-            Pose { t0: 5.0, t1: 7.0, att: (0.0, 0.0), turn: Some((false, -90.0)) },
+            Pose {
+                t0: 1.0,
+                t1: 3.0,
+                att: (90.0, 0.0),
+                turn: None,
+            },
+            Pose {
+                t0: 5.0,
+                t1: 7.0,
+                att: (0.0, 0.0),
+                turn: Some((false, -90.0)),
+            },
         ];
         let mut v = Vec::new();
         synthesize(&poses, 0.0, 9.0, |s| v.push(s));

@@ -77,14 +77,17 @@ pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> 
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    let name = out.file_name().map_or("import".into(), |n| n.to_string_lossy().into_owned());
+    let name = out
+        .file_name()
+        .map_or("import".into(), |n| n.to_string_lossy().into_owned());
     let stage = parent.join(format!(".{name}.import-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&stage);
     let mut guard = Staging(Some(stage.clone()));
     let io = |e: std::io::Error| out_error(out, &format!("cannot write: {e}"));
 
-    let mut writer = RecordingWriter::create_exact(&stage, manifest(map, Vec::new()), Columns::default())
-        .map_err(io)?;
+    let mut writer =
+        RecordingWriter::create_exact(&stage, manifest(map, Vec::new()), Columns::default())
+            .map_err(io)?;
     let mut cols: Vec<&crate::map::Col> = map.columns.iter().collect();
     if let TimeSpec::Column { col, .. } = &map.time {
         cols.push(col);
@@ -168,7 +171,10 @@ pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> 
     let m = writer.manifest().clone();
     let dropped = writer.close();
     if dropped > 0 {
-        return Err(out_error(out, &format!("{dropped} samples could not be written (internal error)")));
+        return Err(out_error(
+            out,
+            &format!("{dropped} samples could not be written (internal error)"),
+        ));
     }
     let _ = std::fs::remove_file(stage.join("journal.jsonl"));
     let prov = Provenance {

@@ -76,7 +76,14 @@ impl Conversion {
             .axes
             .iter()
             .enumerate()
-            .map(|(b, (i, s))| format!("{} = {}{}", AXES[b], if *s < 0.0 { "-" } else { "" }, AXES[*i]))
+            .map(|(b, (i, s))| {
+                format!(
+                    "{} = {}{}",
+                    AXES[b],
+                    if *s < 0.0 { "-" } else { "" },
+                    AXES[*i]
+                )
+            })
             .collect::<Vec<_>>()
             .join(", ");
         let triad = |s: &crate::map::Scale, unit: &str| {
