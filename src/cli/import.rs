@@ -30,7 +30,13 @@ pub fn main(args: Args) -> ExitCode {
     let text = match std::fs::read(&args.map) {
         Ok(b) => String::from_utf8_lossy(&b).into_owned(),
         Err(e) => {
-            errln!("error: cannot read the import map {name}: {e}");
+            let e = ratecal_import::ImportError::in_file(
+                ratecal_import::ErrorKind::Io,
+                &name,
+                &format!("cannot read the import map: {e}"),
+                "--map names the YAML import map (docs/import.md)",
+            );
+            errln!("{:?}", miette::Report::new(*e));
             return ExitCode::from(1);
         }
     };

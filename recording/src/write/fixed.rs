@@ -202,4 +202,19 @@ mod tests {
         assert_eq!(fixed(9.0, 6), "9.000000");
         assert_eq!(fixed(1e300, 6), "1e300");
     }
+
+    #[test]
+    fn shortest_reads_back_exactly() {
+        let short = |x: f64| {
+            let mut l = Line::new();
+            l.shortest(x);
+            String::from_utf8(l.as_bytes().to_vec()).unwrap()
+        };
+        assert_eq!(short(1.0), "1");
+        assert_eq!(short(-0.25), "-0.25");
+        assert_eq!(short(f64::NAN), "NaN");
+        for x in [10.332114257812501, 0.1 + 0.2, 1e-7, -4.4e-17, 5700.000001, 1e300] {
+            assert_eq!(short(x).parse::<f64>().unwrap(), x, "{x}");
+        }
+    }
 }
