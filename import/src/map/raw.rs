@@ -123,7 +123,7 @@ pub struct RawSite {
 #[derive(Debug)]
 pub enum RawSegments {
     List(Vec<Spanned<RawSegment>>),
-    Detect(RawDetect),
+    Detect(Box<RawDetect>),
 }
 
 /// One declared segment.
@@ -184,7 +184,7 @@ impl<'de> Deserialize<'de> for RawSegments {
             }
             fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<Self::Value, A::Error> {
                 let w = RawDetectWrap::deserialize(de::value::MapAccessDeserializer::new(map))?;
-                Ok(RawSegments::Detect(w.detect))
+                Ok(RawSegments::Detect(Box::new(w.detect)))
             }
         }
         d.deserialize_any(V)

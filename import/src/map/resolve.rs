@@ -426,7 +426,9 @@ impl Resolver<'_> {
             }
             (None, Some(r)) => {
                 let at = self.at(&r.referenced);
-                if !(r.value[0] < r.value[1]) || !r.value[1].is_finite() {
+                if r.value[0].partial_cmp(&r.value[1]) != Some(std::cmp::Ordering::Less)
+                    || !r.value[1].is_finite()
+                {
                     return Err(self.err(at, "time [t0, t1) needs t0 < t1", HELP));
                 }
                 (SegRange::Time(r.value[0], r.value[1]), at)

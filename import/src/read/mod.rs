@@ -171,12 +171,10 @@ impl Rows {
                          (or write `header: none`)",
                     ));
                 }
-                let (text, _, _) = map.source.encoding.decode(&s.buf);
                 for c in &s.cells {
                     let (t, _, _) = map.source.encoding.decode(&s.buf[c.clone()]);
                     names.push(unquote(t.trim()).to_string());
                 }
-                let _ = text;
                 s.width = Some(s.cells.len());
                 offset += s.cells.len();
             } else {
