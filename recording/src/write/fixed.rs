@@ -213,7 +213,14 @@ mod tests {
         assert_eq!(short(1.0), "1");
         assert_eq!(short(-0.25), "-0.25");
         assert_eq!(short(f64::NAN), "NaN");
-        for x in [10.332114257812501, 0.1 + 0.2, 1e-7, -4.4e-17, 5700.000001, 1e300] {
+        for x in [
+            10.332114257812501,
+            0.1 + 0.2,
+            1e-7,
+            -4.4e-17,
+            5700.000001,
+            1e300,
+        ] {
             assert_eq!(short(x).parse::<f64>().unwrap(), x, "{x}");
         }
     }
