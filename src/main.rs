@@ -53,6 +53,8 @@ enum Command {
     Key(cli::key::Args),
     /// The calibration archive: add, list, show, export, trend, backup, check.
     Archive(cli::archive::Args),
+    /// Convert a lab's own DAQ files (CSV, raw counts, no time column) to a recording.
+    Import(cli::import::Args),
 }
 
 fn main() -> ExitCode {
@@ -70,5 +72,6 @@ fn main() -> ExitCode {
         Command::Explain(a) => cli::explain::main(a),
         Command::Key(a) => cli::key::main(a),
         Command::Archive(a) => cli::archive::main(a),
+        Command::Import(a) => cli::import::main(a),
     }
 }

@@ -8,6 +8,7 @@ pub mod diff;
 pub mod emulate;
 pub mod explain;
 pub mod fmt;
+pub mod import;
 pub mod key;
 pub mod lock;
 pub mod log;

@@ -76,6 +76,19 @@ impl Line {
         }
     }
 
+    /// Appends `x` in its shortest form that reads back to the same `f64` (ryu): values
+    /// copied from another system's file, kept exactly.
+    pub(crate) fn shortest(&mut self, x: f64) {
+        if !x.is_finite() {
+            self.fixed::<0>(x);
+            return;
+        }
+        let mut rb = ryu::Buffer::new();
+        let s = rb.format_finite(x);
+        let s = s.strip_suffix(".0").unwrap_or(s);
+        self.bytes(s.as_bytes());
+    }
+
     /// Appends `x` with exactly `DEC` (<= 12) decimals; `DEC` is a constant so that the
     /// divisions below compile to multiplications.
     #[inline(always)]
@@ -188,5 +201,27 @@ mod tests {
         assert_eq!(fixed(123456.789, 2), "123456.79");
         assert_eq!(fixed(9.0, 6), "9.000000");
         assert_eq!(fixed(1e300, 6), "1e300");
+    }
+
+    #[test]
+    fn shortest_reads_back_exactly() {
+        let short = |x: f64| {
+            let mut l = Line::new();
+            l.shortest(x);
+            String::from_utf8(l.as_bytes().to_vec()).unwrap()
+        };
+        assert_eq!(short(1.0), "1");
+        assert_eq!(short(-0.25), "-0.25");
+        assert_eq!(short(f64::NAN), "NaN");
+        for x in [
+            10.332114257812501,
+            0.1 + 0.2,
+            1e-7,
+            -4.4e-17,
+            5700.000001,
+            1e300,
+        ] {
+            assert_eq!(short(x).parse::<f64>().unwrap(), x, "{x}");
+        }
     }
 }

@@ -147,6 +147,22 @@ impl RecordingWriter {
 
     /// Creates `dir` (if needed) and the recording's files; writes the manifest once.
     pub fn create(dir: &Path, manifest: Manifest, columns: Columns) -> io::Result<Self> {
+        Self::create_with(dir, manifest, columns, false)
+    }
+
+    /// As [`RecordingWriter::create`], but the IMU stream's times and values are written in
+    /// their shortest form that reads back to the same `f64` (an import: another system's
+    /// samples kept exactly, not rounded to the format's usual decimals).
+    pub fn create_exact(dir: &Path, manifest: Manifest, columns: Columns) -> io::Result<Self> {
+        Self::create_with(dir, manifest, columns, true)
+    }
+
+    fn create_with(
+        dir: &Path,
+        manifest: Manifest,
+        columns: Columns,
+        exact: bool,
+    ) -> io::Result<Self> {
         std::fs::create_dir_all(dir)?;
         let imu = Stream::create(&dir.join("imu.csv"), &columns.imu_header())?;
         let table = Stream::create(&dir.join("table.csv"), &columns.table_header())?;
@@ -158,6 +174,7 @@ impl RecordingWriter {
             table,
             columns,
             dropped: 0,
+            exact,
             journal,
         };
         let mut w = Self::start(dir, streams, manifest)?;
@@ -198,6 +215,7 @@ impl RecordingWriter {
             table,
             columns,
             dropped: 0,
+            exact: false,
             journal,
         };
         let mut w = Self::start(dir, streams, manifest)?;

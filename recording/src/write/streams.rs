@@ -299,6 +299,8 @@ pub(crate) struct Streams {
     pub dropped: u64,
     /// `journal.jsonl`: the run's events and the streams' block records, in order.
     pub journal: File,
+    /// IMU values written in their shortest exact form instead of fixed decimals.
+    pub exact: bool,
 }
 
 impl Streams {
@@ -356,14 +358,22 @@ impl Streams {
             }
             self.imu.last_t = Some(s.t);
             let mut l = Line::new();
-            l.fixed::<T_DEC>(s.t);
-            for v in s.accel {
-                l.byte(b',');
-                l.fixed::<ACCEL_DEC>(v);
-            }
-            for v in s.gyro {
-                l.byte(b',');
-                l.fixed::<GYRO_DEC>(v);
+            if self.exact {
+                l.shortest(s.t);
+                for v in s.accel.into_iter().chain(s.gyro) {
+                    l.byte(b',');
+                    l.shortest(v);
+                }
+            } else {
+                l.fixed::<T_DEC>(s.t);
+                for v in s.accel {
+                    l.byte(b',');
+                    l.fixed::<ACCEL_DEC>(v);
+                }
+                for v in s.gyro {
+                    l.byte(b',');
+                    l.fixed::<GYRO_DEC>(v);
+                }
             }
             if self.columns.imu_temp {
                 l.byte(b',');

@@ -1,0 +1,311 @@
+//! The import itself: stream the sources through the conversion into a staging folder
+//! beside `--out`, follow or detect the segments, check the data against the map, then
+//! synthesize the table stream, write the manifest with its provenance and move the folder
+//! into place. A refusal removes the staging folder: nothing is written.
+
+mod provenance;
+
+pub use provenance::{Conversion, FileHash, Oblique, Provenance};
+
+use crate::check;
+use crate::error::{ErrorKind, ImportError};
+use crate::map::{Format, ImportMap, Segments, TimeSpec, Up};
+use crate::read::{self, Rows};
+use crate::segment::table::{Pose, synthesize};
+use crate::segment::{Found, Stretch, Tracker, face_up, turn};
+use ratecal_recording::{
+    Columns, FORMAT, ImuSample, Manifest, ManifestStation, RecordingWriter, Segment, SegmentKind,
+    TableAxes,
+};
+use std::path::{Path, PathBuf};
+
+type Res<T> = Result<T, Box<ImportError>>;
+
+/// What an import wrote (printed for the engineer to confirm).
+#[derive(Debug, Clone)]
+pub struct Summary {
+    /// The recording folder.
+    pub out: PathBuf,
+    /// IMU samples.
+    pub samples: u64,
+    /// First and last time, s.
+    pub t: (f64, f64),
+    /// The manifest's segments.
+    pub segments: Vec<Found>,
+    /// Oblique static intervals (in the provenance, not among the segments).
+    pub oblique: Vec<Found>,
+    /// Whether the segments were detected.
+    pub detected: bool,
+    /// Table samples synthesized.
+    pub table_samples: u64,
+}
+
+/// Removes the staging folder unless the import completed.
+struct Staging(Option<PathBuf>);
+
+impl Drop for Staging {
+    fn drop(&mut self) {
+        if let Some(p) = self.0.take() {
+            let _ = std::fs::remove_dir_all(p);
+        }
+    }
+}
+
+fn out_error(out: &Path, what: &str) -> Box<ImportError> {
+    ImportError::in_file(
+        ErrorKind::Io,
+        &out.display().to_string(),
+        what,
+        "--out names a new folder (or an empty one) in a writable directory",
+    )
+}
+
+/// Imports `sources` with `map` into the new recording folder `out`.
+pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> {
+    if let Format::Mat { variable } = &map.source.format {
+        for s in sources {
+            read::check_mat(s, variable)?;
+        }
+    }
+    if out.exists() {
+        let empty = out.is_dir() && std::fs::read_dir(out).is_ok_and(|mut d| d.next().is_none());
+        if !empty {
+            return Err(out_error(out, "already exists"));
+        }
+    }
+    let parent = out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = out
+        .file_name()
+        .map_or("import".into(), |n| n.to_string_lossy().into_owned());
+    let stage = parent.join(format!(".{name}.import-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&stage);
+    let mut guard = Staging(Some(stage.clone()));
+    let io = |e: std::io::Error| out_error(out, &format!("cannot write: {e}"));
+
+    let mut writer =
+        RecordingWriter::create_exact(&stage, manifest(map, Vec::new()), Columns::default())
+            .map_err(io)?;
+    let mut cols: Vec<&crate::map::Col> = map.columns.iter().collect();
+    if let TimeSpec::Column { col, .. } = &map.time {
+        cols.push(col);
+    }
+    let paths: Vec<&Path> = sources.iter().map(PathBuf::as_path).collect();
+    let mut rows = Rows::open(&paths, map, &cols)?;
+    let mut tracker = Tracker::new(map);
+    let mut all = Stretch::default();
+    let mut cells = [0f64; 7];
+    let mut last_t: Option<f64> = None;
+    let (a, g) = (&map.accel, &map.gyro);
+    while let Some(at) = rows.next(&mut cells)? {
+        let t = match &map.time {
+            TimeSpec::Rate(hz) => at.sample as f64 / hz,
+            TimeSpec::Column { to_s, .. } => {
+                let t = cells[6] * to_s;
+                if let Some(l) = last_t
+                    && t <= l
+                {
+                    let what = if t == l {
+                        format!("time repeats: t = {t} s twice")
+                    } else {
+                        format!("time goes backwards: t = {t} s after {l} s")
+                    };
+                    return Err(rows.cell_error(
+                        6,
+                        ErrorKind::Time,
+                        &what,
+                        "sample times must increase strictly; nothing is reordered or dropped",
+                    ));
+                }
+                t
+            }
+        };
+        last_t = Some(t);
+        let s_f: [f64; 3] = std::array::from_fn(|k| (cells[k] - a.zero[k]) * a.factor);
+        let s_w: [f64; 3] = std::array::from_fn(|k| (cells[3 + k] - g.zero[k]) * g.factor);
+        let f: [f64; 3] = std::array::from_fn(|b| map.axes[b].1 * s_f[map.axes[b].0]);
+        let w: [f64; 3] = std::array::from_fn(|b| map.axes[b].1 * s_w[map.axes[b].0]);
+        writer
+            .write_imu(&[ImuSample {
+                t,
+                accel: f,
+                gyro: w,
+                temp_c: None,
+                t_host: None,
+            }])
+            .map_err(io)?;
+        tracker.add(at, t, &f, &w);
+        all.add(at.sample, at.line, t, &f, &w);
+    }
+    if all.n < 2 {
+        return Err(ImportError::in_file(
+            ErrorKind::Cell,
+            rows.name(),
+            &format!("holds {} samples", all.n),
+            "check source.skip_lines and source.header",
+        ));
+    }
+    let hashes = rows.finish();
+    let found = tracker.finish(map, &all)?;
+    check::check(map, &found, rows.name())?;
+    let (oblique, kept): (Vec<Found>, Vec<Found>) = found
+        .into_iter()
+        .partition(|f| f.kind == SegmentKind::Static && f.up == Some(Up::Oblique));
+
+    let (poses, segments) = poses(&kept);
+    let mut table_samples = 0u64;
+    let mut werr = None;
+    synthesize(&poses, all.t.0, all.t.1, |s| {
+        table_samples += 1;
+        if let Err(e) = writer.write_table(&[s]) {
+            werr.get_or_insert(e);
+        }
+    });
+    if let Some(e) = werr {
+        return Err(io(e));
+    }
+    writer.manifest_mut().segments = segments;
+    writer.finish().map_err(io)?;
+    let m = writer.manifest().clone();
+    let dropped = writer.close();
+    if dropped > 0 {
+        return Err(out_error(
+            out,
+            &format!("{dropped} samples could not be written (internal error)"),
+        ));
+    }
+    let _ = std::fs::remove_file(stage.join("journal.jsonl"));
+    let prov = Provenance {
+        tool: format!("ratecal import {}", env!("CARGO_PKG_VERSION")),
+        imported: ratecal_recording::rfc3339(std::time::SystemTime::now()),
+        map: FileHash {
+            file: map.file.clone(),
+            sha256: map.sha256.clone(),
+        },
+        sources: sources
+            .iter()
+            .zip(hashes)
+            .map(|(p, h)| FileHash {
+                file: p.display().to_string(),
+                sha256: h,
+            })
+            .collect(),
+        conversion: Conversion::of(map, all.n),
+        table: "synthesized".into(),
+        segments: match map.segments {
+            Segments::None => "none",
+            Segments::List(_) => "declared",
+            Segments::Detect(_) => "detected",
+        }
+        .into(),
+        oblique_static: oblique
+            .iter()
+            .map(|f| Oblique {
+                id: f.id.clone(),
+                t_start: f.stretch.t.0,
+                t_end: f.stretch.t.1,
+                f_mean: f.stretch.mean_f(),
+            })
+            .collect(),
+    };
+    let mut text = ratecal_recording::manifest_yaml(&m).map_err(io)?;
+    text.push_str(&provenance::yaml(&prov).map_err(|e| out_error(out, &e))?);
+    std::fs::write(stage.join("manifest.yaml"), text).map_err(io)?;
+    if out.exists() {
+        std::fs::remove_dir(out).map_err(io)?;
+    }
+    std::fs::rename(&stage, out).map_err(io)?;
+    guard.0 = None;
+    Ok(Summary {
+        out: out.to_path_buf(),
+        samples: all.n,
+        t: all.t,
+        segments: kept,
+        oblique,
+        detected: matches!(map.segments, Segments::Detect(_)),
+        table_samples,
+    })
+}
+
+/// The manifest before its segments.
+fn manifest(map: &ImportMap, segments: Vec<Segment>) -> Manifest {
+    Manifest {
+        format: FORMAT.to_string(),
+        station: ManifestStation {
+            site: map.site,
+            table: TableAxes {
+                outer_axis: [0.0, -1.0, 0.0],
+                inner_axis: [1.0, 0.0, 0.0],
+                model: Some("none: synthesized by ratecal import from the segments".into()),
+            },
+            mount: None,
+        },
+        imu: map.device.clone(),
+        procedure: None,
+        segments,
+        environment: None,
+        run: None,
+    }
+}
+
+/// The table attitude of each kept segment and its manifest entry.
+fn poses(kept: &[Found]) -> (Vec<Pose>, Vec<Segment>) {
+    let mut poses = Vec::with_capacity(kept.len());
+    let mut segs = Vec::with_capacity(kept.len());
+    let mut last = (0.0, 0.0);
+    for f in kept {
+        let (t0, t1) = f.stretch.t;
+        let mut seg = Segment {
+            id: f.id.clone(),
+            kind: f.kind,
+            t_start: t0,
+            t_end: t1,
+            axis: None,
+            rate_dps: None,
+            amplitude_deg: None,
+            period_s: None,
+            center_deg: None,
+            pitch_deg: None,
+            roll_deg: None,
+            mount: None,
+        };
+        let pose = match (f.up, f.rate) {
+            (up, Some((axis, rate))) => {
+                // A turn starts from its own `up` when the map gives one.
+                let from = match up {
+                    Some(Up::Axis(k, s)) => face_up(k, s),
+                    _ => last,
+                };
+                let (att, outer, r) = turn(axis, rate, from);
+                seg.axis = Some(if outer { "outer" } else { "inner" }.into());
+                seg.rate_dps = Some(r);
+                Pose {
+                    t0,
+                    t1,
+                    att,
+                    turn: Some((outer, r)),
+                }
+            }
+            (Some(Up::Axis(k, s)), None) => {
+                last = face_up(k, s);
+                Pose {
+                    t0,
+                    t1,
+                    att: last,
+                    turn: None,
+                }
+            }
+            _ => Pose {
+                t0,
+                t1,
+                att: last,
+                turn: None,
+            },
+        };
+        poses.push(pose);
+        segs.push(seg);
+    }
+    (poses, segs)
+}

@@ -1,0 +1,191 @@
+//! `ratecal import` with static-interval detection on two public real sessions no one here
+//! wrote: imu_tk's Xsens MTi (two whitespace text files named `.mat`, unsigned counts) and
+//! an MPU-6050 (raw registers after a metadata header). The detected intervals are checked
+//! against the sources through values the importer never sees: the Xsens factory
+//! calibration (`shared/real/imu_tk/README.md`) and the MPU-6050's documented start-up rest.
+
+mod support;
+use support::*;
+
+use std::path::{Path, PathBuf};
+
+fn shared(rel: &str) -> Option<PathBuf> {
+    let found = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .ancestors()
+        .skip(1)
+        .take(3)
+        .map(|a| a.join("shared").join(rel))
+        .find(|p| p.exists());
+    if found.is_none() {
+        println!("skipped: ../shared/{rel} is absent");
+    }
+    found
+}
+
+fn map(name: &str) -> String {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("docs/examples/import")
+        .join(name);
+    p.to_str().unwrap().to_string()
+}
+
+/// Whitespace- or comma-separated numbers, after `skip` lines.
+fn numbers(path: &Path, skip: usize) -> Vec<Vec<f64>> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .skip(skip)
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| {
+            l.split(|c: char| c == ',' || c.is_whitespace())
+                .filter(|c| !c.is_empty())
+                .map(|c| c.parse().unwrap())
+                .collect()
+        })
+        .collect()
+}
+
+/// Every detected static interval: (t_start, t_end, up) from the manifest's segments and
+/// provenance.oblique_static.
+fn intervals(run: &Path) -> Vec<(f64, f64, Option<String>)> {
+    let text = std::fs::read_to_string(run.join("manifest.yaml")).unwrap();
+    let m: serde_json::Value = serde_saphyr::from_str(&text).unwrap();
+    let mut v: Vec<(f64, f64, Option<String>)> = Vec::new();
+    for s in m["segments"].as_array().unwrap() {
+        assert_eq!(s["kind"], "static");
+        v.push((
+            s["t_start"].as_f64().unwrap(),
+            s["t_end"].as_f64().unwrap(),
+            None,
+        ));
+    }
+    if let Some(o) = m["provenance"]["oblique_static"].as_array() {
+        for s in o {
+            v.push((
+                s["t_start"].as_f64().unwrap(),
+                s["t_end"].as_f64().unwrap(),
+                Some("oblique".into()),
+            ));
+        }
+    }
+    v.sort_by(|a, b| a.0.total_cmp(&b.0));
+    v
+}
+
+#[test]
+fn imu_tk_xsens_poses_are_found_and_static_by_the_factory_calibration() {
+    let (Some(acc), Some(gyr)) = (
+        shared("real/imu_tk/xsens_acc.mat"),
+        shared("real/imu_tk/xsens_gyro.mat"),
+    ) else {
+        return;
+    };
+    let tmp = tempfile::tempdir().unwrap();
+    let o = ratecal(
+        &[
+            "import",
+            acc.to_str().unwrap(),
+            gyr.to_str().unwrap(),
+            "--map",
+            &map("imu_tk-xsens.yaml"),
+            "--out",
+            "run",
+        ],
+        tmp.path(),
+    );
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    assert!(
+        text(&o).contains("detected from the signal"),
+        "{}",
+        text(&o)
+    );
+    let run = tmp.path().join("run");
+    let found = intervals(&run);
+    // About 50 s at rest, then about 37 poses (the source's README).
+    assert!(
+        (35..=42).contains(&found.len()),
+        "{} intervals",
+        found.len()
+    );
+    assert!(found[0].0 < 0.1 && found[0].1 > 45.0, "{:?}", found[0]);
+
+    // The time column is the source's, exactly; the gyro file's columns follow the accel's.
+    let (a, g) = (numbers(&acc, 0), numbers(&gyr, 0));
+    let imu = numbers(&run.join("imu.csv"), 1);
+    assert_eq!(imu.len(), a.len());
+    for i in [0, 1000, a.len() - 1] {
+        assert_eq!(imu[i][0], a[i][0]);
+        assert!(
+            (imu[i][4] - (g[i][1] - 32768.0) / 4767.0 * 180.0 / std::f64::consts::PI).abs() < 1e-9
+        );
+    }
+
+    // Each interval, averaged from the source's raw counts and calibrated with the factory
+    // values, reads gravity (the README: 9.803 +- 0.013 m/s^2 over the static poses): a
+    // window that took in part of a hand turn would not.
+    let offset = [33123.0, 33276.0, 32360.0];
+    let k = [415.0, 413.0, 415.0];
+    let m = [[1.00, 0.00, -0.01], [0.01, 1.00, 0.01], [0.02, 0.01, 1.00]];
+    for (t0, t1, _) in &found {
+        let rows: Vec<&Vec<f64>> = a.iter().filter(|r| r[0] >= *t0 && r[0] <= *t1).collect();
+        let raw: [f64; 3] = std::array::from_fn(|j| {
+            rows.iter().map(|r| r[j + 1]).sum::<f64>() / rows.len() as f64 - offset[j]
+        });
+        // x = inv(K M) raw: solve K M x = raw (M is close to I: three Jacobi sweeps suffice).
+        let mut x = [0.0; 3];
+        for _ in 0..20 {
+            x = std::array::from_fn(|i| {
+                let off: f64 = (0..3).filter(|&j| j != i).map(|j| m[i][j] * x[j]).sum();
+                (raw[i] / k[i] - off) / m[i][i]
+            });
+        }
+        let norm = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+        assert!(
+            (norm - 9.803).abs() < 0.05,
+            "interval {t0}..{t1}: |a| = {norm}"
+        );
+    }
+}
+
+#[test]
+fn mpu6050_start_up_rest_and_poses_are_found() {
+    let Some(src) = shared("real/mpu6050/example_data_calibration.csv") else {
+        return;
+    };
+    let tmp = tempfile::tempdir().unwrap();
+    let o = ratecal(
+        &[
+            "import",
+            src.to_str().unwrap(),
+            "--map",
+            &map("mpu6050.yaml"),
+            "--out",
+            "run",
+        ],
+        tmp.path(),
+    );
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let run = tmp.path().join("run");
+    let found = intervals(&run);
+    // The logger's own header: "Initialization time,36.5" (s at rest, z up).
+    assert!(
+        found[0].0 == 0.0 && (35.0..38.0).contains(&found[0].1),
+        "{:?}",
+        found[0]
+    );
+    assert!(found.len() >= 6, "{found:?}");
+    // Every interval reads one g within the part's tolerances, from the raw registers.
+    let raw = numbers(&src, 5);
+    for (t0, t1, _) in &found {
+        let (i0, i1) = ((t0 * 100.0).round() as usize, (t1 * 100.0).round() as usize);
+        let mean: [f64; 3] = std::array::from_fn(|j| {
+            raw[i0..=i1].iter().map(|r| r[j]).sum::<f64>() / (i1 - i0 + 1) as f64 / 16384.0
+        });
+        let g = (mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2]).sqrt();
+        assert!((0.88..1.12).contains(&g), "{t0}..{t1}: {g} g");
+    }
+    // Samples exactly the registers scaled: 16384 counts per g.
+    let imu = numbers(&run.join("imu.csv"), 1);
+    assert_eq!(imu.len(), raw.len());
+    assert_eq!(imu[7][3], raw[7][2] * (9.80665 / 16384.0));
+}
