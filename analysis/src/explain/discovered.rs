@@ -4,7 +4,7 @@
 
 use super::data::Data;
 use super::discover::{Discovery, channel_of, local_axis, name};
-use super::output::{Evidence, Finding, ParamOut, Term};
+use super::output::{Finding, ParamOut, Term};
 use super::probe::Form;
 use super::{locate, model::Terms, model::rms};
 use crate::fit::joint::{CHANNELS, Fit};
@@ -98,15 +98,7 @@ pub(crate) fn finding(
         located: locate::locate(m, data, step),
         residuals: locate::per_segment(m, data, step),
         parameters,
-        evidence: Evidence {
-            chi2: step.chi2,
-            dof: step.dof,
-            p_value: step.p,
-            alpha: step.alpha,
-            holdout_rms_before: rms(data, &step.before, &data.held),
-            holdout_rms_after: rms(data, &step.after, &data.held),
-            not_separable_from: locate::confusions(data, terms, step.effect),
-        },
+        evidence: super::evidence(data, step, terms),
         rms_after: rms(data, &step.after, &all),
         defined_in: None,
         alternatives: Vec::new(),

@@ -304,15 +304,7 @@ fn finding(
     // The Earth's rate is the only candidate with a latitude, and it is held: its
     // parameters are replaced by the held ones (earth::Held::parameters).
     let all: Vec<usize> = (0..data.accs.len()).collect();
-    let evidence = Evidence {
-        chi2: step.chi2,
-        dof: step.dof,
-        p_value: step.p,
-        alpha: step.alpha,
-        holdout_rms_before: rms(data, &step.before, &data.held),
-        holdout_rms_after: rms(data, &step.after, &data.held),
-        not_separable_from: locate::confusions(data, terms, step.effect),
-    };
+    let evidence = evidence(data, step, terms);
     Finding {
         effect: fx.id().into(),
         explanation: fx.explanation().into(),
@@ -339,5 +331,18 @@ fn finding(
                 .collect::<Vec<_>>()
                 .join("; ")
         }),
+    }
+}
+
+/// A step's evidence: its test, and the held-out residual before and after it.
+fn evidence(data: &Data, step: &select::Step, terms: &Terms) -> Evidence {
+    Evidence {
+        chi2: step.chi2,
+        dof: step.dof,
+        p_value: step.p,
+        alpha: step.alpha,
+        holdout_rms_before: rms(data, &step.before, &data.held),
+        holdout_rms_after: rms(data, &step.after, &data.held),
+        not_separable_from: locate::confusions(data, terms, step.effect),
     }
 }
