@@ -53,6 +53,8 @@ enum Command {
     Key(cli::key::Args),
     /// The calibration archive: add, list, show, export, trend, backup, check.
     Archive(cli::archive::Args),
+    /// Approve a run's results for a certificate: signer, role and time, signed into its seal.
+    Approve(cli::approve::Args),
 }
 
 fn main() -> ExitCode {
@@ -70,5 +72,6 @@ fn main() -> ExitCode {
         Command::Explain(a) => cli::explain::main(a),
         Command::Key(a) => cli::key::main(a),
         Command::Archive(a) => cli::archive::main(a),
+        Command::Approve(a) => cli::approve::main(a),
     }
 }

@@ -2,6 +2,7 @@
 //! needs (files, station, drivers) and maps outcomes to the exit codes of spec/cli.md.
 
 pub mod analyze;
+pub mod approve;
 pub mod archive;
 pub mod check;
 pub mod diff;

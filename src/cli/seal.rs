@@ -39,7 +39,8 @@ pub fn write(dir: &Path, key: Option<&SigningKey>) -> std::io::Result<()> {
     save(dir, &seal)
 }
 
-fn save(dir: &Path, seal: &Seal) -> std::io::Result<()> {
+/// Writes `seal.json` and its hash beside it.
+pub fn save(dir: &Path, seal: &Seal) -> std::io::Result<()> {
     let json = seal.to_json();
     std::fs::write(dir.join(SEAL_FILE), &json)?;
     std::fs::write(dir.join(SEAL_HASH_FILE), Seal::hash_line(&json))
