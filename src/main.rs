@@ -55,6 +55,8 @@ enum Command {
     Archive(cli::archive::Args),
     /// Approve a run's results for a certificate: signer, role and time, signed into its seal.
     Approve(cli::approve::Args),
+    /// Issue a calibration certificate (PDF, HTML, Markdown or JSON) for an archived run.
+    Certificate(cli::certificate::Args),
 }
 
 fn main() -> ExitCode {
@@ -73,5 +75,6 @@ fn main() -> ExitCode {
         Command::Key(a) => cli::key::main(a),
         Command::Archive(a) => cli::archive::main(a),
         Command::Approve(a) => cli::approve::main(a),
+        Command::Certificate(a) => cli::certificate::main(a),
     }
 }

@@ -4,6 +4,7 @@
 pub mod analyze;
 pub mod approve;
 pub mod archive;
+pub mod certificate;
 pub mod check;
 pub mod diff;
 pub mod emulate;

@@ -3,6 +3,8 @@
 pub mod doc;
 mod html;
 mod md;
+mod pdf;
 
 pub use html::html;
 pub use md::markdown;
+pub use pdf::{PdfError, pdf};
