@@ -214,6 +214,31 @@ fn a_draft_says_so_on_every_page_and_refusals_have_their_exit_codes() {
     let html = certificate(dir, "draft", &["--format", "html"]);
     assert!(String::from_utf8_lossy(&html.stdout).contains("DRAFT"));
 
+    // Acceptance checks on calibrated parameters: evaluated with the results, in the
+    // limit's unit, and stated on the certificate under the named decision rule.
+    let accepting = support::MINI.replacen(
+        "  step statics",
+        "  accept accel.bias.x <= 80 mg\n  accept gyro.scale.x <= 300000 ppm guarded\n\n  step statics",
+        1,
+    );
+    std::fs::write(dir.join("acc.rcal"), &accepting).unwrap();
+    std::fs::write(dir.join("s.yaml"), &station).unwrap();
+    let o = ratecal(&["run", "acc.rcal", "--dry-run", "--station", "s.yaml", "--out", "acc"], dir);
+    assert!(matches!(code(&o), 0 | 3), "{}", text(&o));
+    let res = support::json(&dir.join("acc/results.json"));
+    let acc = res["acceptance"].as_array().unwrap();
+    let bias = acc.iter().find(|a| a["quantity"] == "accel.bias.x").unwrap();
+    let b = res["parameters"]["accel.bias.x"]["value"].as_f64().unwrap();
+    let mg = b.abs() / 9.80665 * 1000.0;
+    assert!((bias["value"].as_f64().unwrap() - mg).abs() < 1e-9 * mg.max(1.0), "{bias}");
+    assert_eq!(bias["verdict"], if mg <= 80.0 { "pass" } else { "fail" });
+    let o = ratecal(&["archive", "add", "acc", "--archive", "archive"], dir);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let j = json_of(&certificate(dir, "acc", &["--format", "json"]));
+    let conf = &j["conformity"];
+    assert!(conf["rule"].as_str().unwrap().contains("guarded acceptance"), "{conf}");
+    assert!(conf["checks"].to_string().contains("accel.bias.x <= 80 mg"), "{conf}");
+
     // A run not in the archive: exit 1, help names `ratecal archive add`.
     std::fs::write(dir.join("s.yaml"), &station).unwrap();
     let o = mini_run(dir, "loose", &["--station", "s.yaml"]);
