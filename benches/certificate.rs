@@ -27,11 +27,43 @@ fn bench(c: &mut Criterion) {
     let station = format!("{root}/docs/examples/station.yaml");
     let procedure = format!("{root}/procedures/imu-2d-standard");
     let lab = format!("{root}/docs/examples/lab.yaml");
-    ratecal(&["run", &procedure, "--dry-run", "--station", &station, "--out", "cal"], dir);
+    ratecal(
+        &[
+            "run",
+            &procedure,
+            "--dry-run",
+            "--station",
+            &station,
+            "--out",
+            "cal",
+        ],
+        dir,
+    );
     ratecal(&["key", "new", "keys"], dir);
-    ratecal(&["approve", "cal", "--signer", "A", "--role", "B", "--key", "keys/lab.key"], dir);
+    ratecal(
+        &[
+            "approve",
+            "cal",
+            "--signer",
+            "A",
+            "--role",
+            "B",
+            "--key",
+            "keys/lab.key",
+        ],
+        dir,
+    );
     ratecal(&["archive", "add", "cal", "--archive", "archive"], dir);
-    let args = ["certificate", "cal", "--lab", &lab, "--archive", "archive", "--out", "c.pdf"];
+    let args = [
+        "certificate",
+        "cal",
+        "--lab",
+        &lab,
+        "--archive",
+        "archive",
+        "--out",
+        "c.pdf",
+    ];
     let mut g = c.benchmark_group("certificate");
     g.sample_size(10);
     g.bench_function("pdf_whole_process", |b| b.iter(|| ratecal(&args, dir)));

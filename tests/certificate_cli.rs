@@ -49,7 +49,16 @@ fn mini(dir: &Path, name: &str, station: &str, approve: bool) -> PathBuf {
             assert_eq!(code(&o), 0, "{}", text(&o));
         }
         let o = ratecal(
-            &["approve", name, "--signer", "A. Metrologist", "--role", "Head of laboratory", "--key", "keys/lab.key"],
+            &[
+                "approve",
+                name,
+                "--signer",
+                "A. Metrologist",
+                "--role",
+                "Head of laboratory",
+                "--key",
+                "keys/lab.key",
+            ],
             dir,
         );
         assert_eq!(code(&o), 0, "{}", text(&o));
@@ -61,7 +70,14 @@ fn mini(dir: &Path, name: &str, station: &str, approve: bool) -> PathBuf {
 
 fn certificate(dir: &Path, run: &str, extra: &[&str]) -> Output {
     let lab = lab();
-    let mut args = vec!["certificate", run, "--lab", lab.as_str(), "--archive", "archive"];
+    let mut args = vec![
+        "certificate",
+        run,
+        "--lab",
+        lab.as_str(),
+        "--archive",
+        "archive",
+    ];
     args.extend_from_slice(extra);
     ratecal(&args, dir)
 }
@@ -76,22 +92,57 @@ fn the_standard_procedure_gives_a_signed_certificate_whose_pdf_holds_every_eleme
     let dir = tmp.path();
     std::fs::write(dir.join("s.yaml"), certified_station("2099-12-31")).unwrap();
     let procedure = support::procedures("imu-2d-standard");
-    let o = ratecal(&["run", &procedure, "--dry-run", "--station", "s.yaml", "--out", "cal"], dir);
+    let o = ratecal(
+        &[
+            "run",
+            &procedure,
+            "--dry-run",
+            "--station",
+            "s.yaml",
+            "--out",
+            "cal",
+        ],
+        dir,
+    );
     assert!(matches!(code(&o), 0 | 3), "{}", text(&o));
     let o = ratecal(&["key", "new", "keys"], dir);
     assert_eq!(code(&o), 0, "{}", text(&o));
     let o = ratecal(
-        &["approve", "cal", "--signer", "A. Metrologist", "--role", "Head of laboratory", "--key", "keys/lab.key"],
+        &[
+            "approve",
+            "cal",
+            "--signer",
+            "A. Metrologist",
+            "--role",
+            "Head of laboratory",
+            "--key",
+            "keys/lab.key",
+        ],
         dir,
     );
     assert_eq!(code(&o), 0, "{}", text(&o));
     let o = ratecal(&["verify", "cal"], dir);
     assert_eq!(code(&o), 0, "{}", text(&o));
-    assert!(text(&o).contains("approval by A. Metrologist (Head of laboratory)"), "{}", text(&o));
+    assert!(
+        text(&o).contains("approval by A. Metrologist (Head of laboratory)"),
+        "{}",
+        text(&o)
+    );
     let o = ratecal(&["archive", "add", "cal", "--archive", "archive"], dir);
     assert_eq!(code(&o), 0, "{}", text(&o));
 
-    let o = certificate(dir, "cal", &["--customer", "ACME Avionics", "--order", "PO-4711", "--out", "cert.pdf"]);
+    let o = certificate(
+        dir,
+        "cal",
+        &[
+            "--customer",
+            "ACME Avionics",
+            "--order",
+            "PO-4711",
+            "--out",
+            "cert.pdf",
+        ],
+    );
     assert_eq!(code(&o), 0, "{}", text(&o));
     let pages = pdf_pages(&std::fs::read(dir.join("cert.pdf")).unwrap());
     let n = pages.len();
@@ -109,30 +160,65 @@ fn the_standard_procedure_gives_a_signed_certificate_whose_pdf_holds_every_eleme
         ] {
             assert!(p.contains(&want), "page {}: no `{want}` in {p}", i + 1);
         }
-        assert!(!p.contains("DRAFT"), "an approved certificate says DRAFT: {p}");
+        assert!(
+            !p.contains("DRAFT"),
+            "an approved certificate says DRAFT: {p}"
+        );
     }
     let all = flat(&pages.join("\n"));
     let results = support::json(&dir.join("cal/results.json"));
     let manifest = std::fs::read_to_string(dir.join("cal/manifest.yaml")).unwrap();
-    let started = manifest.lines().find_map(|l| l.trim().strip_prefix("started: ")).unwrap();
+    let started = manifest
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("started: "))
+        .unwrap();
     let calibration_date = started.trim_matches(|c| c == '\'' || c == '"')[..10].to_string();
-    let sha = results["model"]["procedure"]["sha256"].as_str().unwrap().to_string();
+    let sha = results["model"]["procedure"]["sha256"]
+        .as_str()
+        .unwrap()
+        .to_string();
     let mut order = Vec::new();
     for want in [
-        "ACME Avionics", "PO-4711", "SIM-TAC-100", "SIM-0001", "tactical",
-        "imu-2d-standard version 1.1.0", &sha, "Example Motion Systems", "EMS-2A-0042",
-        &format!("Date of calibration {calibration_date}"), "Date of issue",
-        "Method and conditions", "Static calibration of the accelerometers",
-        "Ambient temperature mean", "9.8156 m/s^2", "55.7 deg",
-        "Results", "gyro.scale.x", "(k = ", "95 %", "Statements of conformity",
-        "ILAC-G8", "Traceability", "NMI-2026-0815", "National Metrology Institute",
-        "due 2099-12-31", "Approved by A. Metrologist", "Head of laboratory", "SHA256:",
-        "Annex: uncertainty budget", "table rate accuracy", "reference gravity",
-        "table position accuracy", "nu_eff",
+        "ACME Avionics",
+        "PO-4711",
+        "SIM-TAC-100",
+        "SIM-0001",
+        "tactical",
+        "imu-2d-standard version 1.1.0",
+        &sha,
+        "Example Motion Systems",
+        "EMS-2A-0042",
+        &format!("Date of calibration {calibration_date}"),
+        "Date of issue",
+        "Method and conditions",
+        "Static calibration of the accelerometers",
+        "Ambient temperature mean",
+        "9.8156 m/s^2",
+        "55.7 deg",
+        "Results",
+        "gyro.scale.x",
+        "(k = ",
+        "95 %",
+        "Statements of conformity",
+        "ILAC-G8",
+        "Traceability",
+        "NMI-2026-0815",
+        "National Metrology Institute",
+        "due 2099-12-31",
+        "Approved by A. Metrologist",
+        "Head of laboratory",
+        "SHA256:",
+        "Annex: uncertainty budget",
+        "table rate accuracy",
+        "reference gravity",
+        "table position accuracy",
+        "nu_eff",
         "This certificate shall not be reproduced except in full without the written approval of the laboratory.",
         &format!("End of certificate {number}"),
     ] {
-        let at = all.find(want).unwrap_or_else(|| panic!("no `{want}` in the PDF text: {all}"));
+        let at = all
+            .find(want)
+            .unwrap_or_else(|| panic!("no `{want}` in the PDF text: {all}"));
         order.push((want.to_string(), at));
     }
     // The sections in the issue's order.
@@ -147,10 +233,16 @@ fn the_standard_procedure_gives_a_signed_certificate_whose_pdf_holds_every_eleme
         .objects
         .values()
         .filter_map(|o| o.as_dict().ok())
-        .filter(|d| d.get(b"Type").ok().and_then(|t| t.as_name().ok()) == Some(b"FontDescriptor".as_slice()))
+        .filter(|d| {
+            d.get(b"Type").ok().and_then(|t| t.as_name().ok()) == Some(b"FontDescriptor".as_slice())
+        })
         .collect();
     assert!(!descriptors.is_empty());
-    assert!(descriptors.iter().all(|d| d.has(b"FontFile2") || d.has(b"FontFile3") || d.has(b"FontFile")));
+    assert!(
+        descriptors
+            .iter()
+            .all(|d| d.has(b"FontFile2") || d.has(b"FontFile3") || d.has(b"FontFile"))
+    );
 
     // Reissued: the same number; the JSON holds the stable keys.
     let o = certificate(dir, "cal", &["--format", "json"]);
@@ -159,7 +251,10 @@ fn the_standard_procedure_gives_a_signed_certificate_whose_pdf_holds_every_eleme
     assert_eq!(j["number"], number.as_str());
     assert_eq!(j["draft"], false);
     let budget = j["budget"].as_array().unwrap();
-    let g = budget.iter().find(|b| b["quantity"] == "gyro.scale.x").unwrap();
+    let g = budget
+        .iter()
+        .find(|b| b["quantity"] == "gyro.scale.x")
+        .unwrap();
     for key in ["unit", "terms", "u_c", "nu_eff", "k", "U"] {
         assert!(g.get(key).is_some(), "budget entry lacks {key}: {g}");
     }
@@ -167,12 +262,27 @@ fn the_standard_procedure_gives_a_signed_certificate_whose_pdf_holds_every_eleme
     // segment, Type B the table's 10 ppm rate accuracy, rectangular.
     let u_a = results["parameters"]["gyro.scale.x"]["u"].as_f64().unwrap();
     let segments = results["segments"].as_array().unwrap();
-    let used = segments.iter().filter(|s| s["used_for"].as_array().unwrap().iter().any(|u| u == "gyro")).count();
+    let used = segments
+        .iter()
+        .filter(|s| {
+            s["used_for"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|u| u == "gyro")
+        })
+        .count();
     let params = results["parameters"]
         .as_object()
         .unwrap()
         .iter()
-        .filter(|(n, p)| n.starts_with("gyro.") && p.get("u").is_some() && !n.contains(".noise.") && !n.contains(".arw.") && !n.contains(".bias_instability."))
+        .filter(|(n, p)| {
+            n.starts_with("gyro.")
+                && p.get("u").is_some()
+                && !n.contains(".noise.")
+                && !n.contains(".arw.")
+                && !n.contains(".bias_instability.")
+        })
         .count();
     let nu_a = (3 * used - params) as f64;
     let u_b = 10.0 / 3f64.sqrt();
@@ -182,7 +292,10 @@ fn the_standard_procedure_gives_a_signed_certificate_whose_pdf_holds_every_eleme
     assert!((g["nu_eff"].as_f64().unwrap() - nu_eff).abs() < 1e-6 * nu_eff);
     let k = g["k"].as_f64().unwrap();
     let t95 = ratecal_certificate::budget::coverage_factor(Some(nu_eff));
-    assert!((k - t95).abs() < 1e-9 && k > 1.96, "k {k} for nu_eff {nu_eff}");
+    assert!(
+        (k - t95).abs() < 1e-9 && k > 1.96,
+        "k {k} for nu_eff {nu_eff}"
+    );
     assert!((g["U"].as_f64().unwrap() - k * u_c).abs() < 1e-9 * u_c.max(1.0));
     let terms = g["terms"].as_array().unwrap();
     assert_eq!(terms[0]["type"], "A");
@@ -205,10 +318,23 @@ fn a_draft_says_so_on_every_page_and_refusals_have_their_exit_codes() {
     let o = certificate(dir, "draft", &["--format", "json"]);
     let j = json_of(&o);
     assert_eq!(j["draft"], true);
-    let scale = j["budget"].as_array().unwrap().iter().find(|b| b["quantity"] == "accel.scale.x").unwrap();
-    let gravity = scale["terms"].as_array().unwrap().iter().find(|t| t["source"] == "reference gravity").unwrap();
+    let scale = j["budget"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|b| b["quantity"] == "accel.scale.x")
+        .unwrap();
+    let gravity = scale["terms"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|t| t["source"] == "reference gravity")
+        .unwrap();
     assert_eq!(gravity["status"], "not_stated");
-    assert!(gravity["u"].is_null(), "a figure not stated is never 0: {gravity}");
+    assert!(
+        gravity["u"].is_null(),
+        "a figure not stated is never 0: {gravity}"
+    );
     let md = certificate(dir, "draft", &["--format", "md"]);
     assert!(String::from_utf8_lossy(&md.stdout).contains("not stated"));
     let html = certificate(dir, "draft", &["--format", "html"]);
@@ -223,21 +349,47 @@ fn a_draft_says_so_on_every_page_and_refusals_have_their_exit_codes() {
     );
     std::fs::write(dir.join("acc.rcal"), &accepting).unwrap();
     std::fs::write(dir.join("s.yaml"), &station).unwrap();
-    let o = ratecal(&["run", "acc.rcal", "--dry-run", "--station", "s.yaml", "--out", "acc"], dir);
+    let o = ratecal(
+        &[
+            "run",
+            "acc.rcal",
+            "--dry-run",
+            "--station",
+            "s.yaml",
+            "--out",
+            "acc",
+        ],
+        dir,
+    );
     assert!(matches!(code(&o), 0 | 3), "{}", text(&o));
     let res = support::json(&dir.join("acc/results.json"));
     let acc = res["acceptance"].as_array().unwrap();
-    let bias = acc.iter().find(|a| a["quantity"] == "accel.bias.x").unwrap();
+    let bias = acc
+        .iter()
+        .find(|a| a["quantity"] == "accel.bias.x")
+        .unwrap();
     let b = res["parameters"]["accel.bias.x"]["value"].as_f64().unwrap();
     let mg = b.abs() / 9.80665 * 1000.0;
-    assert!((bias["value"].as_f64().unwrap() - mg).abs() < 1e-9 * mg.max(1.0), "{bias}");
+    assert!(
+        (bias["value"].as_f64().unwrap() - mg).abs() < 1e-9 * mg.max(1.0),
+        "{bias}"
+    );
     assert_eq!(bias["verdict"], if mg <= 80.0 { "pass" } else { "fail" });
     let o = ratecal(&["archive", "add", "acc", "--archive", "archive"], dir);
     assert_eq!(code(&o), 0, "{}", text(&o));
     let j = json_of(&certificate(dir, "acc", &["--format", "json"]));
     let conf = &j["conformity"];
-    assert!(conf["rule"].as_str().unwrap().contains("guarded acceptance"), "{conf}");
-    assert!(conf["checks"].to_string().contains("accel.bias.x <= 80 mg"), "{conf}");
+    assert!(
+        conf["rule"]
+            .as_str()
+            .unwrap()
+            .contains("guarded acceptance"),
+        "{conf}"
+    );
+    assert!(
+        conf["checks"].to_string().contains("accel.bias.x <= 80 mg"),
+        "{conf}"
+    );
 
     // A run not in the archive: exit 1, help names `ratecal archive add`.
     std::fs::write(dir.join("s.yaml"), &station).unwrap();
@@ -260,7 +412,10 @@ fn a_draft_says_so_on_every_page_and_refusals_have_their_exit_codes() {
     let o = certificate(dir, "expired", &["--format", "json"]);
     assert_eq!(code(&o), 1, "{}", text(&o));
     let t = text(&o);
-    assert!(t.contains("due: 2001-01-31") && t.contains("station.yaml:"), "{t}");
+    assert!(
+        t.contains("due: 2001-01-31") && t.contains("station.yaml:"),
+        "{t}"
+    );
     assert!(t.contains("--allow-expired"), "{t}");
     let o = certificate(dir, "expired", &["--format", "json", "--allow-expired"]);
     assert_eq!(code(&o), 0, "{}", text(&o));
@@ -276,7 +431,11 @@ fn a_draft_says_so_on_every_page_and_refusals_have_their_exit_codes() {
     let o = certificate(dir, "untraceable", &["--format", "json"]);
     assert_eq!(code(&o), 1, "{}", text(&o));
     assert!(text(&o).contains("--allow-untraceable"), "{}", text(&o));
-    let o = certificate(dir, "untraceable", &["--format", "md", "--allow-untraceable"]);
+    let o = certificate(
+        dir,
+        "untraceable",
+        &["--format", "md", "--allow-untraceable"],
+    );
     assert_eq!(code(&o), 0, "{}", text(&o));
     assert!(String::from_utf8_lossy(&o.stdout).contains("not shown to be traceable"));
 }
@@ -291,7 +450,19 @@ fn numbers_are_unique_and_stable_across_concurrent_processes_and_an_amendment_re
     let runs = ["r0", "r1", "r2", "r3"];
     for (i, r) in runs.iter().enumerate().skip(1) {
         copy_dir(&dir.join("r0"), &dir.join(r));
-        let o = ratecal(&["approve", r, "--signer", &format!("Signer {i}"), "--role", "Engineer", "--key", "keys/lab.key"], dir);
+        let o = ratecal(
+            &[
+                "approve",
+                r,
+                "--signer",
+                &format!("Signer {i}"),
+                "--role",
+                "Engineer",
+                "--key",
+                "keys/lab.key",
+            ],
+            dir,
+        );
         assert_eq!(code(&o), 0, "{}", text(&o));
         let o = ratecal(&["archive", "add", r, "--archive", "archive"], dir);
         assert_eq!(code(&o), 0, "{}", text(&o));
@@ -301,7 +472,16 @@ fn numbers_are_unique_and_stable_across_concurrent_processes_and_an_amendment_re
     let children: Vec<(usize, std::process::Child)> = (0..12)
         .map(|i| {
             let child = Command::new(env!("CARGO_BIN_EXE_ratecal"))
-                .args(["certificate", runs[i % 4], "--lab", &lab, "--archive", "archive", "--format", "json"])
+                .args([
+                    "certificate",
+                    runs[i % 4],
+                    "--lab",
+                    &lab,
+                    "--archive",
+                    "archive",
+                    "--format",
+                    "json",
+                ])
                 .current_dir(dir)
                 .stdout(std::process::Stdio::piped())
                 .stderr(std::process::Stdio::piped())
@@ -324,7 +504,12 @@ fn numbers_are_unique_and_stable_across_concurrent_processes_and_an_amendment_re
     let year = &ratecal_engine::recording::rfc3339(std::time::SystemTime::now())[..4];
     let expected: std::collections::BTreeSet<String> =
         (1..=4).map(|n| format!("EICL-{year}-{n:06}")).collect();
-    assert_eq!(all.into_iter().cloned().collect::<std::collections::BTreeSet<_>>(), expected);
+    assert_eq!(
+        all.into_iter()
+            .cloned()
+            .collect::<std::collections::BTreeSet<_>>(),
+        expected
+    );
 
     // An amendment: the next number, naming the one it replaces.
     let old = by_run[0].iter().next().unwrap().clone();
@@ -335,7 +520,11 @@ fn numbers_are_unique_and_stable_across_concurrent_processes_and_an_amendment_re
     assert_eq!(j["replaces"], old.as_str());
     let o = certificate(dir, "r0", &["--format", "md"]);
     let md = String::from_utf8_lossy(&o.stdout).to_string();
-    assert!(md.contains(&format!("EICL-{year}-000005")) && md.contains(&format!("replaces certificate No. {old}")), "{md}");
+    assert!(
+        md.contains(&format!("EICL-{year}-000005"))
+            && md.contains(&format!("replaces certificate No. {old}")),
+        "{md}"
+    );
 }
 
 fn copy_dir(from: &Path, to: &Path) {

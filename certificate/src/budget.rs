@@ -127,8 +127,10 @@ pub struct Budget {
 impl Budget {
     /// Combines `terms` (GUM 5.1.2 with unit sensitivities already applied, G.4.1, G.3).
     pub fn combine(quantity: &str, unit: &str, value: f64, terms: Vec<Term>) -> Budget {
-        let stated: Vec<(f64, Option<f64>)> =
-            terms.iter().filter_map(|t| t.u.map(|u| (u, t.dof))).collect();
+        let stated: Vec<(f64, Option<f64>)> = terms
+            .iter()
+            .filter_map(|t| t.u.map(|u| (u, t.dof)))
+            .collect();
         let u_c = stated.iter().map(|(u, _)| u * u).sum::<f64>().sqrt();
         let denom: f64 = stated
             .iter()
@@ -177,7 +179,9 @@ mod tests {
 
     #[test]
     fn a_term_not_stated_is_left_out_and_marks_the_budget_incomplete() {
-        let a = Term::stated("fit", Evaluation::A, "normal").dof(9.0).u(Some(3.0));
+        let a = Term::stated("fit", Evaluation::A, "normal")
+            .dof(9.0)
+            .u(Some(3.0));
         let b = Term::stated("table", Evaluation::B, "rectangular").u(None);
         let budget = Budget::combine("gyro.scale.x", "ppm", 1.0, vec![a, b]);
         assert_eq!(budget.u_c, 3.0);

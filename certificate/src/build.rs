@@ -125,7 +125,10 @@ pub fn build(input: Input<'_>) -> Certificate {
         ));
     }
     if m.run.as_ref().is_some_and(|run| run.dry_run) {
-        notes.push("Measured on the simulated station (a dry run): not a calibration of a real item.".into());
+        notes.push(
+            "Measured on the simulated station (a dry run): not a calibration of a real item."
+                .into(),
+        );
     }
     let run = m.run.as_ref();
     let calibration_date = run
@@ -150,6 +153,7 @@ pub fn build(input: Input<'_>) -> Certificate {
         })
         .unwrap_or_default();
     let site = &m.station.site;
+    let statements = conformity(r, &budgets);
     let method = Method {
         steps,
         temperature_c: r
@@ -168,7 +172,9 @@ pub fn build(input: Input<'_>) -> Certificate {
         (Some(c), Some(by)) => format!(
             "The results are traceable to the SI through the rate table's calibration, \
              certificate {c} issued by {by}{}.",
-            due.as_deref().map(|d| format!(", due {d}")).unwrap_or_default()
+            due.as_deref()
+                .map(|d| format!(", due {d}"))
+                .unwrap_or_default()
         ),
         (Some(c), None) => format!(
             "The results are traceable to the SI through the rate table's calibration, \
@@ -206,7 +212,7 @@ pub fn build(input: Input<'_>) -> Certificate {
         model_equation: equation(r),
         results,
         budget: budgets,
-        conformity: conformity(r),
+        conformity: statements,
         traceability: Traceability {
             certificate,
             issued_by,
@@ -240,8 +246,10 @@ fn equation(r: &Results) -> Vec<String> {
     }
 }
 
-/// The conformity statements of the run's acceptance checks (ILAC-G8:2019).
-fn conformity(r: &Results) -> Option<Conformity> {
+/// The conformity statements of the run's acceptance checks (ILAC-G8:2019). A check on a
+/// calibrated parameter states the certificate's U (its budget's, in the check's unit) and,
+/// under guarded acceptance, is decided with it; other checks keep the analysis's U.
+fn conformity(r: &Results, budgets: &[Budget]) -> Option<Conformity> {
     if r.acceptance.is_empty() {
         return None;
     }
@@ -257,12 +265,34 @@ fn conformity(r: &Results) -> Option<Conformity> {
         .acceptance
         .iter()
         .map(|a| {
-            let verdict = serde_json::to_value(a.verdict)
+            let mut verdict = serde_json::to_value(a.verdict)
                 .ok()
                 .and_then(|v| v.as_str().map(String::from))
                 .unwrap_or_default();
-            let band = (a.rule != "simple").then_some(a.expanded_u).flatten();
-            let within_band = matches!((a.value, a.expanded_u), (Some(v), Some(u)) if (v - a.limit).abs() < u);
+            let from_budget = budgets
+                .iter()
+                .find(|b| b.quantity == a.quantity)
+                .and_then(|b| {
+                    let v = a.value?;
+                    (b.value != 0.0).then(|| b.expanded * v / b.value.abs())
+                });
+            let expanded = from_budget.or(a.expanded_u);
+            let is_guarded = a.rule != "simple";
+            if let (Some(v), Some(u), true, Some(_)) = (a.value, expanded, is_guarded, from_budget)
+            {
+                let upper = matches!(a.op.as_str(), "<=" | "<");
+                let margin = if upper { a.limit - v } else { v - a.limit };
+                verdict = if margin >= u {
+                    "pass"
+                } else if margin < -u {
+                    "fail"
+                } else {
+                    "indeterminate"
+                }
+                .into();
+            }
+            let within_band =
+                matches!((a.value, expanded), (Some(v), Some(u)) if (v - a.limit).abs() < u);
             let statement = match (a.value, verdict.as_str()) {
                 (None, _) => format!("{}: not evaluated", a.name),
                 (Some(_), "indeterminate") => format!(
@@ -271,7 +301,11 @@ fn conformity(r: &Results) -> Option<Conformity> {
                     a.name
                 ),
                 (Some(_), v) => {
-                    let word = if v == "pass" { "conforms" } else { "does not conform" };
+                    let word = if v == "pass" {
+                        "conforms"
+                    } else {
+                        "does not conform"
+                    };
                     let near = if within_band {
                         " (the value lies within U of the limit)"
                     } else {
@@ -286,8 +320,8 @@ fn conformity(r: &Results) -> Option<Conformity> {
                 op: a.op.clone(),
                 limit: a.limit,
                 unit: a.unit.clone(),
-                expanded: a.expanded_u,
-                guard_band: band,
+                expanded,
+                guard_band: expanded.filter(|_| is_guarded),
                 verdict,
                 statement,
             }

@@ -18,6 +18,6 @@ pub mod terms;
 
 pub use build::{Input, build, gum_text, type_a_dof};
 pub use model::{
-    ApprovalBlock, Certificate, Conformity, ConformityCheck, END_MARK, FORMAT, Identification,
-    Lab, Method, ProcedureId, REPRODUCTION, ResultLine, StationId, Traceability,
+    ApprovalBlock, Certificate, Conformity, ConformityCheck, END_MARK, FORMAT, Identification, Lab,
+    Method, ProcedureId, REPRODUCTION, ResultLine, StationId, Traceability,
 };

@@ -145,15 +145,21 @@ pub fn main(args: Args) -> ExitCode {
     };
     let bytes = match args.format {
         Format::Json => {
-            serde_json::to_string_pretty(&certificate).expect("a certificate serializes") + "\n"
+            { serde_json::to_string_pretty(&certificate).expect("a certificate serializes") + "\n" }
+                .into_bytes()
         }
-        .into_bytes(),
         Format::Md => render::markdown(&certificate).into_bytes(),
         Format::Html => render::html(&certificate).into_bytes(),
         Format::Pdf => match render::pdf(&certificate) {
             Ok(b) => b,
             Err(e) => {
-                errln!("{:?}", miette::miette!(code = "certificate::pdf", "cannot typeset the certificate: {e}"));
+                errln!(
+                    "{:?}",
+                    miette::miette!(
+                        code = "certificate::pdf",
+                        "cannot typeset the certificate: {e}"
+                    )
+                );
                 return ExitCode::from(1);
             }
         },
@@ -187,7 +193,10 @@ fn read_text(path: &Path, help: &str) -> miette::Result<String> {
 }
 
 fn read_lab(path: &Path) -> miette::Result<Lab> {
-    let text = read_text(path, "give the laboratory's file (docs/examples/lab.yaml shows one)")?;
+    let text = read_text(
+        path,
+        "give the laboratory's file (docs/examples/lab.yaml shows one)",
+    )?;
     let name = path.display().to_string();
     let lab: Lab = serde_saphyr::from_str(&text).map_err(|e| {
         let span = e
@@ -224,7 +233,8 @@ async fn issue(args: &Args) -> miette::Result<Certificate> {
     let lab = read_lab(&args.lab)?;
     let results_path = dir.join("results.json");
     let text = read_text(&results_path, "run `ratecal analyze RUN_DIR` first")?;
-    let results: Results = serde_json::from_str(&text).map_err(|e| io(&results_path, e, "results.json follows docs/results.md"))?;
+    let results: Results = serde_json::from_str(&text)
+        .map_err(|e| io(&results_path, e, "results.json follows docs/results.md"))?;
     let manifest_path = dir.join("manifest.yaml");
     let text = read_text(&manifest_path, "give the folder `ratecal run` wrote")?;
     let manifest =
@@ -233,7 +243,10 @@ async fn issue(args: &Args) -> miette::Result<Certificate> {
         .ok()
         .and_then(|t| serde_json::from_str(&t).ok());
     let station_path = dir.join("station.yaml");
-    let station_text = read_text(&station_path, "a run folder keeps a copy of its station file")?;
+    let station_text = read_text(
+        &station_path,
+        "a run folder keeps a copy of its station file",
+    )?;
     let station = Station::from_yaml(&station_text, &station_path.display().to_string())
         .map_err(|e| miette::Report::new(*e))?;
     let calibration_date: String = manifest
@@ -242,15 +255,14 @@ async fn issue(args: &Args) -> miette::Result<Certificate> {
         .map(|r| r.started.chars().take(10).collect())
         .unwrap_or_default();
     let mut notes = Vec::new();
-    let located = |message: String, after: Option<&str>, key: &str, label: &str, help: &str| {
-        Located {
+    let located =
+        |message: String, after: Option<&str>, key: &str, label: &str, help: &str| Located {
             message,
             span: key_span(&station_text, after, key),
             src: NamedSource::new(station_path.display().to_string(), station_text.clone()),
             label: label.into(),
             help: help.into(),
-        }
-    };
+        };
     let cal = station.table.calibration.clone();
     match &cal {
         None if !args.allow_untraceable => {
@@ -319,7 +331,13 @@ async fn issue(args: &Args) -> miette::Result<Certificate> {
     let now = ratecal_engine::recording::rfc3339(std::time::SystemTime::now());
     let year: i32 = now[..4].parse().unwrap_or(1970);
     let issued = archive
-        .certificate_number(&folder.facts.id, &lab.certificate_prefix, year, args.amend, &now)
+        .certificate_number(
+            &folder.facts.id,
+            &lab.certificate_prefix,
+            year,
+            args.amend,
+            &now,
+        )
         .await?;
     archive.close().await;
     let seal: Option<Seal> = std::fs::read_to_string(dir.join(SEAL_FILE))

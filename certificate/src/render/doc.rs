@@ -146,7 +146,11 @@ pub fn blocks(c: &Certificate) -> Vec<Block> {
         ),
         (
             "Latitude".into(),
-            format!("{} deg (source: {})", num(m.latitude_deg), m.latitude_source),
+            format!(
+                "{} deg (source: {})",
+                num(m.latitude_deg),
+                m.latitude_source
+            ),
         ),
     ]));
     b.push(Block::Heading("Results".into()));
@@ -193,18 +197,16 @@ pub fn blocks(c: &Certificate) -> Vec<Block> {
     }
     let t = &c.traceability;
     b.push(Block::Heading("Traceability".into()));
-    b.push(Block::Fields(vec![
-        (
-            "Reference standard".into(),
-            format!(
-                "rate table {}, calibration certificate {}, issued by {}, due {}",
-                c.identification.station.table_model,
-                or_not_stated(&t.certificate),
-                or_not_stated(&t.issued_by),
-                or_not_stated(&t.due)
-            ),
+    b.push(Block::Fields(vec![(
+        "Reference standard".into(),
+        format!(
+            "rate table {}, calibration certificate {}, issued by {}, due {}",
+            c.identification.station.table_model,
+            or_not_stated(&t.certificate),
+            or_not_stated(&t.issued_by),
+            or_not_stated(&t.due)
         ),
-    ]));
+    )]));
     b.push(Block::Para(t.statement.clone()));
     if !c.notes.is_empty() {
         b.push(Block::Heading("Notes".into()));
@@ -220,9 +222,7 @@ pub fn blocks(c: &Certificate) -> Vec<Block> {
             ("Date".into(), a.time.clone()),
             ("Signature key".into(), a.key_fingerprint.clone()),
         ])),
-        None => b.push(Block::Para(
-            "Not approved: DRAFT (no signature).".into(),
-        )),
+        None => b.push(Block::Para("Not approved: DRAFT (no signature).".into())),
     }
     b.push(Block::Heading("Annex: uncertainty budget".into()));
     for bu in &c.budget {
@@ -233,15 +233,25 @@ pub fn blocks(c: &Certificate) -> Vec<Block> {
             bu.unit,
             num(bu.u_c),
             bu.unit,
-            bu.nu_eff.map(|n| format!("{n:.1}")).unwrap_or_else(|| "infinite".into()),
+            bu.nu_eff
+                .map(|n| format!("{n:.1}"))
+                .unwrap_or_else(|| "infinite".into()),
             bu.k,
             num(bu.expanded),
             bu.unit
         )));
         b.push(Block::Table(
-            ["Source", "Type", "Distribution", "Stated", "Sensitivity", "u", "dof"]
-                .map(String::from)
-                .to_vec(),
+            [
+                "Source",
+                "Type",
+                "Distribution",
+                "Stated",
+                "Sensitivity",
+                "u",
+                "dof",
+            ]
+            .map(String::from)
+            .to_vec(),
             bu.terms
                 .iter()
                 .map(|t| {
@@ -255,7 +265,9 @@ pub fn blocks(c: &Certificate) -> Vec<Block> {
                             (TermStatus::Stated, Some(u)) => format!("{} {}", num(u), bu.unit),
                             _ => "not stated".into(),
                         },
-                        t.dof.map(|d| format!("{d:.0}")).unwrap_or_else(|| "inf".into()),
+                        t.dof
+                            .map(|d| format!("{d:.0}"))
+                            .unwrap_or_else(|| "inf".into()),
                     ]
                 })
                 .collect(),

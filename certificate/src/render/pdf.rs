@@ -47,7 +47,11 @@ pub fn pdf(c: &Certificate) -> Result<Vec<u8>, PdfError> {
     typeset(c, Some(pages.get()), pages)
 }
 
-fn typeset(c: &Certificate, total: Option<usize>, seen: Rc<Cell<usize>>) -> Result<Vec<u8>, PdfError> {
+fn typeset(
+    c: &Certificate,
+    total: Option<usize>,
+    seen: Rc<Cell<usize>>,
+) -> Result<Vec<u8>, PdfError> {
     let mut doc = Document::new(fonts()?);
     doc.set_title(format!("Certificate No. {}", c.number));
     doc.set_font_size(9);
@@ -62,8 +66,12 @@ fn typeset(c: &Certificate, total: Option<usize>, seen: Rc<Cell<usize>>) -> Resu
         let mut l = LinearLayout::vertical();
         if draft {
             l.push(
-                Paragraph::new("DRAFT - not approved")
-                    .styled(Style::new().bold().with_font_size(14).with_color(Color::Rgb(180, 0, 0))),
+                Paragraph::new("DRAFT - not approved").styled(
+                    Style::new()
+                        .bold()
+                        .with_font_size(14)
+                        .with_color(Color::Rgb(180, 0, 0)),
+                ),
             );
         }
         l.push(Paragraph::new(lines[0].clone()).styled(Style::new().bold().with_font_size(11)));

@@ -346,7 +346,9 @@ pub fn verify_hashes(
         let what = format!("approval by {} ({}) at {}", a.signer, a.role, a.time);
         push(
             &what,
-            parsed.approval_problem().map_or(Status::Intact, Status::Unsigned),
+            parsed
+                .approval_problem()
+                .map_or(Status::Intact, Status::Unsigned),
         );
     }
     if let Some(key) = key {
@@ -451,7 +453,10 @@ mod tests {
         let json = seal.to_json();
         let r = verify_seal(Some(&json), Some(&Seal::hash_line(&json)), &f, None);
         assert!(r.intact(), "{}", r.text());
-        assert!(r.text().contains("approval by A. Metrologist (Head of laboratory) at t1"));
+        assert!(
+            r.text()
+                .contains("approval by A. Metrologist (Head of laboratory) at t1")
+        );
 
         // Another name, role or time under the same signature: refused.
         let mut forged = seal.clone();
@@ -460,7 +465,11 @@ mod tests {
         let json = forged.to_json();
         let r = verify_seal(Some(&json), Some(&Seal::hash_line(&json)), &f, None);
         assert!(!r.intact());
-        assert!(r.text().contains("! UNSIGNED approval by Someone Else"), "{}", r.text());
+        assert!(
+            r.text().contains("! UNSIGNED approval by Someone Else"),
+            "{}",
+            r.text()
+        );
 
         // A file added after the approval is not approved.
         let mut later = seal.clone();
