@@ -358,6 +358,8 @@ fn a_draft_says_so_on_every_page_and_refusals_have_their_exit_codes() {
             "s.yaml",
             "--out",
             "acc",
+            "--serial",
+            "SN-4242",
         ],
         dir,
     );
@@ -378,6 +380,8 @@ fn a_draft_says_so_on_every_page_and_refusals_have_their_exit_codes() {
     let o = ratecal(&["archive", "add", "acc", "--archive", "archive"], dir);
     assert_eq!(code(&o), 0, "{}", text(&o));
     let j = json_of(&certificate(dir, "acc", &["--format", "json"]));
+    // `run --serial` sets the item's serial without editing the station file.
+    assert_eq!(j["identification"]["item_serial"], "SN-4242");
     let conf = &j["conformity"];
     assert!(
         conf["rule"]
