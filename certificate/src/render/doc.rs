@@ -220,7 +220,11 @@ pub fn blocks(c: &Certificate) -> Vec<Block> {
             ("Approved by".into(), a.signer.clone()),
             ("Role".into(), a.role.clone()),
             ("Date".into(), a.time.clone()),
-            ("Signature key".into(), a.key_fingerprint.clone()),
+            // A space after the scheme: the hex alone fits a narrow column.
+            (
+                "Signature key".into(),
+                a.key_fingerprint.replacen("SHA256:", "SHA256: ", 1),
+            ),
         ])),
         None => b.push(Block::Para("Not approved: DRAFT (no signature).".into())),
     }

@@ -93,13 +93,13 @@ fn typeset(
                 doc.push(Break::new(0.6));
                 doc.push(Paragraph::new(h).styled(Style::new().bold().with_font_size(12)));
             }
-            Block::Para(p) => doc.push(Paragraph::new(p)),
+            Block::Para(p) => doc.push(Paragraph::new(breakable(&p, fit(180.0, 9.0)))),
             Block::Fields(f) => {
                 let mut t = TableLayout::new(vec![1, 3]);
                 for (k, v) in f {
                     t.row()
                         .element(Paragraph::new(k).styled(Style::new().bold()))
-                        .element(Paragraph::new(v))
+                        .element(Paragraph::new(breakable(&v, fit(135.0, 9.0))))
                         .push()
                         .map_err(err)?;
                 }
@@ -113,6 +113,11 @@ fn typeset(
                     n => vec![1; n],
                 };
                 let small = Style::new().with_font_size(7);
+                let sum: usize = weights.iter().sum();
+                let widths: Vec<usize> = weights
+                    .iter()
+                    .map(|w| fit(180.0 * *w as f64 / sum as f64 - 2.0, 7.0))
+                    .collect();
                 let mut t = TableLayout::new(weights);
                 t.set_cell_decorator(FrameCellDecorator::new(true, true, false));
                 let mut row = t.row();
@@ -122,7 +127,8 @@ fn typeset(
                 row.push().map_err(err)?;
                 for r in rows {
                     let mut row = t.row();
-                    for cell in r {
+                    for (cell, w) in r.iter().zip(&widths) {
+                        let cell = breakable(cell, *w);
                         row.push_element(Paragraph::new(cell).styled(small).padded(1));
                     }
                     row.push().map_err(err)?;
@@ -133,5 +139,86 @@ fn typeset(
     }
     let mut out = Vec::new();
     doc.render(&mut out).map_err(err)?;
+    if total.is_some() { tidy(&out) } else { Ok(out) }
+}
+
+/// How many characters of DejaVu Sans at `pt` fit in `mm` (digits, hex and lower case are
+/// at most 0.65 em wide: a SHA-256 fits a field's column whole).
+fn fit(mm: f64, pt: f64) -> usize {
+    ((mm * 72.0 / 25.4) / (pt * 0.65)).floor().max(4.0) as usize
+}
+
+/// `text` with a space put into any run of more than `max` non-space characters: genpdf
+/// drops the rest of a paragraph whose word is wider than its column.
+fn breakable(text: &str, max: usize) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut run = 0;
+    for c in text.chars() {
+        if c.is_whitespace() {
+            run = 0;
+        } else {
+            if run == max {
+                out.push(' ');
+                run = 0;
+            }
+            run += 1;
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// Rewrites what printpdf 0.3 writes loosely, with lopdf: each font's ToUnicode map as a
+/// plain CMap (printpdf puts PostScript comments inside it and writes code points past
+/// U+FFFF as five hex digits, which stricter readers refuse), and every stream compressed
+/// (the embedded fonts shrink to about a third).
+fn tidy(pdf: &[u8]) -> Result<Vec<u8>, PdfError> {
+    let mut doc = lopdf::Document::load_mem(pdf).map_err(err)?;
+    let maps: Vec<lopdf::ObjectId> = doc
+        .objects
+        .values()
+        .filter_map(|o| o.as_dict().ok())
+        .filter_map(|d| d.get(b"ToUnicode").ok()?.as_reference().ok())
+        .collect();
+    for id in maps {
+        let stream = doc
+            .get_object_mut(id)
+            .and_then(|o| o.as_stream_mut())
+            .map_err(err)?;
+        let text = String::from_utf8_lossy(&stream.content).into_owned();
+        stream.set_plain_content(clean_cmap(&text).into_bytes());
+    }
+    doc.compress();
+    let mut out = Vec::new();
+    doc.save_to(&mut out).map_err(err)?;
     Ok(out)
+}
+
+/// A ToUnicode CMap with the `<glyph> <unicode>` pairs of `text` within the BMP, in blocks
+/// of at most 100.
+fn clean_cmap(text: &str) -> String {
+    let pairs: Vec<(&str, &str)> = text
+        .lines()
+        .filter_map(|l| {
+            let l = l.trim();
+            let (a, b) = l.strip_prefix('<')?.split_once("> <")?;
+            let b = b.strip_suffix('>')?;
+            (a.len() == 4 && b.len() == 4).then_some((a, b))
+        })
+        .collect();
+    let mut s = String::from(
+        "/CIDInit /ProcSet findresource begin\n12 dict begin\nbegincmap\n\
+         /CIDSystemInfo << /Registry (Adobe) /Ordering (UCS) /Supplement 0 >> def\n\
+         /CMapName /Adobe-Identity-UCS def\n/CMapType 2 def\n\
+         1 begincodespacerange\n<0000> <FFFF>\nendcodespacerange\n",
+    );
+    for chunk in pairs.chunks(100) {
+        s.push_str(&format!("{} beginbfchar\n", chunk.len()));
+        for (g, u) in chunk {
+            s.push_str(&format!("<{g}> <{u}>\n"));
+        }
+        s.push_str("endbfchar\n");
+    }
+    s.push_str("endcmap\nCMapName currentdict /CMap defineresource pop\nend\nend\n");
+    s
 }
