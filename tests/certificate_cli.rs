@@ -130,7 +130,7 @@ fn full_flow(procedure: &str, text_of: Option<&str>, label: &str, step: &str, gy
     let o = ratecal(
         &[
             "run",
-            &procedure,
+            procedure,
             "--dry-run",
             "--station",
             "s.yaml",
