@@ -86,11 +86,8 @@ fn json_of(o: &Output) -> serde_json::Value {
     serde_json::from_slice(&o.stdout).unwrap_or_else(|e| panic!("{e}: {}", text(o)))
 }
 
-/// The standard procedure: a dry run of it takes minutes in a debug build, so it is
-/// ignored by default; run it with
-/// `cargo test --release --test certificate_cli -- --ignored`.
+/// The proof: a dry run of `procedures/imu-2d-standard`, approved, archived, certified.
 #[test]
-#[ignore]
 fn the_standard_procedure_gives_a_signed_certificate_whose_pdf_holds_every_element() {
     let procedure = support::procedures("imu-2d-standard");
     full_flow(
