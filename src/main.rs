@@ -55,6 +55,10 @@ enum Command {
     Archive(cli::archive::Args),
     /// Convert a lab's own DAQ files (CSV, raw counts, no time column) to a recording.
     Import(cli::import::Args),
+    /// Approve a run's results for a certificate: signer, role and time, signed into its seal.
+    Approve(cli::approve::Args),
+    /// Issue a calibration certificate (PDF, HTML, Markdown or JSON) for an archived run.
+    Certificate(cli::certificate::Args),
 }
 
 fn main() -> ExitCode {
@@ -73,5 +77,7 @@ fn main() -> ExitCode {
         Command::Key(a) => cli::key::main(a),
         Command::Archive(a) => cli::archive::main(a),
         Command::Import(a) => cli::import::main(a),
+        Command::Approve(a) => cli::approve::main(a),
+        Command::Certificate(a) => cli::certificate::main(a),
     }
 }

@@ -26,13 +26,22 @@ pub struct Archive {
 
 /// The schema migrations, in order (embedded: the binary carries its schema).
 fn migrator() -> Migrator {
-    Migrator::with_migrations(vec![Migration::new(
-        1,
-        "schema".into(),
-        MigrationType::Simple,
-        include_str!("../migrations/0001_schema.sql").into_sql_str(),
-        false,
-    )])
+    Migrator::with_migrations(vec![
+        Migration::new(
+            1,
+            "schema".into(),
+            MigrationType::Simple,
+            include_str!("../migrations/0001_schema.sql").into_sql_str(),
+            false,
+        ),
+        Migration::new(
+            2,
+            "certificates".into(),
+            MigrationType::Simple,
+            include_str!("../migrations/0002_certificates.sql").into_sql_str(),
+            false,
+        ),
+    ])
 }
 
 impl Archive {

@@ -14,6 +14,7 @@
 
 mod add;
 mod backup;
+mod certificate;
 mod check;
 mod dates;
 mod db;
@@ -26,10 +27,12 @@ mod store;
 pub mod trend;
 
 pub use add::Added;
+pub use certificate::Issued;
 pub use check::CheckReport;
 pub use dates::{days_from_iso, iso_date};
 pub use db::{Archive, Backend};
 pub use error::ArchiveError;
+pub use ingest::read as read_folder;
 pub use ingest::{Folder, IndexFacts, LimitRow, ParamRow};
 pub use location::Location;
 pub use query::{Filter, RunDetail, RunSummary, StoredFile};

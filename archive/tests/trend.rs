@@ -123,6 +123,39 @@ async fn known_drift_is_recovered_within_its_uncertainty() {
     assert!(g.limit.is_none() && g.recalibration_days.is_none());
     assert!(t.svg().contains("class=\"drift\""));
     assert!(t.text().contains("recalibrate within"));
+    // The recommended interval is the earliest parameter's date, and names it.
+    let (by, line) = all.recommended_interval().expect("a recommendation");
+    assert_eq!(Some(by.clone()), p.recalibrate_by);
+    assert!(
+        line.starts_with(&format!(
+            "recommended recalibration: {by} (from the drift of accel.bias.x"
+        )),
+        "{line}"
+    );
+
+    // The same limit written in mg on a plain `accel.bias.x <= L` (how the language
+    // states a check on a calibrated parameter: its magnitude): the same interval.
+    let b = Archive::open(&Location::Folder(tmp.path().join("b")))
+        .await
+        .unwrap();
+    let in_mg: Vec<Folder> = cals
+        .iter()
+        .cloned()
+        .map(|mut f| {
+            f.facts.id = format!("mg{}", f.facts.id);
+            f.facts.limits = vec![LimitRow {
+                quantity: "accel.bias.x".into(),
+                op: "<=".into(),
+                limit: 0.05 / 9.80665 * 1000.0,
+                unit: "mg".into(),
+            }];
+            f
+        })
+        .collect();
+    b.insert_many(&in_mg).await.unwrap();
+    let m = b.trend("1234", &opts(&["accel.bias.x"])).await.unwrap();
+    let mg_days = m.parameters[0].recalibration_days.expect("interval in mg");
+    assert!((mg_days - days).abs() < 1e-6 * days, "{mg_days} vs {days}");
 }
 
 #[tokio::test]

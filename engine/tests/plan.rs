@@ -300,3 +300,41 @@ fn huge_repeat_counts_cost_nothing() {
         vec!["s/{i}/{j}/1", "s/{i}/{j}/2", "s/{i}/{j}/3"]
     );
 }
+
+#[test]
+fn acceptance_checks_on_calibrated_parameters_carry_their_dimension() {
+    let text = STANDARD.replacen(
+        "  step accel_static",
+        "  accept accel.bias.x <= 80 mg\n  accept gyro.scale.x <= 300 ppm\n  \
+         accept accel.misalignment.xy <= 1 mrad\n  accept gyro.bias.z <= 0.1 deg/s\n\n  step accel_static",
+        1,
+    );
+    let plan = check_text("p", &text, &NoImports, &CheckOptions::default())
+        .expect("parameter checks are accepted")
+        .plan;
+    let accept = |q: &str| plan.accepts.iter().find(|a| a.quantity == q).expect(q);
+    assert!((accept("accel.bias.x").limit.value - 0.080 * 9.80665).abs() < 1e-12);
+    assert!((accept("gyro.scale.x").limit.value - 300e-6).abs() < 1e-18);
+    assert!((accept("accel.misalignment.xy").limit.value - 1e-3f64.to_degrees()).abs() < 1e-12);
+    assert_eq!(accept("gyro.bias.z").limit.value, 0.1);
+    // A parameter in the wrong unit, and one that does not exist: located errors.
+    for (bad, code) in [
+        ("accept gyro.scale.x <= 80 mg", "check::unit_mismatch"),
+        ("accept accel.bias.w <= 80 mg", "check::unknown_name"),
+        (
+            "accept accel.misalignment.xx <= 1 mrad",
+            "check::unknown_name",
+        ),
+    ] {
+        let text = STANDARD.replacen(
+            "  step accel_static",
+            &format!("  {bad}\n\n  step accel_static"),
+            1,
+        );
+        let errs = match check_text("p", &text, &NoImports, &CheckOptions::default()) {
+            Ok(_) => panic!("`{bad}` was accepted"),
+            Err(e) => format!("{e:?}"),
+        };
+        assert!(errs.contains(code), "`{bad}`: {errs}");
+    }
+}

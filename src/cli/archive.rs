@@ -100,6 +100,10 @@ enum Command {
         include_dry_runs: bool,
         #[arg(long, value_enum, default_value_t = TrendFormat::Table)]
         format: TrendFormat,
+        /// Print the recommended recalibration date (ISO/IEC 17025 7.8.4.3: only when
+        /// agreed with the customer), when the history allows one.
+        #[arg(long)]
+        recommend_interval: bool,
     },
     /// A consistent copy (a folder archive) another machine can open.
     Backup {
@@ -201,6 +205,7 @@ async fn run(loc: &Location, cmd: Command) -> Result<ExitCode, Report> {
             confidence,
             include_dry_runs,
             format,
+            recommend_interval,
         } => {
             let opt = TrendOptions {
                 params,
@@ -212,6 +217,16 @@ async fn run(loc: &Location, cmd: Command) -> Result<ExitCode, Report> {
                 TrendFormat::Json => println!("{}", to_json(&t)?),
                 TrendFormat::Table => print!("{}", t.text()),
                 TrendFormat::Svg => print!("{}", t.svg()),
+            }
+            if recommend_interval {
+                match t.recommended_interval() {
+                    Some((_, line)) if format == TrendFormat::Table => println!("{line}"),
+                    Some((_, line)) => eprintln!("{line}"),
+                    None => eprintln!(
+                        "no recommended recalibration: the history determines no drift \
+                         against an acceptance limit"
+                    ),
+                }
             }
             ExitCode::SUCCESS
         }

@@ -2,7 +2,9 @@
 //! needs (files, station, drivers) and maps outcomes to the exit codes of spec/cli.md.
 
 pub mod analyze;
+pub mod approve;
 pub mod archive;
+pub mod certificate;
 pub mod check;
 pub mod diff;
 pub mod emulate;

@@ -42,11 +42,15 @@ pub struct Args {
     seed: u64,
     /// Continue an interrupted run from its last completed step (procedure and station
     /// come from the run folder).
-    #[arg(long, value_name = "RUN_DIR", conflicts_with_all = ["procedure", "station", "out"])]
+    #[arg(long, value_name = "RUN_DIR", conflicts_with_all = ["procedure", "station", "out", "serial"])]
     resume: Option<PathBuf>,
     /// Operator name, recorded in the manifest.
     #[arg(long)]
     operator: Option<String>,
+    /// The IMU's serial number for this run (the manifest's `imu.serial`, the archive's
+    /// index, the certificate), instead of the station file's `imu.serial`.
+    #[arg(long, value_name = "SN")]
+    serial: Option<String>,
     /// Sign the run folder's seal with the lab's private key (`ratecal key new` wrote it).
     #[arg(long, value_name = "LAB_KEY")]
     sign: Option<PathBuf>,
@@ -267,7 +271,10 @@ fn prepare_new(args: &Args) -> Result<(Prepared, FolderLock), Report> {
     let builtin = std::fs::read_to_string(&proc_path)
         .ok()
         .map(|text| setup::builtin_for(&text));
-    let st = setup::station_for(args.station.as_deref(), args.dry_run, builtin)?;
+    let mut st = setup::station_for(args.station.as_deref(), args.dry_run, builtin)?;
+    if let Some(sn) = &args.serial {
+        st.station.imu.serial = sn.clone();
+    }
     let changed = setup::released_unchanged(&proc_path, args.allow_changed)?;
     let pr = setup::procedure(&proc_path, &st.station, None)?;
     let dir = args

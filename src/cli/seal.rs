@@ -40,13 +40,18 @@ pub fn write(dir: &Path, key: Option<&SigningKey>) -> std::io::Result<()> {
     if let Some(k) = key {
         seal.sign(k);
     }
-    save(dir, &seal, &[])
+    save_with(dir, &seal, &[])
+}
+
+/// Replaces the seal (an approval added to it), as one committed change.
+pub fn save(dir: &Path, seal: &Seal) -> std::io::Result<()> {
+    save_with(dir, seal, &[])
 }
 
 /// Replaces the seal, together with `files` (name, bytes) written into the folder, as one
 /// change: all staged under the pending folder, then committed (`ratecal_recording::commit`):
 /// a crash leaves the old seal and files or the new ones, never a mix that reads altered.
-fn save(dir: &Path, seal: &Seal, files: &[(String, Vec<u8>)]) -> std::io::Result<()> {
+fn save_with(dir: &Path, seal: &Seal, files: &[(String, Vec<u8>)]) -> std::io::Result<()> {
     let pending = pending_dir(dir)?;
     let json = seal.to_json();
     let mut moves = Vec::with_capacity(files.len() + 2);
@@ -104,7 +109,7 @@ pub fn write_files(
         .collect();
     let now = rfc3339(std::time::SystemTime::now());
     seal.add_hashes(&now, command, &borrowed);
-    save(dir, &seal, files)?;
+    save_with(dir, &seal, files)?;
     Ok(true)
 }
 

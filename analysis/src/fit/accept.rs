@@ -225,8 +225,16 @@ fn lookup(
         return Ok(*v);
     }
     if let Some(p) = res.parameters.get(name) {
+        // A calibrated parameter is in its results unit (ppm, mrad); the limit in the
+        // language's base unit of its dimension.
+        let to_base = match p {
+            crate::results::Parameter::Estimate { unit, .. } => {
+                ratecal_physics::units::parse_quantity(&format!("1 {unit}")).map_or(1.0, |(_, f)| f)
+            }
+            crate::results::Parameter::Unobservable { .. } => 1.0,
+        };
         return match p.value_u() {
-            Some((v, u)) => Ok((v.abs(), u)),
+            Some((v, u)) => Ok((v.abs() * to_base, u * to_base)),
             None => Err(format!("{name} is not observable in this recording")),
         };
     }

@@ -219,6 +219,34 @@ fn param_trend(
     }
 }
 
+impl Trend {
+    /// The recommended recalibration (ISO/IEC 17025, 7.8.4.3: only when agreed with the
+    /// customer): the earliest date a parameter's predicted value plus its expanded
+    /// uncertainty reaches its acceptance limit, and the sentence that says so; `None` when
+    /// the history allows none (no drift determined against a limit).
+    pub fn recommended_interval(&self) -> Option<(String, String)> {
+        let p = self
+            .parameters
+            .iter()
+            .filter(|p| p.recalibration_days.is_some() && p.recalibrate_by.is_some())
+            .min_by(|a, b| {
+                let days = |p: &ParamTrend| p.recalibration_days.unwrap_or(f64::INFINITY);
+                days(a).total_cmp(&days(b))
+            })?;
+        let by = p.recalibrate_by.clone()?;
+        let limit = p.limit.as_ref().map(|l| l.text.clone()).unwrap_or_default();
+        let line = format!(
+            "recommended recalibration: {by} (from the drift of {}, {} calibrations: the \
+             predicted value plus U (k = {:.2}, {:.0} % one-sided) reaches {limit})",
+            p.name,
+            p.points.len(),
+            self.k,
+            self.confidence * 100.0
+        );
+        Some((by, line))
+    }
+}
+
 /// The acceptance limit on `name` (`name op L`, `abs(name) op L` or `|name| op L`).
 fn find_limit(
     name: &str,
@@ -233,23 +261,26 @@ fn find_limit(
             continue;
         }
         let text = format!("{q} {op} {limit} {lunit}");
-        if lunit != unit {
-            notes.push(format!(
-                "limit `{text}` is in {lunit}, the parameter in {unit}: not compared"
-            ));
-            continue;
-        }
-        let bound = match (magnitude, op.as_str()) {
-            (true, "<=" | "<") => Bound::Magnitude,
-            (false, "<=" | "<") => Bound::Upper,
-            (false, ">=" | ">") => Bound::Lower,
+        // A limit in another unit of the same dimension (`80 mg` on a bias in m/s^2).
+        let factor = |u: &str| ratecal_physics::units::parse_quantity(&format!("1 {u}"));
+        let limit = match (lunit == unit, factor(lunit), factor(unit)) {
+            (true, _, _) => *limit,
+            (false, Some((dl, fl)), Some((dp, fp))) if dl == dp && fp != 0.0 => limit * fl / fp,
+            _ => {
+                notes.push(format!(
+                    "limit `{text}` is in {lunit}, the parameter in {unit}: not compared"
+                ));
+                continue;
+            }
+        };
+        // The analysis judges a check on a calibrated parameter by its magnitude
+        // (docs/language.md): `accel.bias.x <= 80 mg` bounds |accel.bias.x|.
+        let bound = match op.as_str() {
+            "<=" | "<" => Bound::Magnitude,
+            ">=" | ">" if !magnitude => Bound::Lower,
             _ => continue,
         };
-        return Some(LimitUse {
-            text,
-            bound,
-            limit: *limit,
-        });
+        return Some(LimitUse { text, bound, limit });
     }
     if !notes.iter().any(|n| n.starts_with("limit")) {
         notes

@@ -49,6 +49,9 @@ pub struct SiteSpec {
     /// Local gravity, m/s^2 (the g-sensitivity is given per g: it divides by it).
     #[serde(deserialize_with = "positive")]
     pub gravity_mps2: f64,
+    /// Standard uncertainty of `gravity_mps2`, m/s^2 (the certificate's budget).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gravity_u_mps2: Option<f64>,
 }
 
 /// Settling behaviour of the table servo: a second-order loop.
@@ -130,6 +133,39 @@ pub struct TableSpec {
     /// Station-side catalogue effects (the encoder eccentricity) under their canonical ids.
     #[serde(default)]
     pub effects: TableEffectsSpec,
+    /// Manufacturer (the certificate's identification).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub manufacturer: Option<String>,
+    /// Serial number of the table.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub serial: Option<String>,
+    /// The manufacturer's accuracy class.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub accuracy_class: Option<String>,
+    /// Rate accuracy, a ratio of the rate (bound of a rectangular distribution).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rate_accuracy: Option<Ratio>,
+    /// Position accuracy of each axis (bound of a rectangular distribution).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub position_accuracy: Option<Angle>,
+    /// Orthogonality (and wobble) of the two axes (bound of a rectangular distribution).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axis_orthogonality: Option<Angle>,
+    /// The table's own calibration: the reference standard certificates trace to.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub calibration: Option<TableCalibration>,
+}
+
+/// The table's calibration certificate (`table.calibration`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TableCalibration {
+    /// Its certificate number.
+    pub certificate: String,
+    /// Who issued it.
+    pub issued_by: String,
+    /// When it is due, YYYY-MM-DD.
+    pub due: String,
 }
 
 fn default_table_model() -> String {

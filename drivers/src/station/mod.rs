@@ -13,7 +13,7 @@ pub use effects::{EffectsSpec, TableEffectsSpec};
 pub use faults::{AxisName, DropoutMode, FaultSpec, LinkName, TableFaultMode};
 pub use file::{
     AmbientSpec, EnvironmentSpec, ImuSpec, ImuTemperatureSpec, MountSpec, SettlingSpec, SiteSpec,
-    Station, TableSpec, TemperatureSpec,
+    Station, TableCalibration, TableSpec, TemperatureSpec,
 };
 pub use quantity::{
     Accel, AccelDensity, Angle, Freq, Pressure, Rate, RateDensity, RateWalk, Ratio, Rotation, Temp,

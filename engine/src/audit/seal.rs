@@ -31,6 +31,33 @@ pub struct Seal {
     /// Files ratecal added or rewrote after sealing, oldest first.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub added: Vec<Addition>,
+    /// Who approved the run for issue (`ratecal approve`), signed over the seal as it was.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub approval: Option<Approval>,
+}
+
+/// An approval of the run's results for a certificate: who, in which role, when, and the
+/// Ed25519 signature of [`Seal::approved_text`] by the approver's key.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Approval {
+    /// The approver's name.
+    pub signer: String,
+    /// The approver's role (`Head of laboratory`...).
+    pub role: String,
+    /// When (RFC 3339).
+    pub time: String,
+    /// `SHA256:` and the hex SHA-256 of the approver's public key bytes.
+    pub key_fingerprint: String,
+    /// The approver's public key, 32 bytes hex.
+    pub public_key: String,
+    /// Signature of [`Seal::approved_text`], 64 bytes hex.
+    pub signature: String,
+}
+
+/// The fingerprint under which a public key is shown: `SHA256:` and the hex SHA-256 of its
+/// 32 bytes.
+pub fn key_fingerprint(key: &VerifyingKey) -> String {
+    format!("SHA256:{}", sha256_hex(key.as_bytes()))
 }
 
 /// An Ed25519 signature and the public key that made it (both hex).
@@ -99,6 +126,7 @@ impl Seal {
                 .collect(),
             signature: None,
             added: Vec::new(),
+            approval: None,
         }
     }
 
@@ -120,6 +148,67 @@ impl Seal {
             public_key: hex::encode(key.verifying_key().as_bytes()),
             signature: hex::encode(sig.to_bytes()),
         });
+    }
+
+    /// The text an approval covers: who, role, when, every sealed file and every file
+    /// added since, as the seal holds them at approval (a later addition is not approved).
+    pub fn approved_text(&self, signer: &str, role: &str, time: &str) -> String {
+        let mut s = format!("ratecal-approval/1\n{signer}\n{role}\n{time}\n");
+        s.push_str(&self.signed_text());
+        for a in &self.added {
+            s.push_str(&format!("added {} {}\n", a.time, a.command));
+            for (path, sha) in &a.files {
+                s.push_str(&format!("{sha}  {path}\n"));
+            }
+        }
+        s
+    }
+
+    /// Records the approval of the run by `signer` in `role` at `time`, signed with `key`
+    /// (replaces an earlier approval).
+    pub fn approve(&mut self, signer: &str, role: &str, time: &str, key: &SigningKey) {
+        let sig = key.sign(self.approved_text(signer, role, time).as_bytes());
+        self.approval = Some(Approval {
+            signer: signer.into(),
+            role: role.into(),
+            time: time.into(),
+            key_fingerprint: key_fingerprint(&key.verifying_key()),
+            public_key: hex::encode(key.verifying_key().as_bytes()),
+            signature: hex::encode(sig.to_bytes()),
+        });
+    }
+
+    /// `None` when the approval (if any) is signed by the key it names, its fingerprint is
+    /// that key's, and it covers the seal as it is now; else why not.
+    pub fn approval_problem(&self) -> Option<String> {
+        let a = self.approval.as_ref()?;
+        let key: Option<VerifyingKey> = hex::decode(&a.public_key)
+            .ok()
+            .and_then(|b| <[u8; 32]>::try_from(b).ok())
+            .and_then(|b| VerifyingKey::from_bytes(&b).ok());
+        let Some(key) = key else {
+            return Some("the approver's public key is not an Ed25519 key".into());
+        };
+        if key_fingerprint(&key) != a.key_fingerprint {
+            return Some("the fingerprint is not the approver's key's".into());
+        }
+        let bytes: Option<[u8; 64]> = hex::decode(&a.signature)
+            .ok()
+            .and_then(|b| b.try_into().ok());
+        let Some(bytes) = bytes else {
+            return Some("the signature is not 64 bytes of hex".into());
+        };
+        let mut before = self.clone();
+        before.approval = None;
+        let text = before.approved_text(&a.signer, &a.role, &a.time);
+        match key.verify(text.as_bytes(), &Signature::from_bytes(&bytes)) {
+            Ok(()) => None,
+            Err(_) => Some(
+                "the signature does not match the approver, the time or the files as sealed \
+                 (altered, or files added after the approval)"
+                    .into(),
+            ),
+        }
     }
 
     /// Records files written after sealing.
@@ -260,6 +349,15 @@ pub fn verify_hashes(
             FileState::Hashed { .. } => push(path, Status::Unknown),
         }
     }
+    if let Some(a) = &parsed.approval {
+        let what = format!("approval by {} ({}) at {}", a.signer, a.role, a.time);
+        push(
+            &what,
+            parsed
+                .approval_problem()
+                .map_or(Status::Intact, Status::Unsigned),
+        );
+    }
     if let Some(key) = key {
         push(
             "signature",
@@ -347,5 +445,42 @@ mod tests {
         assert!(r.text().contains("! UNKNOWN  x"), "{}", r.text());
         let r = verify_seal(Some(&json.replace("t1", "t2")), Some(&hash), &g, None);
         assert!(!r.intact());
+    }
+
+    #[test]
+    fn an_approval_covers_signer_role_time_and_every_file_and_nothing_added_later() {
+        let f = folder(&[("imu.csv", "1"), ("results.json", "{}")]);
+        let lab = SigningKey::from_bytes(&[9; 32]);
+        let mut seal = Seal::new("t0", f.iter().map(|(p, b)| (p.as_str(), b.as_slice())));
+        seal.approve("A. Metrologist", "Head of laboratory", "t1", &lab);
+        assert_eq!(seal.approval_problem(), None);
+        let a = seal.approval.clone().unwrap();
+        assert_eq!(a.key_fingerprint, key_fingerprint(&lab.verifying_key()));
+        assert!(a.key_fingerprint.starts_with("SHA256:") && a.key_fingerprint.len() == 71);
+        let json = seal.to_json();
+        let r = verify_seal(Some(&json), Some(&Seal::hash_line(&json)), &f, None);
+        assert!(r.intact(), "{}", r.text());
+        assert!(
+            r.text()
+                .contains("approval by A. Metrologist (Head of laboratory) at t1")
+        );
+
+        // Another name, role or time under the same signature: refused.
+        let mut forged = seal.clone();
+        forged.approval.as_mut().unwrap().signer = "Someone Else".into();
+        assert!(forged.approval_problem().is_some());
+        let json = forged.to_json();
+        let r = verify_seal(Some(&json), Some(&Seal::hash_line(&json)), &f, None);
+        assert!(!r.intact());
+        assert!(
+            r.text().contains("! UNSIGNED approval by Someone Else"),
+            "{}",
+            r.text()
+        );
+
+        // A file added after the approval is not approved.
+        let mut later = seal.clone();
+        later.add("t2", "ratecal report", &[("report.md", b"x")]);
+        assert!(later.approval_problem().is_some());
     }
 }

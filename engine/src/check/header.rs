@@ -64,6 +64,24 @@ const ACCEPTS: &[(&str, Dim)] = &[
     ("repeatability.cv", Dim::Ratio),
 ];
 
+/// A calibrated parameter acceptance checks may name (`accel.bias.x`, `gyro.scale.y`,
+/// `accel.misalignment.xy`) and its dimension; its magnitude is compared with the limit.
+fn parameter_dim(name: &str) -> Option<Dim> {
+    let parts: Vec<&str> = name.split('.').collect();
+    let axis = |a: &str| ["x", "y", "z"].contains(&a);
+    let pair = |a: &str| {
+        let c: Vec<char> = a.chars().collect();
+        c.len() == 2 && c[0] != c[1] && c.iter().all(|c| "xyz".contains(*c))
+    };
+    match parts.as_slice() {
+        ["accel", "bias", a] if axis(a) => Some(Dim::Accel),
+        ["gyro", "bias", a] if axis(a) => Some(Dim::Rate),
+        ["accel" | "gyro", "scale", a] if axis(a) => Some(Dim::Ratio),
+        ["accel" | "gyro", "misalignment", a] if pair(a) => Some(Dim::Angle),
+        _ => None,
+    }
+}
+
 /// Quantities the language once named that no fit computes: a check on one could never be
 /// evaluated, so it is refused here rather than leaving every run incomplete.
 const NOT_COMPUTED: &[(&str, &str)] = &[("size_effect.uncertainty", "accel.error")];
@@ -341,7 +359,12 @@ impl Ck<'_> {
             );
             return None;
         }
-        let Some(&(name, dim)) = ACCEPTS.iter().find(|x| x.0 == l.name.node) else {
+        let found = ACCEPTS
+            .iter()
+            .find(|x| x.0 == l.name.node)
+            .map(|&(n, d)| (n.to_string(), d))
+            .or_else(|| parameter_dim(&l.name.node).map(|d| (l.name.node.clone(), d)));
+        let Some((name, dim)) = found else {
             self.err(
                 Diagnostic::error(
                     "check::unknown_name",
@@ -353,7 +376,7 @@ impl Ck<'_> {
             return None;
         };
         let q = self.quantity(&l.value, dim, "this limit")?;
-        Some((name.to_string(), cmp(l.op.node), q))
+        Some((name, cmp(l.op.node), q))
     }
 
     pub(crate) fn accept(&mut self, a: &ast::Accept, step: Option<String>) -> Option<Accept> {

@@ -1,0 +1,351 @@
+//! Assembling a certificate from what the CLI read: the run's results, manifest and plan,
+//! the station's facts, the laboratory, the number the archive issued, the approval.
+
+use crate::budget::{Budget, COVERAGE};
+use crate::model::{
+    ApprovalBlock, Certificate, Conformity, ConformityCheck, FORMAT, Identification, Lab, Method,
+    ProcedureId, ResultLine, StationId, Traceability,
+};
+use crate::terms::{Stated, budget};
+use ratecal_engine::plan::Plan;
+use ratecal_engine::recording::Manifest;
+use ratecal_engine::results::{Parameter, Results};
+
+/// Everything a certificate is made of.
+pub struct Input<'a> {
+    /// The number issued (`PREFIX-YYYY-NNNNNN`) and the one it replaces.
+    pub number: String,
+    /// The certificate it amends, if any.
+    pub replaces: Option<String>,
+    /// Date of issue, YYYY-MM-DD.
+    pub issue_date: String,
+    /// The laboratory.
+    pub lab: Lab,
+    /// Customer and order reference.
+    pub customer: Option<String>,
+    /// The customer's order.
+    pub order: Option<String>,
+    /// The run's results.json.
+    pub results: &'a Results,
+    /// The run's manifest.
+    pub manifest: &'a Manifest,
+    /// The run's plan.json, when it has one.
+    pub plan: Option<&'a Plan>,
+    /// The archive's id of the run.
+    pub archive_id: String,
+    /// The station's identity.
+    pub station: StationId,
+    /// The budget's Type B figures.
+    pub stated: Stated,
+    /// The table's calibration (certificate, issued by, due).
+    pub reference: [Option<String>; 3],
+    /// Notes from refusals overridden (`--allow-expired`, `--allow-untraceable`).
+    pub notes: Vec<String>,
+    /// The approval, `None` for a draft.
+    pub approval: Option<ApprovalBlock>,
+}
+
+/// Quantities that describe noise rather than calibrate the model: not stated as results.
+fn reported(name: &str) -> bool {
+    ![".noise.", ".arw.", ".bias_instability."]
+        .iter()
+        .any(|n| name.contains(n))
+}
+
+/// The fit's Type A degrees of freedom for `sensor`: one observation per channel per
+/// segment used, less the sensor's fitted parameters (at least 1).
+pub fn type_a_dof(results: &Results, sensor: &str) -> f64 {
+    let segments = results
+        .segments
+        .iter()
+        .filter(|s| s.used_for.iter().any(|u| u == sensor))
+        .count();
+    let prefix = format!("{sensor}.");
+    let params = results
+        .parameters
+        .iter()
+        .filter(|(n, p)| {
+            n.starts_with(&prefix) && reported(n) && matches!(p, Parameter::Estimate { .. })
+        })
+        .count();
+    (3 * segments).saturating_sub(params).max(1) as f64
+}
+
+/// `value +- U unit (k = 2.05, 95 %)`, `U` to two significant digits and the value to
+/// the same decimal place.
+pub fn gum_text(value: f64, expanded: f64, k: f64, unit: &str) -> String {
+    let decimals = if expanded > 0.0 && expanded.is_finite() {
+        (1 - expanded.log10().floor() as i32).max(0) as usize
+    } else {
+        6
+    };
+    format!(
+        "{value:.decimals$} +- {expanded:.decimals$} {unit} (k = {k:.2}, {:.0} %)",
+        COVERAGE * 100.0
+    )
+}
+
+/// Builds the certificate.
+pub fn build(input: Input<'_>) -> Certificate {
+    let r = input.results;
+    let m = input.manifest;
+    let mut budgets: Vec<Budget> = Vec::new();
+    for (name, p) in &r.parameters {
+        if let Parameter::Estimate { value, u, unit } = p
+            && reported(name)
+        {
+            let sensor = name.split('.').next().unwrap_or("");
+            let nu = type_a_dof(r, sensor);
+            budgets.push(budget(name, *value, *u, unit, nu, &input.stated));
+        }
+    }
+    let results = budgets
+        .iter()
+        .map(|b| ResultLine {
+            quantity: b.quantity.clone(),
+            value: b.value,
+            expanded: b.expanded,
+            k: b.k,
+            p: COVERAGE,
+            unit: b.unit.clone(),
+            text: gum_text(b.value, b.expanded, b.k, &b.unit),
+        })
+        .collect();
+    let mut notes = input.notes;
+    let incomplete: Vec<&str> = budgets
+        .iter()
+        .filter(|b| !b.complete)
+        .map(|b| b.quantity.as_str())
+        .collect();
+    if !incomplete.is_empty() {
+        notes.push(format!(
+            "The station file does not state every figure the budget needs (terms marked \
+             \"not stated\"): the expanded uncertainty of {} covers the stated terms only.",
+            incomplete.join(", ")
+        ));
+    }
+    if m.run.as_ref().is_some_and(|run| run.dry_run) {
+        notes.push(
+            "Measured on the simulated station (a dry run): not a calibration of a real item."
+                .into(),
+        );
+    }
+    let run = m.run.as_ref();
+    let calibration_date = run
+        .map(|r| r.started.chars().take(10).collect())
+        .unwrap_or_default();
+    let procedure = m.procedure.as_ref().map(|p| ProcedureId {
+        name: p.name.clone(),
+        version: p.version.clone(),
+        sha256: p.sha256.clone(),
+        title: input.plan.map(|pl| pl.title.clone()),
+    });
+    let steps = input
+        .plan
+        .map(|pl| {
+            pl.steps
+                .iter()
+                .map(|s| match &s.title {
+                    Some(t) => format!("{t} (step `{}`)", s.name),
+                    None => format!("step `{}`", s.name),
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    let site = &m.station.site;
+    let statements = conformity(r, &budgets);
+    let method = Method {
+        steps,
+        temperature_c: r
+            .environment
+            .ambient
+            .as_ref()
+            .map(|a| [a.mean_c, a.min_c, a.max_c]),
+        gravity_mps2: site.gravity_mps2,
+        gravity_u_mps2: input.stated.gravity_u_mps2,
+        gravity_source: "the station file (site.gravity_mps2)".into(),
+        latitude_deg: site.latitude_deg,
+        latitude_source: "the station file (site.latitude_deg)".into(),
+    };
+    let [certificate, issued_by, due] = input.reference;
+    let statement = match (&certificate, &issued_by) {
+        (Some(c), Some(by)) => format!(
+            "The results are traceable to the SI through the rate table's calibration, \
+             certificate {c} issued by {by}{}.",
+            due.as_deref()
+                .map(|d| format!(", due {d}"))
+                .unwrap_or_default()
+        ),
+        (Some(c), None) => format!(
+            "The results are traceable to the SI through the rate table's calibration, \
+             certificate {c}."
+        ),
+        _ => "No reference calibration is stated for the rate table: the results are not \
+              shown to be traceable."
+            .into(),
+    };
+    Certificate {
+        format: FORMAT.into(),
+        number: input.number,
+        replaces: input.replaces,
+        draft: input.approval.is_none(),
+        identification: Identification {
+            customer: input.customer,
+            order: input.order,
+            item_model: m.imu.get("model").cloned().unwrap_or_default(),
+            item_serial: m.imu.get("serial").cloned().unwrap_or_default(),
+            item_grade: m.imu.get("grade").cloned().unwrap_or_default(),
+            procedure,
+            station: input.station,
+            run: run.map(|r| r.id.clone()).unwrap_or_default(),
+            archive_id: input.archive_id,
+            calibration_date,
+            issue_date: input.issue_date,
+            location: format!(
+                "{} (latitude {:.4} deg)",
+                input.lab.address.replace('\n', ", ").trim(),
+                site.latitude_deg
+            ),
+        },
+        lab: input.lab,
+        method,
+        model_equation: equation(r),
+        results,
+        budget: budgets,
+        conformity: statements,
+        traceability: Traceability {
+            certificate,
+            issued_by,
+            due,
+            statement,
+        },
+        approval: input.approval,
+        notes,
+    }
+}
+
+/// The model equation the parameters belong to (spec/physics.md).
+fn equation(r: &Results) -> Vec<String> {
+    let full = r.parameters.keys().any(|n| n.contains(".misalignment."));
+    if full {
+        vec![
+            "a = K_a s + b_a (m/s^2), w = K_g w_ib + b_g (deg/s)".into(),
+            "K = I + diag(scale) + misalignment (off-diagonal); b = bias; s, w_ib = the \
+             specific force and angular rate the table applies"
+                .into(),
+        ]
+    } else {
+        vec![
+            "a_i = (1 + scale_i) a_ref,i + bias_i (m/s^2), w_i = (1 + scale_i) w_ref,i + bias_i \
+             (deg/s), i = x, y, z"
+                .into(),
+            "scale in ppm (1e-6); bias = the output at zero input; a_ref, w_ref = the specific \
+             force and angular rate the table applies"
+                .into(),
+        ]
+    }
+}
+
+/// The conformity statements of the run's acceptance checks (ILAC-G8:2019). A check on a
+/// calibrated parameter states the certificate's U (its budget's, in the check's unit) and,
+/// under guarded acceptance, is decided with it; other checks keep the analysis's U.
+fn conformity(r: &Results, budgets: &[Budget]) -> Option<Conformity> {
+    if r.acceptance.is_empty() {
+        return None;
+    }
+    let guarded = r.acceptance.iter().any(|a| a.rule != "simple");
+    let rule = if guarded {
+        "ILAC-G8:2019 guarded acceptance: the guard band is the expanded uncertainty U \
+         (w = U, 95 %); a value within U of the limit is neither pass nor fail"
+    } else {
+        "ILAC-G8:2019 simple acceptance (shared risk): the value itself is compared with the \
+         limit; U is stated beside it"
+    };
+    let checks = r
+        .acceptance
+        .iter()
+        .map(|a| {
+            let mut verdict = serde_json::to_value(a.verdict)
+                .ok()
+                .and_then(|v| v.as_str().map(String::from))
+                .unwrap_or_default();
+            let from_budget = budgets
+                .iter()
+                .find(|b| b.quantity == a.quantity)
+                .and_then(|b| {
+                    let v = a.value?;
+                    (b.value != 0.0).then(|| b.expanded * v / b.value.abs())
+                });
+            let expanded = from_budget.or(a.expanded_u);
+            let is_guarded = a.rule != "simple";
+            if let (Some(v), Some(u), true, Some(_)) = (a.value, expanded, is_guarded, from_budget)
+            {
+                let upper = matches!(a.op.as_str(), "<=" | "<");
+                let margin = if upper { a.limit - v } else { v - a.limit };
+                verdict = if margin >= u {
+                    "pass"
+                } else if margin < -u {
+                    "fail"
+                } else {
+                    "indeterminate"
+                }
+                .into();
+            }
+            let within_band =
+                matches!((a.value, expanded), (Some(v), Some(u)) if (v - a.limit).abs() < u);
+            let statement = match (a.value, verdict.as_str()) {
+                (None, _) => format!("{}: not evaluated", a.name),
+                (Some(_), "indeterminate") => format!(
+                    "{}: the value lies within the guard band around the limit: conformity can \
+                     be neither stated nor rejected",
+                    a.name
+                ),
+                (Some(_), v) => {
+                    let word = if v == "pass" {
+                        "conforms"
+                    } else {
+                        "does not conform"
+                    };
+                    let near = if within_band {
+                        " (the value lies within U of the limit)"
+                    } else {
+                        ""
+                    };
+                    format!("{}: {word}{near}", a.name)
+                }
+            };
+            ConformityCheck {
+                name: a.name.clone(),
+                value: a.value,
+                op: a.op.clone(),
+                limit: a.limit,
+                unit: a.unit.clone(),
+                expanded,
+                guard_band: expanded.filter(|_| is_guarded),
+                verdict,
+                statement,
+            }
+        })
+        .collect();
+    Some(Conformity {
+        rule: rule.into(),
+        checks,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn results_are_rounded_to_two_significant_digits_of_u() {
+        assert_eq!(
+            gum_text(-653.123, 11.74, 2.048, "ppm"),
+            "-653 +- 12 ppm (k = 2.05, 95 %)"
+        );
+        assert_eq!(
+            gum_text(0.0120023, 0.0000371, 1.96, "m/s^2"),
+            "0.012002 +- 0.000037 m/s^2 (k = 1.96, 95 %)"
+        );
+    }
+}

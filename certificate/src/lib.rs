@@ -1,0 +1,23 @@
+//! Calibration certificates a laboratory can sign and send (ISO/IEC 17025, 7.8): the data
+//! model, the GUM uncertainty budget (Type A from the fit, Type B from what the station file
+//! states, Welch-Satterthwaite, Student's t) and the renderers.
+//!
+//! ```text
+//! results.json, manifest, plan, station facts, LAB.yaml, number, approval
+//!   ─ build::build ─► Certificate ─ render::{markdown, html, pdf} / serde_json
+//! ```
+//!
+//! Nothing here opens a file or the archive: the CLI (`ratecal certificate`) reads the run
+//! folder, verifies its seal, takes the number from the archive and hands everything in.
+
+pub mod budget;
+mod build;
+mod model;
+pub mod render;
+pub mod terms;
+
+pub use build::{Input, build, gum_text, type_a_dof};
+pub use model::{
+    ApprovalBlock, Certificate, Conformity, ConformityCheck, END_MARK, FORMAT, Identification, Lab,
+    Method, ProcedureId, REPRODUCTION, ResultLine, StationId, Traceability,
+};

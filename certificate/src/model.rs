@@ -1,0 +1,221 @@
+//! What a certificate holds, in its order (`docs/certificate.md`): one data model, rendered
+//! as Markdown, HTML and PDF, and written whole by `--format json` (its keys are a stable
+//! interface).
+
+use crate::budget::Budget;
+use serde::{Deserialize, Serialize};
+
+/// The format tag of `ratecal certificate --format json`.
+pub const FORMAT: &str = "ratecal-certificate/1";
+
+/// The laboratory, from `LAB.yaml`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Lab {
+    /// The laboratory's name.
+    pub name: String,
+    /// Its postal address (one line or several).
+    pub address: String,
+    /// Its accreditation (body, number, scope).
+    pub accreditation: String,
+    /// The certificate numbers' prefix (`PREFIX-YYYY-NNNNNN`): letters, digits and dashes.
+    pub certificate_prefix: String,
+    /// A logo image file, relative to `LAB.yaml` (shown by the HTML certificate).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub logo: Option<String>,
+}
+
+/// A calibration certificate.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Certificate {
+    /// `ratecal-certificate/1`.
+    pub format: String,
+    /// `PREFIX-YYYY-NNNNNN`.
+    pub number: String,
+    /// The number of the certificate this one amends and replaces.
+    pub replaces: Option<String>,
+    /// True until the run is approved (`ratecal approve`): every page says DRAFT.
+    pub draft: bool,
+    /// The laboratory.
+    pub lab: Lab,
+    /// Identification of the calibration.
+    pub identification: Identification,
+    /// Method and conditions.
+    pub method: Method,
+    /// The model equation the parameters belong to.
+    pub model_equation: Vec<String>,
+    /// Each calibrated parameter: value +- U (k, 95 %).
+    pub results: Vec<ResultLine>,
+    /// Uncertainty budget: one entry per reported quantity.
+    pub budget: Vec<Budget>,
+    /// Statements of conformity, when the procedure has acceptance checks.
+    pub conformity: Option<Conformity>,
+    /// Traceability to the reference standards.
+    pub traceability: Traceability,
+    /// Who approved the results, `None` for a draft.
+    pub approval: Option<ApprovalBlock>,
+    /// Notes printed on the certificate (incomplete budgets, overridden refusals).
+    pub notes: Vec<String>,
+}
+
+/// Customer, item, procedure, station, dates, place.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Identification {
+    /// The customer.
+    pub customer: Option<String>,
+    /// The customer's order reference.
+    pub order: Option<String>,
+    /// IMU model.
+    pub item_model: String,
+    /// IMU serial number.
+    pub item_serial: String,
+    /// IMU grade.
+    pub item_grade: String,
+    /// Procedure name, version and canonical SHA-256.
+    pub procedure: Option<ProcedureId>,
+    /// The station: table model, manufacturer, serial, accuracy class.
+    pub station: StationId,
+    /// The run's id (its folder name) and its archive id.
+    pub run: String,
+    /// The archive's content address of the run.
+    pub archive_id: String,
+    /// Date of calibration (YYYY-MM-DD, the run's start).
+    pub calibration_date: String,
+    /// Date of issue (YYYY-MM-DD).
+    pub issue_date: String,
+    /// Where: the laboratory's address and the site's latitude.
+    pub location: String,
+}
+
+/// A procedure's identity.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ProcedureId {
+    /// Name.
+    pub name: String,
+    /// Version.
+    pub version: String,
+    /// SHA-256 of its canonical text.
+    pub sha256: String,
+    /// Its title.
+    pub title: Option<String>,
+}
+
+/// The rate table as the station file names it.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct StationId {
+    /// The station's name.
+    pub name: String,
+    /// The table's model.
+    pub table_model: String,
+    /// Its manufacturer (`not stated` when absent).
+    pub manufacturer: Option<String>,
+    /// Its serial number.
+    pub serial: Option<String>,
+    /// Its accuracy class.
+    pub accuracy_class: Option<String>,
+}
+
+/// What was done and under which conditions.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Method {
+    /// The procedure's steps in an engineer's words (`title`: what it does).
+    pub steps: Vec<String>,
+    /// Ambient temperature during the measurement: mean, min, max (degC), when recorded.
+    pub temperature_c: Option<[f64; 3]>,
+    /// The site's gravity, m/s^2, and where the figure comes from.
+    pub gravity_mps2: f64,
+    /// Its standard uncertainty, when stated.
+    pub gravity_u_mps2: Option<f64>,
+    /// The gravity's source.
+    pub gravity_source: String,
+    /// The site's latitude, deg.
+    pub latitude_deg: f64,
+    /// The latitude's source.
+    pub latitude_source: String,
+}
+
+/// One calibrated parameter as the certificate states it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ResultLine {
+    /// As results.json names it.
+    pub quantity: String,
+    /// Value.
+    pub value: f64,
+    /// Expanded uncertainty.
+    #[serde(rename = "U")]
+    pub expanded: f64,
+    /// Coverage factor.
+    pub k: f64,
+    /// Coverage probability (0.95).
+    pub p: f64,
+    /// Unit.
+    pub unit: String,
+    /// `value +- U unit (k = 2.05, 95 %)`, rounded to U's two significant digits.
+    pub text: String,
+}
+
+/// Conformity statements (ILAC-G8).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Conformity {
+    /// The decision rule, named.
+    pub rule: String,
+    /// Each acceptance check.
+    pub checks: Vec<ConformityCheck>,
+}
+
+/// One acceptance check's statement.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ConformityCheck {
+    /// The check as written.
+    pub name: String,
+    /// The value found, when evaluated.
+    pub value: Option<f64>,
+    /// `<=`, `<`, `>=`, `>`, `within`.
+    pub op: String,
+    /// Its limit.
+    pub limit: f64,
+    /// Unit of value, limit and U.
+    pub unit: String,
+    /// The expanded uncertainty of the value.
+    #[serde(rename = "U")]
+    pub expanded: Option<f64>,
+    /// The guard band applied (`guarded` rule), in the unit.
+    pub guard_band: Option<f64>,
+    /// `pass`, `fail`, `indeterminate`, `not_evaluated`...
+    pub verdict: String,
+    /// The sentence the certificate prints.
+    pub statement: String,
+}
+
+/// The reference standards and the traceability statement.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Traceability {
+    /// The table's own calibration certificate number.
+    pub certificate: Option<String>,
+    /// Who issued it.
+    pub issued_by: Option<String>,
+    /// When it is due (YYYY-MM-DD).
+    pub due: Option<String>,
+    /// The statement printed.
+    pub statement: String,
+}
+
+/// The signature block.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ApprovalBlock {
+    /// The approver's name.
+    pub signer: String,
+    /// Role.
+    pub role: String,
+    /// When approved (RFC 3339).
+    pub time: String,
+    /// The approver's key fingerprint.
+    pub key_fingerprint: String,
+}
+
+/// The sentence every certificate ends with.
+pub const REPRODUCTION: &str = "This certificate shall not be reproduced except in full \
+without the written approval of the laboratory.";
+
+/// The end-of-certificate mark.
+pub const END_MARK: &str = "End of certificate";

@@ -1,0 +1,283 @@
+//! A certificate as a sequence of blocks, in its order: each renderer (Markdown, HTML,
+//! PDF) walks the same blocks, so the formats hold the same content.
+
+use crate::budget::TermStatus;
+use crate::model::{Certificate, END_MARK, REPRODUCTION};
+
+/// One block of the certificate's body.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Block {
+    /// A section heading.
+    Heading(String),
+    /// A paragraph.
+    Para(String),
+    /// Label and value pairs.
+    Fields(Vec<(String, String)>),
+    /// A table: header and rows.
+    Table(Vec<String>, Vec<Vec<String>>),
+}
+
+/// The page header's lines: lab name, address, accreditation, the number (the page count
+/// is the renderer's).
+pub fn header(c: &Certificate) -> Vec<String> {
+    vec![
+        c.lab.name.clone(),
+        c.lab.address.replace('\n', ", ").trim().to_string(),
+        c.lab.accreditation.clone(),
+        format!("Certificate No. {}", c.number),
+    ]
+}
+
+/// A number as a reader wants it: up to 6 significant digits, no trailing zeros.
+pub fn num(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let mag = x.abs().log10().floor() as i32;
+    if (-4..6).contains(&mag) {
+        let decimals = (5 - mag).max(0) as usize;
+        let s = format!("{x:.decimals$}");
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        }
+    } else {
+        format!("{x:.4e}")
+    }
+}
+
+fn or_not_stated(v: &Option<String>) -> String {
+    v.clone()
+        .filter(|s| !s.is_empty())
+        .unwrap_or_else(|| "not stated".into())
+}
+
+/// The body's blocks, in the certificate's order.
+pub fn blocks(c: &Certificate) -> Vec<Block> {
+    let id = &c.identification;
+    let mut b = vec![Block::Heading("Calibration certificate".into())];
+    b.push(Block::Para(format!("Certificate No. {}", c.number)));
+    if let Some(r) = &c.replaces {
+        b.push(Block::Para(format!(
+            "This certificate amends and replaces certificate No. {r}."
+        )));
+    }
+    if c.draft {
+        b.push(Block::Para(
+            "DRAFT: the results have not been approved (ratecal approve); this is not a valid \
+             certificate."
+                .into(),
+        ));
+    }
+    b.push(Block::Heading("Identification".into()));
+    let proc = id
+        .procedure
+        .as_ref()
+        .map(|p| {
+            format!(
+                "{} version {}{} (sha256 {})",
+                p.name,
+                p.version,
+                p.title
+                    .as_deref()
+                    .map(|t| format!(", \"{t}\""))
+                    .unwrap_or_default(),
+                p.sha256
+            )
+        })
+        .unwrap_or_else(|| "none".into());
+    let st = &id.station;
+    b.push(Block::Fields(vec![
+        ("Customer".into(), or_not_stated(&id.customer)),
+        ("Order".into(), or_not_stated(&id.order)),
+        ("Item".into(), format!("IMU {}", id.item_model)),
+        ("Serial number".into(), id.item_serial.clone()),
+        ("Grade".into(), id.item_grade.clone()),
+        ("Procedure".into(), proc),
+        (
+            "Station".into(),
+            format!(
+                "{}: rate table {}, manufacturer {}, serial {}, accuracy class {}",
+                st.name,
+                st.table_model,
+                or_not_stated(&st.manufacturer),
+                or_not_stated(&st.serial),
+                or_not_stated(&st.accuracy_class)
+            ),
+        ),
+        (
+            "Run".into(),
+            format!("{} (archive id {})", id.run, id.archive_id),
+        ),
+        ("Date of calibration".into(), id.calibration_date.clone()),
+        ("Date of issue".into(), id.issue_date.clone()),
+        ("Location".into(), id.location.clone()),
+    ]));
+    let m = &c.method;
+    b.push(Block::Heading("Method and conditions".into()));
+    let mut steps = String::from("The procedure ran these steps, in order: ");
+    steps.push_str(&m.steps.join("; "));
+    steps.push('.');
+    b.push(Block::Para(steps));
+    let temp = m
+        .temperature_c
+        .map(|[mean, lo, hi]| {
+            format!(
+                "mean {} degC, range {} degC to {} degC",
+                num(mean),
+                num(lo),
+                num(hi)
+            )
+        })
+        .unwrap_or_else(|| "not recorded".into());
+    b.push(Block::Fields(vec![
+        ("Ambient temperature".into(), temp),
+        (
+            "Gravity".into(),
+            format!(
+                "{} m/s^2{} (source: {})",
+                num(m.gravity_mps2),
+                m.gravity_u_mps2
+                    .map(|u| format!(", standard uncertainty {} m/s^2", num(u)))
+                    .unwrap_or_else(|| ", uncertainty not stated".into()),
+                m.gravity_source
+            ),
+        ),
+        (
+            "Latitude".into(),
+            format!(
+                "{} deg (source: {})",
+                num(m.latitude_deg),
+                m.latitude_source
+            ),
+        ),
+    ]));
+    b.push(Block::Heading("Results".into()));
+    b.push(Block::Para(format!(
+        "Model: {}",
+        c.model_equation.join(". ")
+    )));
+    b.push(Block::Para(
+        "Each result is stated as value +- U, the expanded uncertainty with the coverage factor \
+         k for a coverage probability of about 95 % (GUM, JCGM 100:2008)."
+            .into(),
+    ));
+    b.push(Block::Table(
+        vec!["Parameter".into(), "Result".into()],
+        c.results
+            .iter()
+            .map(|r| vec![r.quantity.clone(), r.text.clone()])
+            .collect(),
+    ));
+    if let Some(conf) = &c.conformity {
+        b.push(Block::Heading("Statements of conformity".into()));
+        b.push(Block::Para(format!("Decision rule: {}.", conf.rule)));
+        b.push(Block::Table(
+            ["Check", "Value", "Limit", "U", "Verdict"]
+                .map(String::from)
+                .to_vec(),
+            conf.checks
+                .iter()
+                .map(|k| {
+                    vec![
+                        k.name.clone(),
+                        k.value
+                            .map(|v| format!("{} {}", num(v), k.unit))
+                            .unwrap_or_else(|| "-".into()),
+                        format!("{} {} {}", k.op, num(k.limit), k.unit),
+                        k.expanded
+                            .map(|u| format!("{} {}", num(u), k.unit))
+                            .unwrap_or_else(|| "-".into()),
+                        k.statement.clone(),
+                    ]
+                })
+                .collect(),
+        ));
+    }
+    let t = &c.traceability;
+    b.push(Block::Heading("Traceability".into()));
+    b.push(Block::Fields(vec![(
+        "Reference standard".into(),
+        format!(
+            "rate table {}, calibration certificate {}, issued by {}, due {}",
+            c.identification.station.table_model,
+            or_not_stated(&t.certificate),
+            or_not_stated(&t.issued_by),
+            or_not_stated(&t.due)
+        ),
+    )]));
+    b.push(Block::Para(t.statement.clone()));
+    if !c.notes.is_empty() {
+        b.push(Block::Heading("Notes".into()));
+        for n in &c.notes {
+            b.push(Block::Para(n.clone()));
+        }
+    }
+    b.push(Block::Heading("Approval".into()));
+    match &c.approval {
+        Some(a) => b.push(Block::Fields(vec![
+            ("Approved by".into(), a.signer.clone()),
+            ("Role".into(), a.role.clone()),
+            ("Date".into(), a.time.clone()),
+            // A space after the scheme: the hex alone fits a narrow column.
+            (
+                "Signature key".into(),
+                a.key_fingerprint.replacen("SHA256:", "SHA256: ", 1),
+            ),
+        ])),
+        None => b.push(Block::Para("Not approved: DRAFT (no signature).".into())),
+    }
+    b.push(Block::Heading("Annex: uncertainty budget".into()));
+    for bu in &c.budget {
+        b.push(Block::Para(format!(
+            "{} = {} {}: u_c = {} {}, nu_eff = {}, k = {:.2}, U = {} {}",
+            bu.quantity,
+            num(bu.value),
+            bu.unit,
+            num(bu.u_c),
+            bu.unit,
+            bu.nu_eff
+                .map(|n| format!("{n:.1}"))
+                .unwrap_or_else(|| "infinite".into()),
+            bu.k,
+            num(bu.expanded),
+            bu.unit
+        )));
+        b.push(Block::Table(
+            [
+                "Source",
+                "Type",
+                "Distribution",
+                "Stated",
+                "Sensitivity",
+                "u",
+                "dof",
+            ]
+            .map(String::from)
+            .to_vec(),
+            bu.terms
+                .iter()
+                .map(|t| {
+                    vec![
+                        t.source.clone(),
+                        format!("{:?}", t.evaluation),
+                        t.distribution.clone(),
+                        t.stated.clone().unwrap_or_else(|| "-".into()),
+                        t.sensitivity.clone(),
+                        match (t.status, t.u) {
+                            (TermStatus::Stated, Some(u)) => format!("{} {}", num(u), bu.unit),
+                            _ => "not stated".into(),
+                        },
+                        t.dof
+                            .map(|d| format!("{d:.0}"))
+                            .unwrap_or_else(|| "inf".into()),
+                    ]
+                })
+                .collect(),
+        ));
+    }
+    b.push(Block::Para(REPRODUCTION.into()));
+    b.push(Block::Para(format!("{END_MARK} {}", c.number)));
+    b
+}

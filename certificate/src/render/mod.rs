@@ -1,0 +1,10 @@
+//! Renderers: every format walks the same blocks ([`doc::blocks`]).
+
+pub mod doc;
+mod html;
+mod md;
+mod pdf;
+
+pub use html::html;
+pub use md::markdown;
+pub use pdf::{PdfError, pdf};

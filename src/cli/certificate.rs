@@ -1,0 +1,387 @@
+//! `ratecal certificate RUN_DIR --lab LAB.yaml [--customer NAME] [--order REF]
+//! [--format pdf|html|md|json] [--out FILE] [--archive DIR_OR_URL] [--amend]
+//! [--allow-expired] [--allow-untraceable]`: a calibration certificate (ISO/IEC 17025, 7.8)
+//! of an archived, sealed run (`ratecal_certificate`). The seal is verified first; the
+//! number comes from the archive's sequence (the same on reissue, the next with `--amend`).
+//!
+//! Exit codes: 0 written (a DRAFT too), 1 input error or refused (no LAB.yaml, run not in
+//! the archive, reference calibration expired or not stated), 2 usage, 4 the folder fails
+//! its seal.
+
+use miette::{Diagnostic, NamedSource, SourceSpan};
+use ratecal_archive::{Archive, Location, days_from_iso};
+use ratecal_certificate::terms::Stated;
+use ratecal_certificate::{ApprovalBlock, Certificate, Input, Lab, StationId, render};
+use ratecal_drivers::Station;
+use ratecal_engine::audit::seal::{SEAL_FILE, Seal};
+use ratecal_engine::plan::Plan;
+use ratecal_engine::results::Results;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Arguments of `ratecal certificate`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Run folder (sealed, approved with `ratecal approve`, added with `ratecal archive add`).
+    run_dir: PathBuf,
+    /// The laboratory: name, address, accreditation, certificate_prefix, optional logo.
+    #[arg(long, value_name = "LAB.yaml")]
+    lab: PathBuf,
+    /// The customer, as the certificate names them.
+    #[arg(long, value_name = "NAME")]
+    customer: Option<String>,
+    /// The customer's order reference.
+    #[arg(long, value_name = "REF")]
+    order: Option<String>,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = Format::Pdf)]
+    format: Format,
+    /// Write here instead of standard output.
+    #[arg(long, value_name = "FILE")]
+    out: Option<PathBuf>,
+    /// The archive holding the run and the number sequence (default: $RATECAL_ARCHIVE,
+    /// else ./archive/).
+    #[arg(long, value_name = "DIR_OR_URL")]
+    archive: Option<String>,
+    /// Issue an amended certificate: a new number that names the one it replaces.
+    #[arg(long)]
+    amend: bool,
+    /// Issue although the table's calibration had expired on the date of calibration
+    /// (printed on the certificate).
+    #[arg(long)]
+    allow_expired: bool,
+    /// Issue although the station states no calibration of the table (printed).
+    #[arg(long)]
+    allow_untraceable: bool,
+}
+
+/// `--format`.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Format {
+    /// PDF (a typeset document, fonts embedded).
+    Pdf,
+    /// Self-contained HTML.
+    Html,
+    /// Markdown.
+    Md,
+    /// The certificate's data (`docs/certificate.md`).
+    Json,
+}
+
+/// A refusal located in a YAML file.
+#[derive(Debug, thiserror::Error, Diagnostic)]
+#[error("{message}")]
+#[diagnostic(code(certificate::refused))]
+struct Located {
+    message: String,
+    #[source_code]
+    src: NamedSource<String>,
+    #[label("{label}")]
+    span: SourceSpan,
+    label: String,
+    #[help]
+    help: String,
+}
+
+/// The span of `key: value` in YAML `text`, searched after the key `after` (block or flow
+/// style): enough to point at a key of a small hand-written file.
+fn key_span(text: &str, after: Option<&str>, key: &str) -> SourceSpan {
+    let from = after.and_then(|a| find_key(text, 0, a)).unwrap_or(0);
+    let Some(start) = find_key(text, from, key) else {
+        return (from, 0).into();
+    };
+    let len = text[start..]
+        .find(['\n', ',', '}'])
+        .unwrap_or(text.len() - start);
+    (start, text[start..start + len].trim_end().len()).into()
+}
+
+/// Where `key:` starts at or after byte `from`, as a key (after indentation, `{` or `,`).
+fn find_key(text: &str, from: usize, key: &str) -> Option<usize> {
+    let pat = format!("{key}:");
+    let mut at = from;
+    while let Some(i) = text[at..].find(&pat) {
+        let s = at + i;
+        let before = text[..s].chars().next_back();
+        if before.is_none_or(|c| c == ' ' || c == '\n' || c == '{' || c == ',') {
+            return Some(s);
+        }
+        at = s + pat.len();
+    }
+    None
+}
+
+fn io(path: &Path, e: impl std::fmt::Display, help: &str) -> miette::Report {
+    miette::miette!(
+        code = "certificate::io",
+        help = help.to_string(),
+        "cannot read {}: {e}",
+        path.display()
+    )
+}
+
+/// Runs the subcommand.
+pub fn main(args: Args) -> ExitCode {
+    if let Err(e) = super::verify::require_intact(&args.run_dir, "certificate") {
+        errln!("{e:?}");
+        return ExitCode::from(4);
+    }
+    let rt = match tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+    {
+        Ok(rt) => rt,
+        Err(e) => {
+            errln!("{:?}", miette::miette!("cannot start the runtime: {e}"));
+            return ExitCode::from(1);
+        }
+    };
+    let certificate = match rt.block_on(issue(&args)) {
+        Ok(c) => c,
+        Err(e) => {
+            errln!("{e:?}");
+            return ExitCode::from(1);
+        }
+    };
+    let bytes = match args.format {
+        Format::Json => {
+            { serde_json::to_string_pretty(&certificate).expect("a certificate serializes") + "\n" }
+                .into_bytes()
+        }
+        Format::Md => render::markdown(&certificate).into_bytes(),
+        Format::Html => render::html(&certificate).into_bytes(),
+        Format::Pdf => match render::pdf(&certificate) {
+            Ok(b) => b,
+            Err(e) => {
+                errln!(
+                    "{:?}",
+                    miette::miette!(
+                        code = "certificate::pdf",
+                        "cannot typeset the certificate: {e}"
+                    )
+                );
+                return ExitCode::from(1);
+            }
+        },
+    };
+    match &args.out {
+        Some(path) => {
+            if let Err(e) = std::fs::write(path, &bytes) {
+                errln!("cannot write {}: {e}", path.display());
+                return ExitCode::from(1);
+            }
+            errln!(
+                "certificate No. {}{} written to {}",
+                certificate.number,
+                if certificate.draft { " (DRAFT)" } else { "" },
+                path.display()
+            );
+        }
+        None => {
+            use std::io::Write;
+            let mut out = std::io::stdout().lock();
+            if out.write_all(&bytes).and_then(|()| out.flush()).is_err() {
+                return ExitCode::SUCCESS;
+            }
+        }
+    }
+    ExitCode::SUCCESS
+}
+
+fn read_text(path: &Path, help: &str) -> miette::Result<String> {
+    std::fs::read_to_string(path).map_err(|e| io(path, e, help))
+}
+
+fn read_lab(path: &Path) -> miette::Result<Lab> {
+    let text = read_text(
+        path,
+        "give the laboratory's file (docs/examples/lab.yaml shows one)",
+    )?;
+    let name = path.display().to_string();
+    let lab: Lab = serde_saphyr::from_str(&text).map_err(|e| {
+        let span = e
+            .location()
+            .filter(|l| l.line() > 0)
+            .map(|l| ratecal_drivers::yaml_offset(&text, l.line(), l.column()))
+            .unwrap_or(0);
+        Located {
+            message: format!("{name} is not a laboratory file"),
+            src: NamedSource::new(name.clone(), text.clone()),
+            span: (span, 0).into(),
+            label: e.to_string().lines().next().unwrap_or("here").to_string(),
+            help: "keys: name, address, accreditation, certificate_prefix, optional logo \
+                   (docs/certificate.md)"
+                .into(),
+        }
+    })?;
+    let p = &lab.certificate_prefix;
+    if p.is_empty() || !p.chars().all(|c| c.is_ascii_alphanumeric() || c == '-') {
+        return Err(Located {
+            message: format!("certificate_prefix `{p}` cannot start a certificate number"),
+            span: key_span(&text, None, "certificate_prefix"),
+            src: NamedSource::new(name, text),
+            label: "letters, digits and dashes only".into(),
+            help: "e.g. `certificate_prefix: RCL`: numbers read RCL-2026-000001".into(),
+        }
+        .into());
+    }
+    Ok(lab)
+}
+
+async fn issue(args: &Args) -> miette::Result<Certificate> {
+    let dir = &args.run_dir;
+    let lab = read_lab(&args.lab)?;
+    let results_path = dir.join("results.json");
+    let text = read_text(&results_path, "run `ratecal analyze RUN_DIR` first")?;
+    let results: Results = serde_json::from_str(&text)
+        .map_err(|e| io(&results_path, e, "results.json follows docs/results.md"))?;
+    let manifest_path = dir.join("manifest.yaml");
+    let text = read_text(&manifest_path, "give the folder `ratecal run` wrote")?;
+    let manifest =
+        ratecal_engine::recording::parse_manifest(&manifest_path.display().to_string(), &text)?;
+    let plan: Option<Plan> = std::fs::read_to_string(dir.join("plan.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok());
+    let station_path = dir.join("station.yaml");
+    let station_text = read_text(
+        &station_path,
+        "a run folder keeps a copy of its station file",
+    )?;
+    let station = Station::from_yaml(&station_text, &station_path.display().to_string())
+        .map_err(|e| miette::Report::new(*e))?;
+    let calibration_date: String = manifest
+        .run
+        .as_ref()
+        .map(|r| r.started.chars().take(10).collect())
+        .unwrap_or_default();
+    let mut notes = Vec::new();
+    let located =
+        |message: String, after: Option<&str>, key: &str, label: &str, help: &str| Located {
+            message,
+            span: key_span(&station_text, after, key),
+            src: NamedSource::new(station_path.display().to_string(), station_text.clone()),
+            label: label.into(),
+            help: help.into(),
+        };
+    let cal = station.table.calibration.clone();
+    match &cal {
+        None if !args.allow_untraceable => {
+            return Err(located(
+                "the station states no calibration of the rate table: the results would not be traceable".into(),
+                None,
+                "table",
+                "no `calibration: { certificate, issued_by, due }` here",
+                "state the table's calibration certificate in the station file, or give \
+                 --allow-untraceable (printed on the certificate)",
+            )
+            .into());
+        }
+        None => notes.push(
+            "Issued with --allow-untraceable: the station states no calibration of the rate \
+             table; the results are not shown to be traceable."
+                .into(),
+        ),
+        Some(c) => {
+            let due = days_from_iso(&c.due);
+            let on = days_from_iso(&calibration_date);
+            let expired = match (due, on) {
+                (Some(d), Some(o)) => o > d,
+                _ => true,
+            };
+            if expired && !args.allow_expired {
+                return Err(located(
+                    format!(
+                        "the rate table's calibration ({}) was due {}, before the calibration date {calibration_date}",
+                        c.certificate, c.due
+                    ),
+                    Some("calibration"),
+                    "due",
+                    "expired on the date of calibration",
+                    "recalibrate the table and state its new certificate, or give \
+                     --allow-expired (printed on the certificate)",
+                )
+                .into());
+            }
+            if expired {
+                notes.push(format!(
+                    "Issued with --allow-expired: the rate table's calibration {} was due {}, \
+                     before the date of calibration.",
+                    c.certificate, c.due
+                ));
+            }
+        }
+    }
+    // The archive must hold this very folder (its content address).
+    let folder = ratecal_archive::read_folder(dir)?;
+    let loc = Location::resolve(args.archive.as_deref(), None);
+    let archive = Archive::open_existing(&loc).await?;
+    if !archive.exists(&folder.facts.id).await? {
+        return Err(miette::miette!(
+            code = "certificate::not_archived",
+            help = format!(
+                "add it first: `ratecal archive add {}` (after `ratecal approve`)",
+                dir.display()
+            ),
+            "{} (archive id {}) is not in the archive {}",
+            dir.display(),
+            folder.facts.id,
+            archive.location()
+        ));
+    }
+    let now = ratecal_engine::recording::rfc3339(std::time::SystemTime::now());
+    let year: i32 = now[..4].parse().unwrap_or(1970);
+    let issued = archive
+        .certificate_number(
+            &folder.facts.id,
+            &lab.certificate_prefix,
+            year,
+            args.amend,
+            &now,
+        )
+        .await?;
+    archive.close().await;
+    let seal: Option<Seal> = std::fs::read_to_string(dir.join(SEAL_FILE))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok());
+    let approval = seal.and_then(|s| s.approval).map(|a| ApprovalBlock {
+        signer: a.signer,
+        role: a.role,
+        time: a.time,
+        key_fingerprint: a.key_fingerprint,
+    });
+    let t = &station.table;
+    let deg = std::f64::consts::PI / 180.0;
+    let input = Input {
+        number: issued.number,
+        replaces: issued.replaces,
+        issue_date: issued.issued.chars().take(10).collect(),
+        lab,
+        customer: args.customer.clone(),
+        order: args.order.clone(),
+        results: &results,
+        manifest: &manifest,
+        plan: plan.as_ref(),
+        archive_id: folder.facts.id.clone(),
+        station: StationId {
+            name: station.name.clone(),
+            table_model: t.model.clone(),
+            manufacturer: t.manufacturer.clone(),
+            serial: t.serial.clone(),
+            accuracy_class: t.accuracy_class.clone(),
+        },
+        stated: Stated {
+            rate_accuracy: t.rate_accuracy.map(|r| r.get()),
+            position_accuracy_rad: t.position_accuracy.map(|a| a.get() * deg),
+            axis_orthogonality_rad: t.axis_orthogonality.map(|a| a.get() * deg),
+            gravity_u_mps2: station.site.gravity_u_mps2,
+            gravity_mps2: manifest.station.site.gravity_mps2,
+        },
+        reference: match cal {
+            Some(c) => [Some(c.certificate), Some(c.issued_by), Some(c.due)],
+            None => [None, None, None],
+        },
+        notes,
+        approval,
+    };
+    Ok(ratecal_certificate::build(input))
+}
