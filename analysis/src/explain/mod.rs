@@ -78,19 +78,41 @@ pub fn explain_source<S: Source>(
     nominal: &NominalModel,
     opts: &Options,
 ) -> Result<Explanation, S::Error> {
+    let (data, nonfinite) = accumulate(src, opts)?;
+    Ok(explain_data(src.manifest(), &data, &nonfinite, nominal, opts))
+}
+
+/// The recording accumulated once for explain (the registry's effects and `opts.user`),
+/// and each user effect's count of non-finite regressor values before the pass: what
+/// [`explain_data`] and the twin's comparison (`crate::twin`) share.
+pub(crate) fn accumulate<S: Source>(
+    src: &S,
+    opts: &Options,
+) -> Result<(Data, Vec<usize>), S::Error> {
     let mut effects: Vec<&'static dyn Effect> = REGISTRY.to_vec();
     effects.extend(opts.user.iter().map(|u| *u as &'static dyn Effect));
     let nonfinite: Vec<usize> = opts.user.iter().map(|u| u.nonfinite()).collect();
     let clock = std::time::Instant::now();
-    let debug = std::env::var_os("RATECAL_EXPLAIN_DEBUG").is_some();
     let data = Data::with_effects(src, effects)?;
-    if debug {
+    if std::env::var_os("RATECAL_EXPLAIN_DEBUG").is_some() {
         eprintln!("accumulated in {:?}", clock.elapsed());
     }
-    let m = src.manifest();
+    Ok((data, nonfinite))
+}
+
+/// [`explain_source`] on a recording already accumulated ([`accumulate`]).
+pub(crate) fn explain_data(
+    m: &Manifest,
+    data: &Data,
+    nonfinite: &[usize],
+    nominal: &NominalModel,
+    opts: &Options,
+) -> Explanation {
+    let clock = std::time::Instant::now();
+    let debug = std::env::var_os("RATECAL_EXPLAIN_DEBUG").is_some();
     let lay = &data.layout;
     let mut warnings = Vec::new();
-    for (u, before) in opts.user.iter().zip(nonfinite) {
+    for (u, &before) in opts.user.iter().zip(nonfinite) {
         let n = u.nonfinite() - before;
         if n > 0 {
             warnings.push(format!(
@@ -200,7 +222,7 @@ pub fn explain_source<S: Source>(
         .map(|f| f.effect.as_str())
         .collect();
     let adopt = (!ids.is_empty()).then(|| format!("with {}", ids.join(", ")));
-    Ok(Explanation {
+    Explanation {
         format: FORMAT.into(),
         recording: opts.path.clone(),
         nominal: nominal_out,
@@ -232,7 +254,7 @@ pub fn explain_source<S: Source>(
             })
             .collect(),
         warnings,
-    })
+    }
 }
 
 /// One accepted step as a finding, its parameters from the final model fitted on every

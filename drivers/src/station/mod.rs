@@ -2,6 +2,7 @@
 //! Parsing refuses unknown keys and wrong units with a diagnostic located in the file.
 
 mod describe;
+mod edit;
 mod effects;
 mod faults;
 mod file;
@@ -9,6 +10,7 @@ mod quantity;
 
 pub use describe::{Environment, ImuIdentity, StationInfo};
 
+pub use edit::{SetValue, edit, locate, number};
 pub use effects::{EffectsSpec, TableEffectsSpec};
 pub use faults::{AxisName, DropoutMode, FaultSpec, LinkName, TableFaultMode};
 pub use file::{
