@@ -1,5 +1,6 @@
 //! `ratecal explain RUN_DIR [--procedure PROCEDURE] [--effects FILE_OR_DIR]... [--without ID]...
-//! [--format text|json] [--plots DIR]`: where the recording and the nominal model disagree,
+//! [--twin STATION] [--write-twin OUT.yaml] [--format text|json] [--plots DIR]`: where the
+//! recording and the nominal model (or the station's twin) disagree,
 //! what physics was left out, the refit with it, and one before/after figure per finding
 //! (`explain-<effect>.svg`). Exit codes, like diff(1): 0 nothing found, 1 findings
 //! reported, 2 error; 4 the run folder's seal fails (or it was never sealed).
@@ -47,6 +48,14 @@ pub struct Args {
     /// ratecal run folder they are written beside explain.json in any case).
     #[arg(long, value_name = "DIR")]
     plots: Option<PathBuf>,
+    /// Compare the recording with its station's twin: a station file, or a run folder
+    /// (its station.yaml). The JSON gains `twin` (docs/explain.md).
+    #[arg(long, value_name = "STATION", conflicts_with = "procedure")]
+    twin: Option<PathBuf>,
+    /// Write the corrected twin there (the input's layout and comments, values changed,
+    /// effects added) and print the diff.
+    #[arg(long, value_name = "OUT.yaml", requires = "twin")]
+    write_twin: Option<PathBuf>,
 }
 
 /// The effect files named by `--effects` and `RATECAL_EFFECTS`: files as given, folders
@@ -163,13 +172,57 @@ pub fn main(args: Args) -> ExitCode {
         without: args.without.clone(),
         ..Options::default()
     };
-    let mut x = match explain::explain_source(&rec, &nominal, &opts) {
+    let twin_file = match &args.twin {
+        None => None,
+        Some(p) => {
+            let Ok(f) = super::twin::read(p) else {
+                return ExitCode::from(2);
+            };
+            if let Err(e) = super::twin::refuse(&f, rec.manifest()) {
+                eprintln!("{:?}", miette::Report::new(*e));
+                return ExitCode::from(2);
+            }
+            Some(f)
+        }
+    };
+    let explained = match &twin_file {
+        None => explain::explain_source(&rec, &nominal, &opts).map(|x| (x, None)),
+        Some(f) => {
+            let twin = super::twin::twin_of(&f.station);
+            ratecal_engine::twin::compare_source(&rec, &twin, &opts).map(|(x, r)| (x, Some(r)))
+        }
+    };
+    let (mut x, mut twin) = match explained {
         Ok(x) => x,
         Err(e) => {
             eprintln!("{:?}", miette::Report::new(e));
             return ExitCode::from(2);
         }
     };
+    if let (Some(f), Some(r)) = (&twin_file, &mut twin) {
+        r.station = args.twin.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
+        if let Some(out) = &args.write_twin {
+            match super::twin::corrected(f, &r.changes, out) {
+                Ok((text, diff, skipped)) => {
+                    if let Err(e) = std::fs::write(out, &text) {
+                        errln!("error: cannot write the corrected twin {}: {e}", out.display());
+                        return ExitCode::from(2);
+                    }
+                    for s in skipped {
+                        x.warnings.push(format!(
+                            "{s}: a user effect is not written into a station file"
+                        ));
+                    }
+                    r.written = Some(out.display().to_string());
+                    r.diff = Some(diff);
+                }
+                Err(e) => {
+                    errln!("error: cannot correct the twin: {e}");
+                    return ExitCode::from(2);
+                }
+            }
+        }
+    }
     // Only the registry's effects can be declared in a procedure.
     let ids: Vec<String> = x
         .findings
@@ -197,7 +250,11 @@ pub fn main(args: Args) -> ExitCode {
             )),
         }
     }
-    let json = serde_json::to_string_pretty(&x).expect("plain data serializes");
+    let mut value = serde_json::to_value(&x).expect("plain data serializes");
+    if let Some(r) = &twin {
+        value["twin"] = serde_json::to_value(r).expect("plain data serializes");
+    }
+    let json = serde_json::to_string_pretty(&value).expect("plain data serializes");
     let figures: Vec<(String, String)> =
         render::explain_figures(&serde_json::to_value(&x).expect("plain data serializes"))
             .into_iter()
@@ -235,9 +292,22 @@ pub fn main(args: Args) -> ExitCode {
     }
     let out = match args.format {
         Format::Json => json + "\n",
-        Format::Text => explain::render_text(&x),
+        Format::Text => {
+            explain::render_text(&x)
+                + &twin
+                    .as_ref()
+                    .map(ratecal_engine::twin::render_text)
+                    .unwrap_or_default()
+        }
     };
     out!("{out}");
+    if let Some(r) = &twin {
+        return if r.needs_change {
+            ExitCode::from(1)
+        } else {
+            ExitCode::SUCCESS
+        };
+    }
     if x.findings.is_empty() && x.unexplained.is_empty() {
         ExitCode::SUCCESS
     } else {

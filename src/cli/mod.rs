@@ -15,4 +15,5 @@ pub mod procedure;
 pub mod report;
 pub mod run;
 pub mod seal;
+pub mod twin;
 pub mod verify;

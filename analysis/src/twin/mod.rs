@@ -9,9 +9,11 @@
 mod compare;
 mod output;
 mod predict;
+mod text;
 mod update;
 
 pub use output::{Change, Prediction, SegmentResidual, TwinReport};
+pub use text::render_text;
 pub use update::updated_terms;
 
 use crate::explain::{self, Explanation, NominalModel, Options};
