@@ -6,6 +6,7 @@
 //! reported, 2 error; 4 the run folder's seal fails (or it was never sealed).
 
 use super::procedure;
+use ratecal_physics::Effect;
 use ratecal_engine::explain::{self, AdoptTarget, NominalModel, Options, UserEffect};
 use ratecal_engine::fit::{Source, Streamed};
 use ratecal_engine::render;
@@ -154,7 +155,7 @@ pub fn main(args: Args) -> ExitCode {
     } else {
         None
     };
-    let Ok(user) = load_effects(&args.effects) else {
+    let Ok(mut user) = load_effects(&args.effects) else {
         return ExitCode::from(2);
     };
     let nominal = match &args.procedure {
@@ -166,12 +167,6 @@ pub fn main(args: Args) -> ExitCode {
             Err(()) => return ExitCode::from(2),
         },
     };
-    let opts = Options {
-        path: args.run.display().to_string(),
-        user,
-        without: args.without.clone(),
-        ..Options::default()
-    };
     let twin_file = match &args.twin {
         None => None,
         Some(p) => {
@@ -182,8 +177,21 @@ pub fn main(args: Args) -> ExitCode {
                 eprintln!("{:?}", miette::Report::new(*e));
                 return ExitCode::from(2);
             }
+            // The twin's user effects are explain's candidates too (its terms need their
+            // columns); one already given with --effects is that one.
+            for e in &f.user {
+                if !user.iter().any(|u| u.id() == e.id()) {
+                    user.push(e);
+                }
+            }
             Some(f)
         }
+    };
+    let opts = Options {
+        path: args.run.display().to_string(),
+        user,
+        without: args.without.clone(),
+        ..Options::default()
     };
     let explained = match &twin_file {
         None => explain::explain_source(&rec, &nominal, &opts).map(|x| (x, None)),
@@ -203,15 +211,10 @@ pub fn main(args: Args) -> ExitCode {
         r.station = args.twin.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
         if let Some(out) = &args.write_twin {
             match super::twin::corrected(f, &r.changes, out) {
-                Ok((text, diff, skipped)) => {
+                Ok((text, diff)) => {
                     if let Err(e) = std::fs::write(out, &text) {
                         errln!("error: cannot write the corrected twin {}: {e}", out.display());
                         return ExitCode::from(2);
-                    }
-                    for s in skipped {
-                        x.warnings.push(format!(
-                            "{s}: a user effect is not written into a station file"
-                        ));
                     }
                     r.written = Some(out.display().to_string());
                     r.diff = Some(diff);

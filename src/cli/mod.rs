@@ -15,5 +15,6 @@ pub mod procedure;
 pub mod report;
 pub mod run;
 pub mod seal;
+pub mod station_effects;
 pub mod twin;
 pub mod verify;

@@ -18,6 +18,8 @@ pub struct TwinFile {
     pub text: String,
     /// The parsed station.
     pub station: Station,
+    /// The user effects it references (`imu.user_effects`).
+    pub user: Vec<&'static ratecal_engine::explain::UserEffect>,
 }
 
 /// A twin whose site or table geometry contradicts the recording's manifest.
@@ -47,13 +49,17 @@ pub fn read(arg: &Path) -> Result<TwinFile, ()> {
     let text = std::fs::read_to_string(&path).map_err(|e| {
         errln!("error: cannot read the twin {}: {e}", path.display());
     })?;
-    let station = Station::from_yaml(&text, &path.display().to_string()).map_err(|e| {
+    let mut station = Station::from_yaml(&text, &path.display().to_string()).map_err(|e| {
         eprintln!("{:?}", miette::Report::new(*e));
+    })?;
+    let user = super::station_effects::load(&mut station, &text, Some(&path)).map_err(|e| {
+        eprintln!("{e:?}");
     })?;
     Ok(TwinFile {
         path,
         text,
         station,
+        user,
     })
 }
 
@@ -132,6 +138,9 @@ pub fn twin_of(st: &Station) -> Twin {
             terms.push((id.clone(), st.imu.effects.values(e)));
         }
     }
+    for t in &st.user_terms.0 {
+        terms.push((t.effect.id().to_string(), t.values.clone()));
+    }
     for (id, _) in &st.table.effects.0.0 {
         if let Some(e) = ratecal_physics::effect(id) {
             terms.push((id.clone(), st.table.effects.0.values(e)));
@@ -151,18 +160,21 @@ pub fn twin_of(st: &Station) -> Twin {
 }
 
 /// The corrected station file's text and the unified diff from the twin to it, `out` its
-/// path as given. User effects are not written (a station file does not hold them yet):
-/// they are returned to warn about.
-pub fn corrected(f: &TwinFile, changes: &[Change], out: &Path) -> Result<(String, String, Vec<String>), String> {
-    let (user, registry): (Vec<&Change>, Vec<&Change>) =
-        changes.iter().partition(|c| c.defined_in.is_some());
-    let sets: Vec<SetValue> = registry
+/// path as given. A user effect is written by reference to its `.effect` file
+/// (`imu.user_effects`), the path relative to `out`'s folder.
+pub fn corrected(f: &TwinFile, changes: &[Change], out: &Path) -> Result<(String, String), String> {
+    let sets: Vec<SetValue> = changes
         .iter()
         .map(|c| SetValue {
             effect: c.effect.clone(),
             param: c.parameter.clone(),
             value: c.to,
             u: c.u,
+            file: match (&c.defined_in, f.station.imu.user_effects.get(&c.effect)) {
+                (_, Some(r)) => Some(r.file.clone()),
+                (Some(d), None) => Some(relative_to(Path::new(d), out)),
+                (None, None) => None,
+            },
         })
         .collect();
     let text = station::edit(&f.text, &sets)?;
@@ -173,6 +185,21 @@ pub fn corrected(f: &TwinFile, changes: &[Change], out: &Path) -> Result<(String
         .context_radius(2)
         .header(&f.path.display().to_string(), &out.display().to_string())
         .to_string();
-    let skipped = user.iter().map(|c| format!("{}.{}", c.effect, c.parameter)).collect();
-    Ok((text, diff, skipped))
+    Ok((text, diff))
+}
+
+/// `file` (as given on the command line) as a station file at `out` references it: relative
+/// to `out`'s folder when it lies below it, absolute otherwise.
+fn relative_to(file: &Path, out: &Path) -> String {
+    let dir = out.parent().filter(|d| !d.as_os_str().is_empty());
+    let Some(dir) = dir else {
+        return file.display().to_string();
+    };
+    match (file.canonicalize(), dir.canonicalize()) {
+        (Ok(f), Ok(d)) => f
+            .strip_prefix(&d)
+            .map(|r| r.display().to_string())
+            .unwrap_or_else(|_| f.display().to_string()),
+        _ => file.display().to_string(),
+    }
 }

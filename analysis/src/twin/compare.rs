@@ -140,7 +140,7 @@ pub(super) fn report(
             });
         }
     }
-    let updated = update::updated_terms(twin, &changes);
+    let updated = update::updated(twin, &changes, lay);
     let after = predict(
         m,
         data,

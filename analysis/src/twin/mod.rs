@@ -14,7 +14,6 @@ mod update;
 
 pub use output::{Change, Prediction, SegmentResidual, TwinReport};
 pub use text::render_text;
-pub use update::updated_terms;
 
 use crate::explain::{self, Explanation, NominalModel, Options};
 use crate::fit::Source;

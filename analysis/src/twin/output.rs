@@ -54,6 +54,9 @@ pub struct SegmentResidual {
     pub rms: f64,
     /// Residual mean.
     pub mean: f64,
+    /// Residual standard deviation about the mean: what is left once the segment's offset
+    /// (a wandering gyro bias's, in a right twin) is set aside.
+    pub sd: f64,
     /// The RMS the twin's noise figures allow there.
     pub noise_twin: f64,
     /// The recording's own white noise on the channel (explain's final model).

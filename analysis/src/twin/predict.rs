@@ -127,6 +127,7 @@ pub(super) fn predict(
                 channel: CHANNELS[c].into(),
                 rms: (rss / n).sqrt(),
                 mean: sum / n,
+                sd: (rss / n - (sum / n).powi(2)).max(0.0).sqrt(),
                 noise_twin,
                 noise_recording: white[c],
                 ratio,

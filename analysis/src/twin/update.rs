@@ -2,39 +2,29 @@
 
 use super::Twin;
 use super::output::Change;
+use crate::fit::joint::Layout;
 
 /// `twin` with every change made: a changed parameter takes its new value, an effect the
-/// twin lacked is added with the parameters the recording determined (the rest 0).
-pub fn updated_terms(twin: &Twin, changes: &[Change]) -> Twin {
+/// twin lacked is added with the parameters the recording determined (the rest 0). The
+/// layout knows every effect's parameters, the user effects' too.
+pub(super) fn updated(twin: &Twin, changes: &[Change], lay: &Layout) -> Twin {
     let mut out = twin.clone();
     for c in changes {
-        let n = ratecal_physics::effect(&c.effect)
-            .map(|e| e.params().len())
-            .unwrap_or(0);
-        let k = ratecal_physics::effect(&c.effect)
-            .and_then(|e| e.params().iter().position(|p| p.name == c.parameter));
-        let (Some(k), true) = (k, n > 0) else {
-            // A user effect: its parameters are not the registry's to look up; the
-            // report's order is its own.
-            user_change(&mut out, c);
+        let Some(fx) = lay.index(&c.effect).map(|e| lay.effects[e]) else {
+            continue;
+        };
+        let Some(k) = fx.params().iter().position(|p| p.name == c.parameter) else {
             continue;
         };
         let slot = match out.terms.iter().position(|(id, _)| *id == c.effect) {
             Some(i) => i,
             None => {
-                out.terms.push((c.effect.clone(), vec![0.0; n]));
+                out.terms
+                    .push((c.effect.clone(), vec![0.0; fx.params().len()]));
                 out.terms.len() - 1
             }
         };
         out.terms[slot].1[k] = c.to;
     }
     out
-}
-
-/// A user effect's change: its values in the order the changes list them.
-fn user_change(twin: &mut Twin, c: &Change) {
-    match twin.terms.iter_mut().find(|(id, _)| *id == c.effect) {
-        Some((_, v)) => v.push(c.to),
-        None => twin.terms.push((c.effect.clone(), vec![c.to])),
-    }
 }

@@ -19,6 +19,9 @@ pub struct SetValue {
     pub value: f64,
     /// Its standard uncertainty (0: written with full precision).
     pub u: f64,
+    /// For a user effect: its `.effect` file, as the station file references it
+    /// (`imu.user_effects`).
+    pub file: Option<String>,
 }
 
 #[derive(Deserialize)]
@@ -56,6 +59,14 @@ struct ImuSkel {
     gyro_scale: Triple,
     #[serde(default)]
     effects: Option<Effects>,
+    #[serde(default)]
+    user_effects: Option<Spanned<BTreeMap<String, Spanned<UserSkel>>>>,
+}
+
+#[derive(Deserialize)]
+struct UserSkel {
+    #[serde(default)]
+    values: Option<Params>,
 }
 
 /// The nominal terms: the unit a bare `0` is replaced in, and how many of the
@@ -85,8 +96,14 @@ pub fn edit(text: &str, sets: &[SetValue]) -> Result<String, String> {
     }
     let imu = &skel.imu.value;
     for (id, values) in by_effect {
-        let effect = ratecal_physics::effect(id)
-            .ok_or_else(|| format!("`{id}` is not a registry effect"))?;
+        let Some(effect) = ratecal_physics::effect(id) else {
+            let file = values
+                .iter()
+                .find_map(|v| v.file.clone())
+                .ok_or_else(|| format!("`{id}` is neither a registry effect nor a user effect's"))?;
+            user(text, start(&skel.imu)?, imu, id, &file, &values, &mut edits)?;
+            continue;
+        };
         let named = |name: &str| {
             values
                 .iter()
@@ -193,6 +210,61 @@ pub fn edit(text: &str, sets: &[SetValue]) -> Result<String, String> {
         out.replace_range(a..b, &s);
     }
     Ok(out)
+}
+
+/// A user effect's values under `imu.user_effects` (the entry, or its `values`, added
+/// when missing).
+fn user(
+    text: &str,
+    imu_at: usize,
+    imu: &ImuSkel,
+    id: &str,
+    file: &str,
+    values: &[&SetValue],
+    edits: &mut Edits,
+) -> Result<(), String> {
+    let flow = || {
+        let inner: Vec<String> = values
+            .iter()
+            .map(|v| format!("{}: {}", v.param, number(v.value, v.u)))
+            .collect();
+        format!("{{ {} }}", inner.join(", "))
+    };
+    let entry = || format!("{id}: {{ file: {file:?}, values: {} }}", flow());
+    match &imu.user_effects {
+        None => {
+            let e = if text[imu_at..].starts_with('{') {
+                format!("user_effects: {{ {} }}", entry())
+            } else {
+                let col = column(text, imu_at) + 2;
+                format!("user_effects:\n{}{}", " ".repeat(col), entry())
+            };
+            insert_entry(text, imu_at, &e, edits);
+        }
+        Some(block) => match block.value.get(id) {
+            None => insert_entry(text, start(block)?, &entry(), edits),
+            Some(u) => match &u.value.values {
+                None => insert_entry(text, start(u)?, &format!("values: {}", flow()), edits),
+                Some(map) => {
+                    for v in values {
+                        match map.value.get(&v.param) {
+                            Some(old) => {
+                                let (a, b) = span(old)?;
+                                edits.push((a, b, number(v.value, v.u)));
+                            }
+                            None => insert_entry(
+                                text,
+                                start(map)?,
+                                &format!("{}: {}", v.param, number(v.value, v.u)),
+                                edits,
+                            ),
+                        }
+                    }
+                }
+            },
+        },
+    }
+    Ok(())
 }
 
 /// Where a node starts (a block map: its first key; a flow collection: its bracket).

@@ -15,7 +15,7 @@ pub use effects::{EffectsSpec, TableEffectsSpec};
 pub use faults::{AxisName, DropoutMode, FaultSpec, LinkName, TableFaultMode};
 pub use file::{
     AmbientSpec, EnvironmentSpec, ImuSpec, ImuTemperatureSpec, MountSpec, SettlingSpec, SiteSpec,
-    Station, TableSpec, TemperatureSpec,
+    Station, TableSpec, TemperatureSpec, UserEffectRef, UserTerms,
 };
 pub use quantity::{
     Accel, AccelDensity, Angle, Freq, Pressure, Rate, RateDensity, RateWalk, Ratio, Rotation, Temp,
@@ -115,6 +115,7 @@ impl Station {
                 m.push(e.id(), self.imu.effects.values(e));
             }
         }
+        m.terms.extend(self.user_terms.0.iter().cloned());
         m
     }
 
