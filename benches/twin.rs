@@ -15,7 +15,12 @@ fn real_run() -> PathBuf {
     if !dir.join("imu.csv").exists() {
         let _ = std::fs::remove_dir_all(&dir);
         let st = Command::new(env!("CARGO_BIN_EXE_ratecal"))
-            .args(["run", "procedures/imu-2d-standard", "--dry-run", "--station"])
+            .args([
+                "run",
+                "procedures/imu-2d-standard",
+                "--dry-run",
+                "--station",
+            ])
             .arg("drivers/stations/with-lever-arm.yaml")
             .arg("--out")
             .arg(&dir)

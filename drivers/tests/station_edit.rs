@@ -2,8 +2,8 @@
 //! stand in the unit they are written in, missing ones added beside their neighbours, the
 //! comments kept, and the result a station file that parses to the values asked for.
 
-use ratecal_drivers::station::{SetValue, Station, edit, locate};
 use ratecal_drivers::DEFAULT_STATION_YAML;
+use ratecal_drivers::station::{SetValue, Station, edit, locate};
 
 fn set(effect: &str, param: &str, value: f64, u: f64) -> SetValue {
     SetValue {
@@ -31,12 +31,21 @@ fn values_change_where_they_stand_in_their_own_units() {
     assert!((st.imu.gyro_scale[2].0 - 301.4e-6).abs() < 1e-10);
     assert_eq!(st.imu.effects.value("lever_arm", "rzz_mm"), 31.23);
     assert_eq!(
-        st.table.effects.0.value("table_encoder_eccentricity", "inner_cos_arcsec"),
+        st.table
+            .effects
+            .0
+            .value("table_encoder_eccentricity", "inner_cos_arcsec"),
         7.0
     );
     // The unit as written (mg), the digits of u, everything else as it was.
-    assert!(out.contains("accel_bias: [1.2 mg, -1.0003 mg, 2.1 mg]"), "{out}");
-    assert!(out.contains("gyro_scale: [420 ppm, -310 ppm, 301.4 ppm]"), "{out}");
+    assert!(
+        out.contains("accel_bias: [1.2 mg, -1.0003 mg, 2.1 mg]"),
+        "{out}"
+    );
+    assert!(
+        out.contains("gyro_scale: [420 ppm, -310 ppm, 301.4 ppm]"),
+        "{out}"
+    );
     let changed: Vec<(&str, &str)> = ALL
         .lines()
         .zip(out.lines())
@@ -56,7 +65,10 @@ fn missing_values_are_added_beside_their_neighbours() {
         set("table_encoder_eccentricity", "outer_sin_arcsec", 60.0, 0.0),
     ];
     let out = edit(DEFAULT_STATION_YAML, &sets).unwrap();
-    assert!(out.contains("  effects: { lever_arm: { rxx_mm: -4.000, rzz_mm: 25.040 } }"), "{out}");
+    assert!(
+        out.contains("  effects: { lever_arm: { rxx_mm: -4.000, rzz_mm: 25.040 } }"),
+        "{out}"
+    );
     assert!(out.contains("  feedback_rate: 50 Hz\n  effects:\n    table_encoder_eccentricity: { outer_sin_arcsec: 60 }\nmount:"), "{out}");
     let st = Station::from_yaml(&out, "out.yaml").unwrap();
     assert_eq!(st.imu.effects.value("lever_arm", "rzz_mm"), 25.04);

@@ -6,10 +6,10 @@
 //! reported, 2 error; 4 the run folder's seal fails (or it was never sealed).
 
 use super::procedure;
-use ratecal_physics::Effect;
 use ratecal_engine::explain::{self, AdoptTarget, NominalModel, Options, UserEffect};
 use ratecal_engine::fit::{Source, Streamed};
 use ratecal_engine::render;
+use ratecal_physics::Effect;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -208,12 +208,19 @@ pub fn main(args: Args) -> ExitCode {
         }
     };
     if let (Some(f), Some(r)) = (&twin_file, &mut twin) {
-        r.station = args.twin.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
+        r.station = args
+            .twin
+            .as_ref()
+            .map(|p| p.display().to_string())
+            .unwrap_or_default();
         if let Some(out) = &args.write_twin {
             match super::twin::corrected(f, &r.changes, out) {
                 Ok((text, diff)) => {
                     if let Err(e) = std::fs::write(out, &text) {
-                        errln!("error: cannot write the corrected twin {}: {e}", out.display());
+                        errln!(
+                            "error: cannot write the corrected twin {}: {e}",
+                            out.display()
+                        );
                         return ExitCode::from(2);
                     }
                     r.written = Some(out.display().to_string());
@@ -258,11 +265,14 @@ pub fn main(args: Args) -> ExitCode {
         value["twin"] = serde_json::to_value(r).expect("plain data serializes");
     }
     let json = serde_json::to_string_pretty(&value).expect("plain data serializes");
-    let figures: Vec<(String, String)> =
+    let mut figures: Vec<(String, String)> =
         render::explain_figures(&serde_json::to_value(&x).expect("plain data serializes"))
             .into_iter()
             .filter_map(|(effect, svg)| Some((format!("explain-{effect}.svg"), svg?)))
             .collect();
+    if let Some(svg) = twin.as_ref().and_then(|r| twin_figure(r, &value)) {
+        figures.push(("explain-twin.svg".into(), svg));
+    }
     // Kept in a ratecal run folder (not in another system's recording): its report shows it.
     let in_run = rec.manifest().run.is_some();
     if in_run {
@@ -338,4 +348,28 @@ fn same_dir(a: &Path, b: &Path) -> bool {
         (Ok(a), Ok(b)) => a == b,
         _ => false,
     }
+}
+
+/// The twin's figure: every segment's residual RMS against the twin as it is (orange) and
+/// updated (green), on the channels of the sensors where it disagrees (every channel when
+/// it agrees), the final model's noise floor in grey: explain's finding figure.
+fn twin_figure(r: &ratecal_engine::twin::TwinReport, x: &serde_json::Value) -> Option<String> {
+    let rows: Vec<serde_json::Value> = r
+        .before
+        .segments
+        .iter()
+        .zip(&r.after.segments)
+        .map(|(b, a)| {
+            serde_json::json!({ "segment": b.segment, "channel": b.channel,
+                "rms_before": b.rms, "rms_after": a.rms, "held_out": false })
+        })
+        .collect();
+    let located: Vec<serde_json::Value> = r
+        .before
+        .disagree
+        .iter()
+        .map(|d| serde_json::json!({ "channel": d.channel }))
+        .collect();
+    let f = serde_json::json!({ "title": "twin", "residuals": rows, "located": located });
+    render::figure(&f, x.get("final").and_then(|f| f.get("noise_floor")))
 }

@@ -22,8 +22,8 @@ pub fn load(
     }
     let name = path.map_or("<station>".to_string(), |p| p.display().to_string());
     let located = |message: String, help: &str| {
-        let span = station::locate(text, "imu", "user_effects")
-            .map(|(a, n)| SourceSpan::new(a.into(), n));
+        let span =
+            station::locate(text, "imu", "user_effects").map(|(a, n)| SourceSpan::new(a.into(), n));
         let mut r = miette!(
             labels = span
                 .map(|s| vec![miette::LabeledSpan::at(s, "here")])

@@ -27,7 +27,9 @@ pub struct TwinFile {
 #[error("{message}")]
 #[diagnostic(
     code(explain::twin_contradicts_manifest),
-    help("a twin is compared with recordings of its own station: give the station file the recording was made on (its run folder's station.yaml), or correct the value")
+    help(
+        "a twin is compared with recordings of its own station: give the station file the recording was made on (its run folder's station.yaml), or correct the value"
+    )
 )]
 pub struct Contradiction {
     message: String,
@@ -69,9 +71,11 @@ pub fn refuse(f: &TwinFile, m: &Manifest) -> Result<(), Box<Contradiction>> {
     let st = &f.station;
     let ms = &m.station;
     let close3 = |a: [f64; 3], b: [f64; 3]| a.iter().zip(b).all(|(x, y)| (x - y).abs() <= 1e-6);
-    let mount = ms.mount.map_or([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], |m| {
-        m.rotation
-    });
+    let mount = ms
+        .mount
+        .map_or([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], |m| {
+            m.rotation
+        });
     let checks: [(&str, &str, bool, String); 5] = [
         (
             "site",
@@ -124,6 +128,8 @@ pub fn refuse(f: &TwinFile, m: &Manifest) -> Result<(), Box<Contradiction>> {
 /// The twin's terms and noise as the analysis takes them.
 pub fn twin_of(st: &Station) -> Twin {
     let imu = &st.imu;
+    // The IMU model holds the nominal terms, the catalogue effects set and the user
+    // effects' terms.
     let mut terms: Vec<(String, Vec<f64>)> = st
         .imu_model()
         .terms
@@ -137,9 +143,6 @@ pub fn twin_of(st: &Station) -> Twin {
         {
             terms.push((id.clone(), st.imu.effects.values(e)));
         }
-    }
-    for t in &st.user_terms.0 {
-        terms.push((t.effect.id().to_string(), t.values.clone()));
     }
     for (id, _) in &st.table.effects.0.0 {
         if let Some(e) = ratecal_physics::effect(id) {

@@ -79,7 +79,13 @@ pub fn explain_source<S: Source>(
     opts: &Options,
 ) -> Result<Explanation, S::Error> {
     let (data, nonfinite) = accumulate(src, opts)?;
-    Ok(explain_data(src.manifest(), &data, &nonfinite, nominal, opts))
+    Ok(explain_data(
+        src.manifest(),
+        &data,
+        &nonfinite,
+        nominal,
+        opts,
+    ))
 }
 
 /// The recording accumulated once for explain (the registry's effects and `opts.user`),

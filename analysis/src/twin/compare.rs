@@ -44,7 +44,11 @@ pub(super) fn report(
         .collect();
     let earth = lay.index("earth_rate").expect("a registry id");
     let terms = Terms {
-        effects: own.iter().chain(found.iter().map(|f| &f.0)).copied().collect(),
+        effects: own
+            .iter()
+            .chain(found.iter().map(|f| &f.0))
+            .copied()
+            .collect(),
         fixed: vec![(
             earth,
             ratecal_physics::effects::EarthRate::values(m.station.site.latitude_deg).to_vec(),
@@ -148,8 +152,7 @@ pub(super) fn report(
         &theta(m, data, &updated, t_ref_data),
         &white,
     );
-    let needs_change =
-        !changes.is_empty() || !x.findings.is_empty() || !x.unexplained.is_empty();
+    let needs_change = !changes.is_empty() || !x.findings.is_empty() || !x.unexplained.is_empty();
     TwinReport {
         station: String::new(),
         before,

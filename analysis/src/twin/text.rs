@@ -26,11 +26,18 @@ pub fn render_text(r: &TwinReport) -> String {
         }
     }
     if r.changes.is_empty() {
-        let _ = writeln!(s, "  no change: the twin predicts the recording to its noise");
+        let _ = writeln!(
+            s,
+            "  no change: the twin predicts the recording to its noise"
+        );
     } else {
         let _ = writeln!(s, "  changes:");
         for c in &r.changes {
-            let what = if c.added { "  (the twin lacked it)" } else { "" };
+            let what = if c.added {
+                "  (the twin lacked it)"
+            } else {
+                ""
+            };
             let _ = writeln!(
                 s,
                 "    {}.{}: {} -> {} ({:.1} standard errors){what}",

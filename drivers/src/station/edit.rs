@@ -97,10 +97,9 @@ pub fn edit(text: &str, sets: &[SetValue]) -> Result<String, String> {
     let imu = &skel.imu.value;
     for (id, values) in by_effect {
         let Some(effect) = ratecal_physics::effect(id) else {
-            let file = values
-                .iter()
-                .find_map(|v| v.file.clone())
-                .ok_or_else(|| format!("`{id}` is neither a registry effect nor a user effect's"))?;
+            let file = values.iter().find_map(|v| v.file.clone()).ok_or_else(|| {
+                format!("`{id}` is neither a registry effect nor a user effect's")
+            })?;
             user(text, start(&skel.imu)?, imu, id, &file, &values, &mut edits)?;
             continue;
         };
@@ -303,7 +302,8 @@ fn unit_of(s: &str) -> Option<&'static str> {
 
 /// `value` and `u` (the station file's internal unit) written in `unit`.
 fn quantity(value: f64, u: f64, unit: &str) -> Result<String, String> {
-    let (_, f) = ratecal_physics::units::unit(unit).ok_or_else(|| format!("unknown unit {unit}"))?;
+    let (_, f) =
+        ratecal_physics::units::unit(unit).ok_or_else(|| format!("unknown unit {unit}"))?;
     Ok(format!("{} {unit}", number(value / f, u / f)))
 }
 
@@ -312,7 +312,10 @@ pub fn number(v: f64, u: f64) -> String {
     if u > 0.0 && u.is_finite() {
         let d = (1 - u.log10().floor() as i32).clamp(0, 15) as usize;
         let s = format!("{v:.d$}");
-        if s.trim_start_matches('-').chars().all(|c| c == '0' || c == '.') {
+        if s.trim_start_matches('-')
+            .chars()
+            .all(|c| c == '0' || c == '.')
+        {
             return s.trim_start_matches('-').to_string();
         }
         s
