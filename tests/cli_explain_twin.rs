@@ -79,9 +79,9 @@ fn changes(v: &serde_json::Value) -> Vec<(String, f64, f64, f64)> {
         .collect()
 }
 
-/// `name` changed to within 3u of the truth, plus 0.05 % of it for a lever arm: the
-/// accelerometers sense the lever arm's acceleration through their scale factor (up to
-/// 350 ppm on the default station), so the first-order fit finds `r K`, not `r`.
+/// `name` changed to within 3u of the truth, plus 0.05 % of it for a lever arm: what the
+/// registry's first-order columns on the 50 Hz feedback leave (micrometres at 25 mm; the
+/// scale factor the accelerometers sense it through is taken out).
 fn assert_within(c: &[(String, f64, f64, f64)], name: &str, truth: f64) {
     let (_, _, to, u) = c
         .iter()

@@ -144,7 +144,7 @@ pub(crate) fn explain_data(
         skip: Vec::new(),
     };
     let all: Vec<usize> = (0..data.accs.len()).collect();
-    let (sa, sg) = seed_segments(m, &data);
+    let (sa, sg) = seed_segments(m, data);
     if sa.is_empty() || sg.is_empty() {
         warnings.push(
             "the recording lacks static or rate segments: the nominal model is fitted on every segment"
@@ -156,14 +156,14 @@ pub(crate) fn explain_data(
     } else {
         (sa, sg)
     };
-    let (nom, _) = fit(&data, &start, &sa, &sg);
+    let (nom, _) = fit(data, &start, &sa, &sg);
     let nominal_out = Nominal {
         model: nominal.name.clone(),
         terms: start.names(&data.layout),
-        rms: rms(&data, &nom, &all),
-        holdout_rms: rms(&data, &nom, &data.held),
+        rms: rms(data, &nom, &all),
+        holdout_rms: rms(data, &nom, &data.held),
     };
-    let sel = select::forward(&data, &start, opts.alpha, &opts.without);
+    let sel = select::forward(data, &start, opts.alpha, &opts.without);
     if debug {
         eprintln!("selected in {:?}", clock.elapsed());
     }
@@ -171,7 +171,7 @@ pub(crate) fn explain_data(
     let work = data.working();
     let last = match steps.last() {
         Some(s) => s.after.clone(),
-        None => fit(&data, &start, &work, &work).0,
+        None => fit(data, &start, &work, &work).0,
     };
     // Each finding's parameters come from the final model, every finding in it, refitted
     // on every segment once the held-out ones have confirmed it: an effect found early was
@@ -182,12 +182,12 @@ pub(crate) fn explain_data(
         terms.effects.push(step.effect);
     }
     let latitude = m.station.site.latitude_deg;
-    let held = earth::hold(&data, &mut terms, latitude);
-    let whole = fit(&data, &terms, &all, &all);
+    let held = earth::hold(data, &mut terms, latitude);
+    let whole = fit(data, &terms, &all, &all);
     let findings: Vec<Finding> = steps
         .iter()
         .map(|step| {
-            let mut f = finding(m, &data, step, &terms, &whole);
+            let mut f = finding(m, data, step, &terms, &whole);
             f.defined_in = opts
                 .user
                 .iter()
@@ -201,7 +201,7 @@ pub(crate) fn explain_data(
             f
         })
         .collect();
-    let mut unexplained = unexplained::leftover(m, &data, &terms, opts.alpha);
+    let mut unexplained = unexplained::leftover(m, data, &terms, opts.alpha);
     if debug {
         eprintln!("leftover tested in {:?}", clock.elapsed());
     }
@@ -213,9 +213,9 @@ pub(crate) fn explain_data(
         (v.iter().sum::<f64>() / v.len() as f64).sqrt()
     };
     let final_ = Final {
-        terms: earth::names(&data, &terms),
-        rms: rms(&data, &last, &all),
-        holdout_rms: rms(&data, &last, &data.held),
+        terms: earth::names(data, &terms),
+        rms: rms(data, &last, &all),
+        holdout_rms: rms(data, &last, &data.held),
         noise_floor: Rms {
             accel_mps2: floor(0..3),
             gyro_dps: floor(3..6),

@@ -84,6 +84,16 @@ pub(super) fn report(
                     .map_or(0.0, |g| f.theta[g]);
                 v - drift * dt
             }
+            None if id == "lever_arm" => {
+                // The accelerometers sense the lever arm's acceleration through their
+                // scale factor (`K (f + M r)`): the fit's coefficient is `r (1 + s_i)`.
+                let s = lay
+                    .index("accel_scale")
+                    .map(|e| lay.columns_of(e).start + k / 3)
+                    .filter(|&g| ok(g))
+                    .map_or(0.0, |g| f.theta[g]);
+                v / (1.0 + s * 1e-6)
+            }
             None => v,
         }
     };
@@ -108,7 +118,7 @@ pub(super) fn report(
     let mut changes = Vec::new();
     for (e, k, g, z) in tested {
         let p = 2.0 * normal.sf(z.abs());
-        if !(p < per_test) {
+        if p.is_nan() || p >= per_test {
             continue;
         }
         let fx = lay.effects[e];
@@ -135,7 +145,7 @@ pub(super) fn report(
                 effect: fx.id().into(),
                 parameter: fx.params()[k].name.into(),
                 from: 0.0,
-                to: f.theta[g],
+                to: to_twin_ref(*e, k, f.theta[g]),
                 u: f.u(g),
                 unit: fx.params()[k].unit.into(),
                 standard_errors: (f.theta[g] / f.u(g)).abs(),

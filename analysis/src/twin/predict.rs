@@ -46,6 +46,14 @@ pub(super) fn theta(m: &Manifest, data: &Data, twin: &Twin, t_ref_data: f64) -> 
             set(nominal, &shift);
         }
     }
+    // The accelerometers sense the lever arm's acceleration through their scale factor
+    // (`K (f + M r)`, spec/physics.md): in the registry's linear columns accelerometer i's
+    // coordinates weigh `1 + s_i`.
+    if let (Some(e), Some(scale)) = (lay.index("lever_arm"), twin.values("accel_scale")) {
+        for (k, g) in lay.columns_of(e).enumerate() {
+            th[g] *= 1.0 + scale[k / 3] * 1e-6;
+        }
+    }
     let lat = m.station.site.latitude_deg;
     set(
         "earth_rate",
