@@ -137,14 +137,14 @@ pub fn twin_of(st: &Station) -> Twin {
         .filter(|t| t.effect.id() != "earth_rate")
         .map(|t| (t.effect.id().to_string(), t.values.clone()))
         .collect();
-    for (id, _) in &st.imu.effects.0 {
+    for id in st.imu.effects.0.keys() {
         if !terms.iter().any(|t| t.0 == *id)
             && let Some(e) = ratecal_physics::effect(id)
         {
             terms.push((id.clone(), st.imu.effects.values(e)));
         }
     }
-    for (id, _) in &st.table.effects.0.0 {
+    for id in st.table.effects.0.0.keys() {
         if let Some(e) = ratecal_physics::effect(id) {
             terms.push((id.clone(), st.table.effects.0.values(e)));
         }

@@ -46,6 +46,11 @@ pub(super) fn theta(m: &Manifest, data: &Data, twin: &Twin, t_ref_data: f64) -> 
             set(nominal, &shift);
         }
     }
+    let lat = m.station.site.latitude_deg;
+    set(
+        "earth_rate",
+        &ratecal_physics::effects::EarthRate::values(lat),
+    );
     // The accelerometers sense the lever arm's acceleration through their scale factor
     // (`K (f + M r)`, spec/physics.md): in the registry's linear columns accelerometer i's
     // coordinates weigh `1 + s_i`.
@@ -54,11 +59,6 @@ pub(super) fn theta(m: &Manifest, data: &Data, twin: &Twin, t_ref_data: f64) -> 
             th[g] *= 1.0 + scale[k / 3] * 1e-6;
         }
     }
-    let lat = m.station.site.latitude_deg;
-    set(
-        "earth_rate",
-        &ratecal_physics::effects::EarthRate::values(lat),
-    );
     debug_assert!(NOMINAL.iter().all(|id| lay.index(id).is_some()));
     th
 }
