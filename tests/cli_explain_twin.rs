@@ -268,6 +268,13 @@ fn a_simulated_station_against_the_twin_of_another_station_file() {
     ] {
         assert_within(&ch, name, truth);
     }
+    // The run folder's report gains the twin's section.
+    let o = ratecal(&["report", "real"], dir);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let report = String::from_utf8_lossy(&o.stdout);
+    assert!(report.contains("### The station's twin (`rehearsal`)"), "{report}");
+    assert!(report.contains("- `lever_arm.rzz_mm`: 0 → 25."), "{report}");
+    assert!(report.contains("Corrected station file: `updated.yaml`."), "{report}");
     // The corrected file passes the checker's station rules.
     let o = ratecal(&["check", proc_, "--station", "updated.yaml"], dir);
     assert_eq!(code(&o), 0, "{}", text(&o));
