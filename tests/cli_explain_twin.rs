@@ -272,10 +272,16 @@ fn a_simulated_station_against_the_twin_of_another_station_file() {
     let o = ratecal(&["report", "real"], dir);
     assert_eq!(code(&o), 0, "{}", text(&o));
     let report = String::from_utf8_lossy(&o.stdout);
-    assert!(report.contains("### The station's twin (`rehearsal`)"), "{report}");
+    assert!(
+        report.contains("### The station's twin (`rehearsal`)"),
+        "{report}"
+    );
     assert!(report.contains("\n- `lever_arm.rzz_mm`: 0"), "{report}");
     assert!(report.contains(" (the twin lacked it)\n"), "{report}");
-    assert!(report.contains("Corrected station file: `updated.yaml`."), "{report}");
+    assert!(
+        report.contains("Corrected station file: `updated.yaml`."),
+        "{report}"
+    );
     // The corrected file passes the checker's station rules.
     let o = ratecal(&["check", proc_, "--station", "updated.yaml"], dir);
     assert_eq!(code(&o), 0, "{}", text(&o));
