@@ -249,10 +249,17 @@ fn a_simulated_station_against_the_twin_of_another_station_file() {
             "updated.yaml",
             "--format",
             "json",
+            "--plots",
+            "figs",
         ],
         dir,
     );
     assert_eq!(code(&o), 1, "{}", text(&o));
+    // The twin's figure: beside explain.json in the run folder, and in --plots.
+    for f in ["figs/explain-twin.svg", "real/explain-twin.svg"] {
+        let svg = std::fs::read_to_string(dir.join(f)).unwrap();
+        assert!(svg.starts_with("<svg") && svg.contains("twin"), "{f}");
+    }
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let ch = changes(&v);
     let names: Vec<&str> = ch.iter().map(|c| c.0.as_str()).collect();
