@@ -12,3 +12,4 @@ pub use ratecal_plan as plan;
 /// The recording format lives in its own crate; `crate::recording` names it here.
 pub use ratecal_recording as recording;
 pub mod results;
+pub mod twin;

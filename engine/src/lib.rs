@@ -7,7 +7,7 @@
 
 pub mod audit;
 pub mod check;
-pub use ratecal_analysis::{explain, fit, measured, results};
+pub use ratecal_analysis::{explain, fit, measured, results, twin};
 pub use ratecal_plan as plan;
 /// The recording format lives in its own crate; `crate::recording` names it here.
 pub use ratecal_recording as recording;

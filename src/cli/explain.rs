@@ -1,5 +1,6 @@
 //! `ratecal explain RUN_DIR [--procedure PROCEDURE] [--effects FILE_OR_DIR]... [--without ID]...
-//! [--format text|json] [--plots DIR]`: where the recording and the nominal model disagree,
+//! [--twin STATION] [--write-twin OUT.yaml] [--format text|json] [--plots DIR]`: where the
+//! recording and the nominal model (or the station's twin) disagree,
 //! what physics was left out, the refit with it, and one before/after figure per finding
 //! (`explain-<effect>.svg`). Exit codes, like diff(1): 0 nothing found, 1 findings
 //! reported, 2 error; 4 the run folder's seal fails (or it was never sealed).
@@ -8,6 +9,7 @@ use super::procedure;
 use ratecal_engine::explain::{self, AdoptTarget, NominalModel, Options, UserEffect};
 use ratecal_engine::fit::{Source, Streamed};
 use ratecal_engine::render;
+use ratecal_physics::Effect;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -52,6 +54,14 @@ pub struct Args {
     /// explain.json in any case).
     #[arg(long, value_name = "DIR")]
     draft_effects: Option<PathBuf>,
+    /// Compare the recording with its station's twin: a station file, or a run folder
+    /// (its station.yaml). The JSON gains `twin` (docs/explain.md).
+    #[arg(long, value_name = "STATION", conflicts_with = "procedure")]
+    twin: Option<PathBuf>,
+    /// Write the corrected twin there (the input's layout and comments, values changed,
+    /// effects added) and print the diff.
+    #[arg(long, value_name = "OUT.yaml", requires = "twin")]
+    write_twin: Option<PathBuf>,
 }
 
 /// The effect files named by `--effects` and `RATECAL_EFFECTS`: files as given, folders
@@ -150,7 +160,7 @@ pub fn main(args: Args) -> ExitCode {
     } else {
         None
     };
-    let Ok(user) = load_effects(&args.effects) else {
+    let Ok(mut user) = load_effects(&args.effects) else {
         return ExitCode::from(2);
     };
     let nominal = match &args.procedure {
@@ -162,19 +172,72 @@ pub fn main(args: Args) -> ExitCode {
             Err(()) => return ExitCode::from(2),
         },
     };
+    let twin_file = match &args.twin {
+        None => None,
+        Some(p) => {
+            let Ok(f) = super::twin::read(p) else {
+                return ExitCode::from(2);
+            };
+            if let Err(e) = super::twin::refuse(&f, rec.manifest()) {
+                eprintln!("{:?}", miette::Report::new(*e));
+                return ExitCode::from(2);
+            }
+            // The twin's user effects are explain's candidates too (its terms need their
+            // columns); one already given with --effects is that one.
+            for e in &f.user {
+                if !user.iter().any(|u| u.id() == e.id()) {
+                    user.push(e);
+                }
+            }
+            Some(f)
+        }
+    };
     let opts = Options {
         path: args.run.display().to_string(),
         user,
         without: args.without.clone(),
         ..Options::default()
     };
-    let mut x = match explain::explain_source(&rec, &nominal, &opts) {
+    let explained = match &twin_file {
+        None => explain::explain_source(&rec, &nominal, &opts).map(|x| (x, None)),
+        Some(f) => {
+            let twin = super::twin::twin_of(&f.station);
+            ratecal_engine::twin::compare_source(&rec, &twin, &opts).map(|(x, r)| (x, Some(r)))
+        }
+    };
+    let (mut x, mut twin) = match explained {
         Ok(x) => x,
         Err(e) => {
             eprintln!("{:?}", miette::Report::new(e));
             return ExitCode::from(2);
         }
     };
+    if let (Some(f), Some(r)) = (&twin_file, &mut twin) {
+        r.station = args
+            .twin
+            .as_ref()
+            .map(|p| p.display().to_string())
+            .unwrap_or_default();
+        if let Some(out) = &args.write_twin {
+            match super::twin::corrected(f, &r.changes, out) {
+                Ok((text, diff)) => {
+                    if let Err(e) = std::fs::write(out, &text) {
+                        errln!(
+                            "error: cannot write the corrected twin {}: {e}",
+                            out.display()
+                        );
+                        return ExitCode::from(2);
+                    }
+                    r.written = Some(out.display().to_string());
+                    r.diff = Some(diff);
+                }
+                Err(e) => {
+                    errln!("error: cannot correct the twin: {e}");
+                    return ExitCode::from(2);
+                }
+            }
+        }
+    }
     // Only the registry's effects can be declared in a procedure.
     let ids: Vec<String> = x
         .findings
@@ -223,12 +286,19 @@ pub fn main(args: Args) -> ExitCode {
             });
         }
     }
-    let json = serde_json::to_string_pretty(&x).expect("plain data serializes");
-    let figures: Vec<(String, String)> =
+    let mut value = serde_json::to_value(&x).expect("plain data serializes");
+    if let Some(r) = &twin {
+        value["twin"] = serde_json::to_value(r).expect("plain data serializes");
+    }
+    let json = serde_json::to_string_pretty(&value).expect("plain data serializes");
+    let mut figures: Vec<(String, String)> =
         render::explain_figures(&serde_json::to_value(&x).expect("plain data serializes"))
             .into_iter()
             .filter_map(|(effect, svg)| Some((format!("explain-{effect}.svg"), svg?)))
             .collect();
+    if let Some(svg) = twin.as_ref().and_then(|r| twin_figure(r, &value)) {
+        figures.push(("explain-twin.svg".into(), svg));
+    }
     // Kept in a ratecal run folder (not in another system's recording): its report shows it.
     if in_run {
         let mut files = vec![("explain.json".to_string(), format!("{json}\n"))];
@@ -276,9 +346,22 @@ pub fn main(args: Args) -> ExitCode {
     }
     let out = match args.format {
         Format::Json => json + "\n",
-        Format::Text => explain::render_text(&x),
+        Format::Text => {
+            explain::render_text(&x)
+                + &twin
+                    .as_ref()
+                    .map(ratecal_engine::twin::render_text)
+                    .unwrap_or_default()
+        }
     };
     out!("{out}");
+    if let Some(r) = &twin {
+        return if r.needs_change {
+            ExitCode::from(1)
+        } else {
+            ExitCode::SUCCESS
+        };
+    }
     if x.findings.is_empty() && x.unexplained.is_empty() {
         ExitCode::SUCCESS
     } else {
@@ -309,4 +392,28 @@ fn same_dir(a: &Path, b: &Path) -> bool {
         (Ok(a), Ok(b)) => a == b,
         _ => false,
     }
+}
+
+/// The twin's figure: every segment's residual RMS against the twin as it is (orange) and
+/// updated (green), on the channels of the sensors where it disagrees (every channel when
+/// it agrees), the final model's noise floor in grey: explain's finding figure.
+fn twin_figure(r: &ratecal_engine::twin::TwinReport, x: &serde_json::Value) -> Option<String> {
+    let rows: Vec<serde_json::Value> = r
+        .before
+        .segments
+        .iter()
+        .zip(&r.after.segments)
+        .map(|(b, a)| {
+            serde_json::json!({ "segment": b.segment, "channel": b.channel,
+                "rms_before": b.rms, "rms_after": a.rms, "held_out": false })
+        })
+        .collect();
+    let located: Vec<serde_json::Value> = r
+        .before
+        .disagree
+        .iter()
+        .map(|d| serde_json::json!({ "channel": d.channel }))
+        .collect();
+    let f = serde_json::json!({ "title": "twin", "residuals": rows, "located": located });
+    render::figure(&f, x.get("final").and_then(|f| f.get("noise_floor")))
 }

@@ -19,4 +19,6 @@ pub mod report;
 pub mod run;
 pub mod run_folder;
 pub mod seal;
+pub mod station_effects;
+pub mod twin;
 pub mod verify;

@@ -81,19 +81,47 @@ pub fn explain_source<S: Source>(
     nominal: &NominalModel,
     opts: &Options,
 ) -> Result<Explanation, S::Error> {
+    let (data, nonfinite) = accumulate(src, opts)?;
+    Ok(explain_data(
+        src.manifest(),
+        &data,
+        &nonfinite,
+        nominal,
+        opts,
+    ))
+}
+
+/// The recording accumulated once for explain (the registry's effects and `opts.user`),
+/// and each user effect's count of non-finite regressor values before the pass: what
+/// [`explain_data`] and the twin's comparison (`crate::twin`) share.
+pub(crate) fn accumulate<S: Source>(
+    src: &S,
+    opts: &Options,
+) -> Result<(Data, Vec<usize>), S::Error> {
     let mut effects: Vec<&'static dyn Effect> = REGISTRY.to_vec();
     effects.extend(opts.user.iter().map(|u| *u as &'static dyn Effect));
     let nonfinite: Vec<usize> = opts.user.iter().map(|u| u.nonfinite()).collect();
     let clock = std::time::Instant::now();
-    let debug = std::env::var_os("RATECAL_EXPLAIN_DEBUG").is_some();
     let data = Data::with_effects(src, effects)?;
-    if debug {
+    if std::env::var_os("RATECAL_EXPLAIN_DEBUG").is_some() {
         eprintln!("accumulated in {:?}", clock.elapsed());
     }
-    let m = src.manifest();
+    Ok((data, nonfinite))
+}
+
+/// [`explain_source`] on a recording already accumulated ([`accumulate`]).
+pub(crate) fn explain_data(
+    m: &Manifest,
+    data: &Data,
+    nonfinite: &[usize],
+    nominal: &NominalModel,
+    opts: &Options,
+) -> Explanation {
+    let clock = std::time::Instant::now();
+    let debug = std::env::var_os("RATECAL_EXPLAIN_DEBUG").is_some();
     let lay = &data.layout;
     let mut warnings = Vec::new();
-    for (u, before) in opts.user.iter().zip(nonfinite) {
+    for (u, &before) in opts.user.iter().zip(nonfinite) {
         let n = u.nonfinite() - before;
         if n > 0 {
             warnings.push(format!(
@@ -119,7 +147,7 @@ pub fn explain_source<S: Source>(
         skip: Vec::new(),
     };
     let all: Vec<usize> = (0..data.accs.len()).collect();
-    let (sa, sg) = seed_segments(m, &data);
+    let (sa, sg) = seed_segments(m, data);
     if sa.is_empty() || sg.is_empty() {
         warnings.push(
             "the recording lacks static or rate segments: the nominal model is fitted on every segment"
@@ -131,14 +159,14 @@ pub fn explain_source<S: Source>(
     } else {
         (sa, sg)
     };
-    let (nom, _) = fit(&data, &start, &sa, &sg);
+    let (nom, _) = fit(data, &start, &sa, &sg);
     let nominal_out = Nominal {
         model: nominal.name.clone(),
         terms: start.names(&data.layout),
-        rms: rms(&data, &nom, &all),
-        holdout_rms: rms(&data, &nom, &data.held),
+        rms: rms(data, &nom, &all),
+        holdout_rms: rms(data, &nom, &data.held),
     };
-    let sel = select::forward(&data, &start, opts.alpha, &opts.without);
+    let sel = select::forward(data, &start, opts.alpha, &opts.without);
     if debug {
         eprintln!("selected in {:?}", clock.elapsed());
     }
@@ -153,10 +181,10 @@ pub fn explain_source<S: Source>(
         terms.effects.push(step.effect);
     }
     let latitude = m.station.site.latitude_deg;
-    let mut held = earth::hold(&data, &mut terms, latitude);
+    let mut held = earth::hold(data, &mut terms, latitude);
     // What the registry left: forms of the probe library, found one at a time.
     let registry_terms = terms.clone();
-    let mut discoveries = discover::discover(&data, &mut terms, opts.alpha);
+    let mut discoveries = discover::discover(data, &mut terms, opts.alpha);
     if !discoveries.is_empty() {
         // The registry's selection again beside what was found: a strong unlisted form can
         // hide the Earth's rate (or a registry effect) from the held-out segments, and a
@@ -174,24 +202,24 @@ pub fn explain_source<S: Source>(
                 .iter()
                 .filter(|g| !registry_terms.skip.contains(g)),
         );
-        let sel = select::forward(&data, &again, opts.alpha, &opts.without);
+        let sel = select::forward(data, &again, opts.alpha, &opts.without);
         (steps, rejected, refused) = (sel.steps, sel.last_p, sel.refused);
         for step in &steps {
             again.effects.push(step.effect);
         }
-        held = earth::hold(&data, &mut again, latitude);
-        discoveries.extend(discover::discover(&data, &mut again, opts.alpha));
+        held = earth::hold(data, &mut again, latitude);
+        discoveries.extend(discover::discover(data, &mut again, opts.alpha));
         terms = again;
     }
-    let last = fit(&data, &terms, &work, &work).0;
+    let last = fit(data, &terms, &work, &work).0;
     if debug {
         eprintln!("discovered in {:?}", clock.elapsed());
     }
-    let whole = fit(&data, &terms, &all, &all);
+    let whole = fit(data, &terms, &all, &all);
     let mut findings: Vec<Finding> = steps
         .iter()
         .map(|step| {
-            let mut f = finding(m, &data, step, &terms, &whole);
+            let mut f = finding(m, data, step, &terms, &whole);
             f.defined_in = opts
                 .user
                 .iter()
@@ -208,9 +236,9 @@ pub fn explain_source<S: Source>(
     findings.extend(
         discoveries
             .iter()
-            .map(|d| discovered::finding(m, &data, d, &registry_terms, &whole.0)),
+            .map(|d| discovered::finding(m, data, d, &registry_terms, &whole.0)),
     );
-    let mut unexplained = unexplained::leftover(m, &data, &terms, opts.alpha);
+    let mut unexplained = unexplained::leftover(m, data, &terms, opts.alpha);
     if debug {
         eprintln!("leftover tested in {:?}", clock.elapsed());
     }
@@ -222,9 +250,9 @@ pub fn explain_source<S: Source>(
         (v.iter().sum::<f64>() / v.len() as f64).sqrt()
     };
     let final_ = Final {
-        terms: earth::names(&data, &terms),
-        rms: rms(&data, &last, &all),
-        holdout_rms: rms(&data, &last, &data.held),
+        terms: earth::names(data, &terms),
+        rms: rms(data, &last, &all),
+        holdout_rms: rms(data, &last, &data.held),
         noise_floor: Rms {
             accel_mps2: floor(0..3),
             gyro_dps: floor(3..6),
@@ -237,7 +265,7 @@ pub fn explain_source<S: Source>(
         .map(|f| f.effect.as_str())
         .collect();
     let adopt = (!ids.is_empty()).then(|| format!("with {}", ids.join(", ")));
-    Ok(Explanation {
+    Explanation {
         format: FORMAT.into(),
         recording: opts.path.clone(),
         nominal: nominal_out,
@@ -269,7 +297,7 @@ pub fn explain_source<S: Source>(
             })
             .collect(),
         warnings,
-    })
+    }
 }
 
 /// One accepted step as a finding, its parameters from the final model fitted on every

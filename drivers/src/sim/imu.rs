@@ -37,6 +37,9 @@ pub struct SimImu {
     model: ImuModel,
     /// The table's encoder errors: the profile is the encoder's angle, not the true one.
     encoder: EncoderError,
+    /// Whether a term is a user effect, which may read the time stamp: every sample is
+    /// then evaluated at its own stamp, never reused from a hold.
+    timed: bool,
     next_k: u64,
     hints: [usize; 2],
     cache: Option<Cache>,
@@ -87,6 +90,10 @@ impl SimImu {
             geo: station.geometry(),
             site: station.site(),
             encoder: station.encoder_error(),
+            timed: model
+                .terms
+                .iter()
+                .any(|t| ratecal_physics::effect(t.effect.id()).is_none()),
             model,
             next_k: 0,
             hints: [0; 2],
@@ -154,6 +161,9 @@ impl SimImu {
             let state = self.encoder.true_motion(&reported);
             // Holds are bit-for-bit constant: reuse the physics while nothing changes.
             let temp = self.temp;
+            if self.timed {
+                self.cache = None;
+            }
             let (a, g) = match &self.cache {
                 Some(c) if c.state == state && c.temp == temp => c.outputs,
                 Some(c) if c.state == state => {
@@ -169,7 +179,11 @@ impl SimImu {
                 }
                 _ => {
                     let snap = state.snapshot(&self.geo, &self.site);
-                    let signals = Signals::new(&snap, &self.site, temp - self.model.t_ref_c);
+                    // Only user effects read the stamp (the registry's clock rate re-times
+                    // the motion instead).
+                    let stamp = if self.timed { t } else { 0.0 };
+                    let signals =
+                        Signals::new(&snap, &self.site, temp - self.model.t_ref_c).at(stamp);
                     let outputs = self.model.outputs(&signals);
                     self.cache = Some(Cache {
                         state,

@@ -37,6 +37,9 @@ pub struct Station {
     /// Faults to rehearse aborts with (simulated station only).
     #[serde(default)]
     pub faults: Vec<FaultSpec>,
+    /// The terms of `imu.user_effects`, once the CLI has read their files.
+    #[serde(skip)]
+    pub user_terms: UserTerms,
 }
 
 /// The site: latitude and local gravity.
@@ -243,6 +246,34 @@ pub struct ImuSpec {
     /// Catalogue effects under their canonical ids.
     #[serde(default)]
     pub effects: EffectsSpec,
+    /// User effects (`*.effect` files, docs/user-effects.md) by reference: id -> its file
+    /// and parameter values. The CLI reads the files and hands the terms in
+    /// ([`Station::user_terms`]); the simulator applies them as registry effects.
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub user_effects: std::collections::BTreeMap<String, UserEffectRef>,
+}
+
+/// A user effect in a station file: the `.effect` file that defines it (relative to the
+/// station file's folder) and its parameters' values, in the units the file declares.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct UserEffectRef {
+    /// The `.effect` file.
+    pub file: String,
+    /// Parameter name -> value (0 when absent).
+    #[serde(default)]
+    pub values: std::collections::BTreeMap<String, f64>,
+}
+
+/// The user effects' terms, read from their files by the CLI: equal whatever they hold
+/// (a station's identity is its text).
+#[derive(Debug, Clone, Default)]
+pub struct UserTerms(pub Vec<ratecal_physics::effects::Term>);
+
+impl PartialEq for UserTerms {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 fn default_correlation() -> Time {

@@ -2,6 +2,7 @@
 //! Parsing refuses unknown keys and wrong units with a diagnostic located in the file.
 
 mod describe;
+mod edit;
 mod effects;
 mod faults;
 mod file;
@@ -9,11 +10,12 @@ mod quantity;
 
 pub use describe::{Environment, ImuIdentity, StationInfo};
 
+pub use edit::{SetValue, edit, locate, number};
 pub use effects::{EffectsSpec, TableEffectsSpec};
 pub use faults::{AxisName, DropoutMode, FaultSpec, LinkName, TableFaultMode};
 pub use file::{
     AmbientSpec, EnvironmentSpec, ImuSpec, ImuTemperatureSpec, MountSpec, SettlingSpec, SiteSpec,
-    Station, TableCalibration, TableSpec, TemperatureSpec,
+    Station, TableCalibration, TableSpec, TemperatureSpec, UserEffectRef, UserTerms,
 };
 pub use quantity::{
     Accel, AccelDensity, Angle, Freq, Pressure, Rate, RateDensity, RateWalk, Ratio, Rotation, Temp,
@@ -113,6 +115,7 @@ impl Station {
                 m.push(e.id(), self.imu.effects.values(e));
             }
         }
+        m.terms.extend(self.user_terms.0.iter().cloned());
         m
     }
 

@@ -26,7 +26,7 @@ mod views;
 
 pub use context::CONTEXT_FORMAT;
 pub use error::{RenderError, TemplateError};
-pub use finding::explain_figures;
+pub use finding::{explain_figures, figure};
 
 use crate::fit::Source;
 use crate::plan::Plan;

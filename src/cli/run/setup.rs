@@ -65,6 +65,7 @@ pub fn station_for(
         }
     };
     let mut station = Station::from_yaml(&yaml, &name).map_err(|e| Report::new(*e))?;
+    crate::cli::station_effects::load(&mut station, &yaml, path)?;
     if dry_run {
         station.table.driver = ratecal_drivers::DriverSpec::sim();
         station.imu.driver = ratecal_drivers::DriverSpec::sim();
