@@ -16,7 +16,28 @@ fn run(s: &Scenario, opts: &Options) -> (Explanation, tempfile::TempDir) {
     let dir = tempfile::tempdir().unwrap();
     write(dir.path(), s).unwrap();
     let rec = recording::read(dir.path()).unwrap();
-    (explain::explain(&rec, &NominalModel::seed(), opts), dir)
+    let x = explain::explain(&rec, &NominalModel::seed(), opts);
+    show(&x);
+    (x, dir)
+}
+
+/// Prints each discovered finding's residuals (the note's table: `--nocapture`).
+fn show(x: &Explanation) {
+    for f in x.findings.iter().filter(|f| f.discovered) {
+        let (b, a) = (
+            &f.evidence.holdout_rms_before,
+            &f.evidence.holdout_rms_after,
+        );
+        eprintln!(
+            "{}: held-out RMS accel {:.3e} -> {:.3e} m/s^2, gyro {:.3e} -> {:.3e} deg/s; {:?}",
+            f.effect,
+            b.accel_mps2,
+            a.accel_mps2,
+            b.gyro_dps,
+            a.gyro_dps,
+            f.terms.iter().map(|t| &t.expression).collect::<Vec<_>>()
+        );
+    }
 }
 
 fn discovered(x: &Explanation) -> Vec<&Finding> {
@@ -56,6 +77,7 @@ fn term(x: &Explanation, channel: &str, form: &str, what: &str) -> (f64, f64) {
 }
 
 fn within(what: &str, (v, u): (f64, f64), truth: f64, k: f64) {
+    eprintln!("| {what} | {v:.4} | {u:.4} | {truth:.4} |");
     assert!(
         (v - truth).abs() <= k * u,
         "{what}: {v} +- {u}, truth {truth} ({:.1} u)",
