@@ -11,20 +11,6 @@ use support::*;
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
-/// `../shared/<rel>` beside the repository (or a worktree's parent).
-fn shared(rel: &str) -> Option<PathBuf> {
-    let found = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .ancestors()
-        .skip(1)
-        .take(3)
-        .map(|a| a.join("shared").join(rel))
-        .find(|p| p.exists());
-    if found.is_none() {
-        println!("skipped: ../shared/{rel} is absent");
-    }
-    found
-}
-
 fn example_map(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("docs/examples/import")
@@ -57,8 +43,8 @@ fn param(results: &serde_json::Value, name: &str) -> f64 {
 #[test]
 fn ferraris_session_is_the_hand_converted_example() {
     let (Some(src), Some(example)) = (
-        shared("real/imucal/example_ferraris_session.csv"),
-        shared("examples/real-ferraris-session"),
+        shared_path("real/imucal/example_ferraris_session.csv"),
+        shared_path("examples/real-ferraris-session"),
     ) else {
         return;
     };

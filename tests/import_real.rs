@@ -7,20 +7,7 @@
 mod support;
 use support::*;
 
-use std::path::{Path, PathBuf};
-
-fn shared(rel: &str) -> Option<PathBuf> {
-    let found = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .ancestors()
-        .skip(1)
-        .take(3)
-        .map(|a| a.join("shared").join(rel))
-        .find(|p| p.exists());
-    if found.is_none() {
-        println!("skipped: ../shared/{rel} is absent");
-    }
-    found
-}
+use std::path::Path;
 
 fn map(name: &str) -> String {
     let p = Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -75,8 +62,8 @@ fn intervals(run: &Path) -> Vec<(f64, f64, Option<String>)> {
 #[test]
 fn imu_tk_xsens_poses_are_found_and_static_by_the_factory_calibration() {
     let (Some(acc), Some(gyr)) = (
-        shared("real/imu_tk/xsens_acc.mat"),
-        shared("real/imu_tk/xsens_gyro.mat"),
+        shared_path("real/imu_tk/xsens_acc.mat"),
+        shared_path("real/imu_tk/xsens_gyro.mat"),
     ) else {
         return;
     };
@@ -149,7 +136,7 @@ fn imu_tk_xsens_poses_are_found_and_static_by_the_factory_calibration() {
 
 #[test]
 fn mpu6050_start_up_rest_and_poses_are_found() {
-    let Some(src) = shared("real/mpu6050/example_data_calibration.csv") else {
+    let Some(src) = shared_path("real/mpu6050/example_data_calibration.csv") else {
         return;
     };
     let tmp = tempfile::tempdir().unwrap();

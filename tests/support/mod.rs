@@ -109,6 +109,11 @@ pub fn shared_example(name: &str) -> Option<PathBuf> {
     shared::shared_example(name)
 }
 
+/// `../shared/<rel>`, or `None` with a "skipped" line when this machine lacks it.
+pub fn shared_path(rel: &str) -> Option<PathBuf> {
+    shared::shared_path(rel)
+}
+
 /// The shared lever-arm example recording (`../shared/examples/standard-with-lever-arm`),
 /// or `None` with a "skipped" line when this machine lacks it.
 pub fn example() -> Option<PathBuf> {
