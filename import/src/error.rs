@@ -75,7 +75,6 @@ impl ImportError {
         range: Range<usize>,
         say: Say<'_>,
     ) -> Box<Self> {
-        let Say { what, label, help } = say;
         let (start, end) = (range.start, range.end);
         let start = floor_char(text, start.min(text.len()));
         let end = floor_char(text, end.clamp(start, text.len()));
@@ -83,17 +82,7 @@ impl ImportError {
         let before = &text[..start];
         let line = before.matches('\n').count() as u64 + 1;
         let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-        Box::new(ImportError {
-            kind,
-            message: format!("{file}:{line}:{column}: {what}"),
-            file: file.to_string(),
-            line: Some(line),
-            column: Some(column),
-            src,
-            span: Some(span),
-            label: label.to_string(),
-            help: help.to_string(),
-        })
+        Self::located(kind, file, (line, column), (src, span), say)
     }
 
     /// An error in one line of a source file (`line_text` without its newline, 1-based
@@ -106,13 +95,25 @@ impl ImportError {
         range: Range<usize>,
         say: Say<'_>,
     ) -> Box<Self> {
-        let Say { what, label, help } = say;
         let (start, end) = (range.start, range.end);
         let start = start.min(line_text.len());
         let end = end.clamp(start, line_text.len()).max(start + 1);
         let (src, span) =
             Excerpt::around_at(file, line_text, line.saturating_sub(1) as usize, start, end);
         let column = String::from_utf8_lossy(&line_text[..start]).chars().count() + 1;
+        Self::located(kind, file, (line, column), (src, span), say)
+    }
+
+    /// The error at `line`, `column` of `file`, with its excerpt: what `in_text` and
+    /// `in_line` locate.
+    fn located(
+        kind: ErrorKind,
+        file: &str,
+        (line, column): (u64, usize),
+        (src, span): (Excerpt, SourceSpan),
+        say: Say<'_>,
+    ) -> Box<Self> {
+        let Say { what, label, help } = say;
         Box::new(ImportError {
             kind,
             message: format!("{file}:{line}:{column}: {what}"),
