@@ -10,10 +10,10 @@
 //! score) joins the model, which is refitted jointly with everything found before.
 
 use super::data::Data;
-use super::model::{Terms, fit};
+use super::model::{Terms, fit, misfit};
 use super::probe::{Form, Probe};
 use super::select::{Step, p_value, wald};
-use crate::fit::joint::{Fit, channel, seg_rss};
+use crate::fit::joint::{Fit, channel};
 use ratecal_physics::effects::Sensor;
 
 /// Most terms discovered in one recording.
@@ -77,15 +77,6 @@ fn held_misfit(data: &Data, f: &Fit, base: &Fit, channels: &[usize]) -> f64 {
         .iter()
         .map(|&c| misfit(data, f, c, &data.held, base.noise[c].sigma))
         .sum()
-}
-
-/// Misfit of channel `c` over `segs` under `f`, in units of the white noise `sigma`.
-fn misfit(data: &Data, f: &Fit, c: usize, segs: &[usize], sigma: f64) -> f64 {
-    let sigma = sigma.max(1e-300);
-    segs.iter()
-        .map(|&i| seg_rss(&data.accs[i], &data.layout, c, &f.theta))
-        .sum::<f64>()
-        / (sigma * sigma)
 }
 
 /// Probe `e` added to `terms` with all its channel columns (the channels' fits are

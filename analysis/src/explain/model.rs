@@ -3,7 +3,7 @@
 
 use super::data::Data;
 pub(crate) use crate::fit::joint::Terms;
-use crate::fit::joint::{Fit, fit_terms_merged, rss_on};
+use crate::fit::joint::{Fit, fit_terms_merged, rss_on, seg_rss};
 use crate::plan::Plan;
 use crate::recording::{Manifest, SegmentKind};
 use ratecal_physics::effects::EarthRate;
@@ -103,6 +103,16 @@ pub(crate) fn fit_with(
         Some(&merged),
         white_only,
     )
+}
+
+/// Misfit of channel `c` over `segs` under `fit`: its residual sum of squares in units of
+/// the white noise `sigma`.
+pub(crate) fn misfit(data: &Data, fit: &Fit, c: usize, segs: &[usize], sigma: f64) -> f64 {
+    let sigma = sigma.max(1e-300);
+    segs.iter()
+        .map(|&i| seg_rss(&data.accs[i], &data.layout, c, &fit.theta))
+        .sum::<f64>()
+        / (sigma * sigma)
 }
 
 /// Residual RMS per sensor of a fit over segments.

@@ -5,7 +5,7 @@
 
 use super::data::Data;
 use super::model::{Terms, fit};
-use crate::fit::joint::{Fit, seg_rss};
+use crate::fit::joint::Fit;
 use nalgebra::DMatrix;
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 
@@ -71,16 +71,10 @@ pub(crate) fn score(chi2: f64, dof: usize, n: usize) -> f64 {
 
 /// Held-out misfit in units of each channel's noise under `base`.
 pub(crate) fn holdout_score(data: &Data, fit: &Fit, base: &Fit) -> f64 {
-    let mut s = 0.0;
-    for &i in &data.held {
-        for c in 0..6 {
-            let sig = base.noise[c].sigma;
-            if sig > 0.0 {
-                s += seg_rss(&data.accs[i], &data.layout, c, &fit.theta) / (sig * sig);
-            }
-        }
-    }
-    s
+    (0..6)
+        .filter(|&c| base.noise[c].sigma > 0.0)
+        .map(|c| super::model::misfit(data, fit, c, &data.held, base.noise[c].sigma))
+        .sum()
 }
 
 /// Whether every estimated parameter of effect `e` in `fit` is inside its plausible range.

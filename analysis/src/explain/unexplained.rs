@@ -10,7 +10,7 @@
 //! follows, each with the share of the leftover it explains.
 
 use super::data::Data;
-use super::model::{Terms, fit};
+use super::model::{Terms, fit, misfit};
 use super::output::{Signature, Unexplained};
 use super::select::p_value;
 use crate::fit::joint::{CHANNELS, Fit, seg_rss};
@@ -34,14 +34,6 @@ struct Test {
     chi2: f64,
     /// Fit with the probe.
     fit: usize,
-}
-
-/// Weighted residual sum of squares of channel `c` over `segs` under `fit`.
-fn wrss(data: &Data, fit: &Fit, c: usize, segs: &[usize], sigma: f64) -> f64 {
-    segs.iter()
-        .map(|&i| seg_rss(&data.accs[i], &data.layout, c, &fit.theta))
-        .sum::<f64>()
-        / (sigma * sigma)
 }
 
 /// Tests the final model `terms` for leftover structure; `alpha` is the family-wise
@@ -106,11 +98,11 @@ pub(crate) fn leftover(m: &Manifest, data: &Data, terms: &Terms, alpha: f64) -> 
         let mut forms: Vec<(f64, f64, Signature)> = Vec::new();
         for &c in &channels {
             let sigma = base.noise[c].sigma.max(1e-300);
-            let before = wrss(data, &base, c, &all, sigma);
+            let before = misfit(data, &base, c, &all, sigma);
             let drops: Vec<(&Test, f64)> = tests
                 .iter()
                 .filter(|t| t.c == c)
-                .map(|t| (t, before - wrss(data, &fits[t.fit], c, &all, sigma)))
+                .map(|t| (t, before - misfit(data, &fits[t.fit], c, &all, sigma)))
                 .collect();
             let top = drops.iter().map(|d| d.1).fold(0.0, f64::max);
             if top <= 0.0 {
