@@ -363,7 +363,7 @@ pub struct Acceptance {
     pub step: Option<String>,
     /// Measured value (absent when not evaluated).
     pub value: Option<f64>,
-    /// Comparison as written (`<=`, `<`, `>=`, `>`).
+    /// Comparison as written (`<=`, `<`, `>=`, `>`), or `within` for `within +-limit`.
     pub op: String,
     /// Limit.
     pub limit: f64,

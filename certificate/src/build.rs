@@ -274,13 +274,15 @@ fn conformity(r: &Results, budgets: &[Budget]) -> Option<Conformity> {
                 .find(|b| b.quantity == a.quantity)
                 .and_then(|b| {
                     let v = a.value?;
-                    (b.value != 0.0).then(|| b.expanded * v / b.value.abs())
+                    (b.value != 0.0).then(|| (b.expanded * v / b.value).abs())
                 });
             let expanded = from_budget.or(a.expanded_u);
             let is_guarded = a.rule != "simple";
             if let (Some(v), Some(u), true, Some(_)) = (a.value, expanded, is_guarded, from_budget)
             {
-                let upper = matches!(a.op.as_str(), "<=" | "<");
+                // `within +-L` bounds |v| from above, like `<= L` on a parameter.
+                let upper = matches!(a.op.as_str(), "<=" | "<" | "within");
+                let v = if a.op == "within" { v.abs() } else { v };
                 let margin = if upper { a.limit - v } else { v - a.limit };
                 verdict = if margin >= u {
                     "pass"
@@ -291,8 +293,9 @@ fn conformity(r: &Results, budgets: &[Budget]) -> Option<Conformity> {
                 }
                 .into();
             }
-            let within_band =
-                matches!((a.value, expanded), (Some(v), Some(u)) if (v - a.limit).abs() < u);
+            let magnitude = |v: f64| if a.op == "within" { v.abs() } else { v };
+            let within_band = matches!((a.value, expanded),
+                (Some(v), Some(u)) if (magnitude(v) - a.limit).abs() < u);
             let statement = match (a.value, verdict.as_str()) {
                 (None, _) => format!("{}: not evaluated", a.name),
                 (Some(_), "indeterminate") => format!(

@@ -41,6 +41,7 @@ fn accept(quantity: &str, limit: Quantity, rule: DecisionRule) -> Accept {
         limit,
         over_runs: None,
         rule,
+        within: false,
     }
 }
 

@@ -253,15 +253,49 @@ pub enum Cond {
     Abnormal(Ident),
 }
 
-/// `accept quantity <= limit [over N runs] [guarded]`.
+/// `accept quantity <= limit [over N runs] [guarded]`, `accept abs(quantity) <= limit`,
+/// `accept quantity within +-limit`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Accept {
-    /// The threshold.
-    pub limit: Limit,
+    /// What is checked.
+    pub checked: Checked,
+    /// The bound it must meet.
+    pub bound: AcceptBound,
     /// `over N runs`.
     pub runs: Option<Spanned<String>>,
     /// Guard-banded decision rule.
     pub guarded: bool,
+}
+
+/// The quantity an acceptance check is on: a dotted name, or a function of one
+/// (`abs(gyro.scale.x)`, `norm(accel.bias)`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Checked {
+    /// The function applied, if any (`abs`, `norm`).
+    pub func: Option<Ident>,
+    /// The dotted name it applies to.
+    pub name: Ident,
+    /// The whole expression.
+    pub span: Span,
+}
+
+impl Checked {
+    /// The expression as written, without spaces (`abs(gyro.scale.x)`).
+    pub fn text(&self) -> String {
+        match &self.func {
+            Some(f) => format!("{}({})", f.node, self.name.node),
+            None => self.name.node.clone(),
+        }
+    }
+}
+
+/// The bound of an acceptance check.
+#[derive(Debug, Clone, PartialEq)]
+pub enum AcceptBound {
+    /// `<= 80 mg`.
+    Cmp(Spanned<Cmp>, Value),
+    /// `within +-1 mrad` (or `±1 mrad`): both sides.
+    Within(Value),
 }
 
 /// `verify at <point> [from segments] { limits }`.

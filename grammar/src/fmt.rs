@@ -154,7 +154,15 @@ fn abort(a: &Abort) -> String {
 }
 
 fn accept(a: &Accept) -> String {
-    let mut out = format!("accept {}", limit(&a.limit));
+    let mut out = match &a.bound {
+        AcceptBound::Cmp(op, v) => format!(
+            "accept {} {} {}",
+            a.checked.text(),
+            op.node.as_str(),
+            value(v, 0)
+        ),
+        AcceptBound::Within(v) => format!("accept {} within +-{}", a.checked.text(), value(v, 0)),
+    };
     if let Some(n) = &a.runs {
         out.push_str(&format!(" over {} runs", n.node));
     }

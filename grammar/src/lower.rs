@@ -92,6 +92,9 @@ fn rule_name(r: Rule) -> Option<&'static str> {
         Rule::stmt => "a statement (move, spin, settle, acquire, for, fit, ...)",
         Rule::settle_item => "a settle condition",
         Rule::limit => "a limit (name <= value)",
+        Rule::checked | Rule::call => "a quantity (`accel.bias.x`, `abs(gyro.scale.x)`)",
+        Rule::within => "`within +-` and a value",
+        Rule::accept_cmp => "a comparison (<=, <, >=, >)",
         Rule::env_item => "an environment condition",
         Rule::fit_opt => "a preprocessing option (outliers, lowpass)",
         Rule::condition => "a condition",
@@ -407,7 +410,17 @@ fn stmt(p: P) -> Stmt {
 // children of the rule.
 fn accept_from(it: pest::iterators::Pairs<Rule>) -> Accept {
     let mut it = it;
-    let limit = limit(it.next().expect("accept limit"));
+    let checked = checked(it.next().expect("accept quantity"));
+    let b = it.next().expect("accept bound");
+    let rule = b.as_rule();
+    let mut bi = b.into_inner();
+    let bound = match rule {
+        Rule::within => AcceptBound::Within(value(bi.next().expect("within value"))),
+        _ => AcceptBound::Cmp(
+            cmp(bi.next().expect("accept op")),
+            value(bi.next().expect("accept value")),
+        ),
+    };
     let mut runs = None;
     let mut guarded = false;
     for c in it {
@@ -417,9 +430,32 @@ fn accept_from(it: pest::iterators::Pairs<Rule>) -> Accept {
         }
     }
     Accept {
-        limit,
+        checked,
+        bound,
         runs,
         guarded,
+    }
+}
+
+fn checked(p: P) -> Checked {
+    let span = span(&p);
+    let inner = first(p);
+    match inner.as_rule() {
+        Rule::call => {
+            let mut ci = inner.into_inner();
+            let func = text(ci.next().expect("call name"));
+            let name = text(ci.next().expect("call argument"));
+            Checked {
+                func: Some(func),
+                name,
+                span,
+            }
+        }
+        _ => Checked {
+            func: None,
+            name: text(inner),
+            span,
+        },
     }
 }
 

@@ -7,6 +7,7 @@
 //! expansion would exceed a limit); `repeat N` stays a node, so a large count costs
 //! nothing to check.
 
+pub mod derived;
 pub mod versions;
 
 use serde::{Deserialize, Serialize};
@@ -388,7 +389,9 @@ pub struct Accept {
     /// Step that declared it (`None` at procedure level).
     pub step: Option<String>,
     /// Quantity checked, dotted (`accel.residual.std`, `gyro.residual.std`,
-    /// `repeatability.cv`, `accel.error`, `gyro.error`, `gyro.bias.std`...).
+    /// `repeatability.cv`, `accel.error`, `gyro.error`, `gyro.bias.std`, `accel.bias.x`...),
+    /// or a derived quantity of the fitted parameters (`abs(gyro.scale.x)`,
+    /// `norm(accel.bias)`, `norm(accel.misalignment.x)`).
     pub quantity: String,
     /// Comparison.
     pub op: Cmp,
@@ -398,6 +401,10 @@ pub struct Accept {
     pub over_runs: Option<u32>,
     /// Decision rule.
     pub rule: DecisionRule,
+    /// `within +-limit`: the value must lie between `-limit` and `+limit` (`op` is `Le`,
+    /// on the value's magnitude).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub within: bool,
 }
 
 /// A verification point and its limits.

@@ -95,7 +95,7 @@ pub(crate) fn evaluate(
             out.push(deferred(a, n));
             continue;
         }
-        let measured = lookup(&a.quantity, res, q);
+        let measured = lookup(&a.quantity, a.within, res, q);
         out.push(match measured {
             Ok((v, u)) => judge(a, v, u, None),
             Err(why) => not_evaluated(a, &why),
@@ -164,6 +164,7 @@ pub(crate) fn evaluate(
                 limit: q.clone(),
                 over_runs: None,
                 rule: DecisionRule::Simple,
+                within: false,
             };
             out.push(match value {
                 Some(v) => judge(&a, v, 0.0, None),
@@ -218,25 +219,21 @@ fn env_value(name: &str, res: &Results) -> Option<f64> {
 /// Value and standard uncertainty of a checked quantity, internal units.
 fn lookup(
     name: &str,
+    within: bool,
     res: &Results,
     q: &BTreeMap<String, (f64, f64)>,
 ) -> Result<(f64, f64), String> {
     if let Some(v) = q.get(name) {
         return Ok(*v);
     }
-    if let Some(p) = res.parameters.get(name) {
-        // A calibrated parameter is in its results unit (ppm, mrad); the limit in the
-        // language's base unit of its dimension.
-        let to_base = match p {
-            crate::results::Parameter::Estimate { unit, .. } => {
-                ratecal_physics::units::parse_quantity(&format!("1 {unit}")).map_or(1.0, |(_, f)| f)
-            }
-            crate::results::Parameter::Unobservable { .. } => 1.0,
-        };
-        return match p.value_u() {
-            Some((v, u)) => Ok((v.abs() * to_base, u * to_base)),
-            None => Err(format!("{name} is not observable in this recording")),
-        };
+    let (func, arg) = crate::plan::derived::split(name);
+    if let Ok(d) = crate::plan::derived::derived(func, arg) {
+        return parameters(&d, res).map(|(v, u)| match (func, within) {
+            // A bare parameter is judged by its magnitude (docs/language.md); `within`
+            // keeps the sign for the report and judges the magnitude itself.
+            (None, false) => (v.abs(), u),
+            _ => (v, u),
+        });
     }
     match name {
         "repeatability.cv" => Err("repeatability needs several complete runs (`ratecal analyze RUN1 RUN2 RUN3`); one was given".into()),
@@ -254,7 +251,59 @@ fn lookup(
     }
 }
 
+/// Value and standard uncertainty (internal units) of a calibrated parameter or a function
+/// of several, propagated through the fit's correlations (`results.fits`).
+fn parameters(d: &crate::plan::derived::Derived, res: &Results) -> Result<(f64, f64), String> {
+    let mut v = Vec::new();
+    let mut u = Vec::new();
+    for name in &d.parameters {
+        let Some(p) = res.parameters.get(name) else {
+            return Err(format!("the analysis gave no `{name}`"));
+        };
+        // A calibrated parameter is in its results unit (ppm, mrad); the limit in the
+        // language's base unit of its dimension.
+        let to_base = p.unit().map_or(1.0, |unit| {
+            ratecal_physics::units::parse_quantity(&format!("1 {unit}")).map_or(1.0, |(_, f)| f)
+        });
+        let Some((pv, pu)) = p.value_u() else {
+            return Err(format!("{name} is not observable in this recording"));
+        };
+        v.push(pv * to_base);
+        u.push(pu * to_base);
+    }
+    let n = v.len();
+    let mut r = vec![0.0; n * n];
+    for (i, a) in d.parameters.iter().enumerate() {
+        for (j, b) in d.parameters.iter().enumerate() {
+            r[i * n + j] = if i == j { 1.0 } else { correlation(res, a, b) };
+        }
+    }
+    Ok(crate::plan::derived::evaluate(d.func, &v, &u, &r))
+}
+
+/// The correlation of two parameters in the joint fit that gave both (0 when none did).
+fn correlation(res: &Results, a: &str, b: &str) -> f64 {
+    res.fits
+        .values()
+        .find_map(|f| {
+            let i = f.parameters.iter().position(|p| p == a)?;
+            let j = f.parameters.iter().position(|p| p == b)?;
+            f.correlation.get(i)?.get(j).copied()
+        })
+        .unwrap_or(0.0)
+}
+
 fn lim_name(a: &Accept) -> String {
+    if a.within {
+        return format!(
+            "{} within +-{} {}",
+            a.quantity,
+            fmt_num(a.limit.written),
+            a.limit.unit
+        )
+        .trim_end()
+        .to_string();
+    }
     format!(
         "{} {} {} {}",
         a.quantity,
@@ -275,6 +324,11 @@ fn op_str(op: Cmp) -> &'static str {
     }
 }
 
+/// The comparison as results.json writes it: `within` for a two-sided band.
+fn op_name(a: &Accept) -> &'static str {
+    if a.within { "within" } else { op_str(a.op) }
+}
+
 fn fmt_num(v: f64) -> String {
     format!("{v}")
 }
@@ -293,7 +347,9 @@ pub(crate) fn judge(a: &Accept, v: f64, u: f64, name: Option<String>) -> Accepta
     let f = factor(&a.limit);
     let (value, limit, big_u) = (v / f, a.limit.written, 2.0 * u / f);
     let upper = matches!(a.op, Cmp::Le | Cmp::Lt);
-    let margin = if upper { limit - value } else { value - limit };
+    // `within +-L` bounds both sides: the margin is to the nearer one.
+    let judged = if a.within { value.abs() } else { value };
+    let margin = if upper { limit - judged } else { judged - limit };
     let meets = |m: f64| match a.op {
         Cmp::Le | Cmp::Ge => m >= 0.0,
         Cmp::Lt | Cmp::Gt => m > 0.0,
@@ -321,7 +377,7 @@ pub(crate) fn judge(a: &Accept, v: f64, u: f64, name: Option<String>) -> Accepta
         quantity: a.quantity.clone(),
         step: a.step.clone(),
         value: Some(value),
-        op: op_str(a.op).into(),
+        op: op_name(a).into(),
         limit,
         unit: a.limit.unit.clone(),
         margin: Some(margin),
@@ -346,7 +402,7 @@ pub(crate) fn not_evaluated(a: &Accept, why: &str) -> Acceptance {
         quantity: a.quantity.clone(),
         step: a.step.clone(),
         value: None,
-        op: op_str(a.op).into(),
+        op: op_name(a).into(),
         limit: a.limit.written,
         unit: a.limit.unit.clone(),
         margin: None,

@@ -247,7 +247,8 @@ impl Trend {
     }
 }
 
-/// The acceptance limit on `name` (`name op L`, `abs(name) op L` or `|name| op L`).
+/// The acceptance limit on `name` (`name op L`, `abs(name) op L`, `|name| op L` or
+/// `name within +-L`).
 fn find_limit(
     name: &str,
     unit: &str,
@@ -260,7 +261,11 @@ fn find_limit(
         if q != name && !magnitude {
             continue;
         }
-        let text = format!("{q} {op} {limit} {lunit}");
+        let text = if op == "within" {
+            format!("{q} within +-{limit} {lunit}")
+        } else {
+            format!("{q} {op} {limit} {lunit}")
+        };
         // A limit in another unit of the same dimension (`80 mg` on a bias in m/s^2).
         let factor = |u: &str| ratecal_physics::units::parse_quantity(&format!("1 {u}"));
         let limit = match (lunit == unit, factor(lunit), factor(unit)) {
@@ -274,9 +279,11 @@ fn find_limit(
             }
         };
         // The analysis judges a check on a calibrated parameter by its magnitude
-        // (docs/language.md): `accel.bias.x <= 80 mg` bounds |accel.bias.x|.
+        // (docs/language.md): `accel.bias.x <= 80 mg` bounds |accel.bias.x|; `within
+        // +-L` bounds both sides, so the interval ends when the predicted value plus or
+        // minus U reaches either.
         let bound = match op.as_str() {
-            "<=" | "<" => Bound::Magnitude,
+            "<=" | "<" | "within" => Bound::Magnitude,
             ">=" | ">" if !magnitude => Bound::Lower,
             _ => continue,
         };

@@ -185,7 +185,10 @@ pub fn blocks(c: &Certificate) -> Vec<Block> {
                         k.value
                             .map(|v| format!("{} {}", num(v), k.unit))
                             .unwrap_or_else(|| "-".into()),
-                        format!("{} {} {}", k.op, num(k.limit), k.unit),
+                        match k.op.as_str() {
+                            "within" => format!("within ±{} {}", num(k.limit), k.unit),
+                            op => format!("{op} {} {}", num(k.limit), k.unit),
+                        },
                         k.expanded
                             .map(|u| format!("{} {}", num(u), k.unit))
                             .unwrap_or_else(|| "-".into()),

@@ -4,6 +4,7 @@
 use super::Ck;
 use super::steps::FitCheck;
 use super::values::suggest;
+use crate::plan::derived::parameter_dim;
 use crate::plan::{
     AbortAction, AbortCondition, AbortRule, Accept, Axis, Cmp, DecisionRule, Dim, EnvCondition,
     FitModel, FitSpec, Outliers, Plan, Quantity, Requirement, Signal, Verification, VerifyPoint,
@@ -52,7 +53,7 @@ const SIGNALS: &[(&str, Signal, Dim)] = &[
 ];
 
 /// Quantities acceptance and verification limits may name.
-const ACCEPTS: &[(&str, Dim)] = &[
+pub(super) const ACCEPTS: &[(&str, Dim)] = &[
     ("accel.residual.std", Dim::Accel),
     ("accel.residual.mean", Dim::Accel),
     ("accel.error", Dim::Accel),
@@ -64,27 +65,9 @@ const ACCEPTS: &[(&str, Dim)] = &[
     ("repeatability.cv", Dim::Ratio),
 ];
 
-/// A calibrated parameter acceptance checks may name (`accel.bias.x`, `gyro.scale.y`,
-/// `accel.misalignment.xy`) and its dimension; its magnitude is compared with the limit.
-fn parameter_dim(name: &str) -> Option<Dim> {
-    let parts: Vec<&str> = name.split('.').collect();
-    let axis = |a: &str| ["x", "y", "z"].contains(&a);
-    let pair = |a: &str| {
-        let c: Vec<char> = a.chars().collect();
-        c.len() == 2 && c[0] != c[1] && c.iter().all(|c| "xyz".contains(*c))
-    };
-    match parts.as_slice() {
-        ["accel", "bias", a] if axis(a) => Some(Dim::Accel),
-        ["gyro", "bias", a] if axis(a) => Some(Dim::Rate),
-        ["accel" | "gyro", "scale", a] if axis(a) => Some(Dim::Ratio),
-        ["accel" | "gyro", "misalignment", a] if pair(a) => Some(Dim::Angle),
-        _ => None,
-    }
-}
-
 /// Quantities the language once named that no fit computes: a check on one could never be
 /// evaluated, so it is refused here rather than leaving every run incomplete.
-const NOT_COMPUTED: &[(&str, &str)] = &[("size_effect.uncertainty", "accel.error")];
+pub(super) const NOT_COMPUTED: &[(&str, &str)] = &[("size_effect.uncertainty", "accel.error")];
 
 /// Fit models: (sensor, model word) -> model.
 const MODELS: &[(&str, &str, FitModel)] = &[
@@ -98,7 +81,7 @@ const MODELS: &[(&str, &str, FitModel)] = &[
     ("size_effect", "", FitModel::SizeEffect),
 ];
 
-fn cmp(c: ast::Cmp) -> Cmp {
+pub(super) fn cmp(c: ast::Cmp) -> Cmp {
     match c {
         ast::Cmp::Le => Cmp::Le,
         ast::Cmp::Lt => Cmp::Lt,
@@ -345,14 +328,22 @@ impl Ck<'_> {
     }
 
     fn limit(&mut self, l: &ast::Limit) -> Option<(String, Cmp, Quantity)> {
+        let (name, dim) = self.named(&l.name)?;
+        let q = self.quantity(&l.value, dim, "this limit")?;
+        Some((name, cmp(l.op.node), q))
+    }
+
+    /// A quantity a limit may name (a computed quantity or a calibrated parameter) and its
+    /// dimension; a located error when it is none.
+    pub(super) fn named(&mut self, name: &ast::Ident) -> Option<(String, Dim)> {
         let names: Vec<&str> = ACCEPTS.iter().map(|x| x.0).collect();
-        if let Some((_, instead)) = NOT_COMPUTED.iter().find(|x| x.0 == l.name.node) {
+        if let Some((_, instead)) = NOT_COMPUTED.iter().find(|x| x.0 == name.node) {
             self.err(
                 Diagnostic::error(
                     "check::not_computed",
-                    format!("no fit computes `{}`", l.name.node),
+                    format!("no fit computes `{}`", name.node),
                 )
-                .label(l.name.span, "this check could never be evaluated")
+                .label(name.span, "this check could never be evaluated")
                 .help(format!(
                     "check a quantity the analysis computes, e.g. `{instead}` (docs/language.md lists them)"
                 )),
@@ -361,66 +352,20 @@ impl Ck<'_> {
         }
         let found = ACCEPTS
             .iter()
-            .find(|x| x.0 == l.name.node)
+            .find(|x| x.0 == name.node)
             .map(|&(n, d)| (n.to_string(), d))
-            .or_else(|| parameter_dim(&l.name.node).map(|d| (l.name.node.clone(), d)));
-        let Some((name, dim)) = found else {
+            .or_else(|| parameter_dim(&name.node).map(|d| (name.node.clone(), d)));
+        if found.is_none() {
             self.err(
                 Diagnostic::error(
                     "check::unknown_name",
-                    format!("unknown quantity `{}`", l.name.node),
+                    format!("unknown quantity `{}`", name.node),
                 )
-                .label(l.name.span, "not a quantity ratecal computes")
-                .help(suggest(&l.name.node, &names)),
+                .label(name.span, "not a quantity ratecal computes")
+                .help(suggest(&name.node, &names)),
             );
-            return None;
-        };
-        let q = self.quantity(&l.value, dim, "this limit")?;
-        Some((name, cmp(l.op.node), q))
-    }
-
-    pub(crate) fn accept(&mut self, a: &ast::Accept, step: Option<String>) -> Option<Accept> {
-        let (quantity, op, limit) = self.limit(&a.limit)?;
-        let over_runs = match &a.runs {
-            Some(n) => match n.node.parse::<u32>() {
-                Ok(k) if k >= 2 => Some(k),
-                _ => {
-                    self.err(
-                        Diagnostic::error(
-                            "check::bad_count",
-                            "repeatability needs at least 2 runs",
-                        )
-                        .label(n.span, "here"),
-                    );
-                    return None;
-                }
-            },
-            None => None,
-        };
-        if quantity == "repeatability.cv" && over_runs.is_none() {
-            self.err(
-                Diagnostic::error(
-                    "check::missing_runs",
-                    "repeatability needs a number of runs",
-                )
-                .label(a.limit.name.span, "over how many runs?")
-                .help("write e.g. `accept repeatability.cv <= 1 % over 3 runs`"),
-            );
-            return None;
         }
-        let rule = if a.guarded {
-            DecisionRule::GuardBanded
-        } else {
-            DecisionRule::Simple
-        };
-        Some(Accept {
-            step,
-            quantity,
-            op,
-            limit,
-            over_runs,
-            rule,
-        })
+        found
     }
 
     pub(crate) fn verify(&mut self, v: &ast::Verify) -> Option<Verification> {
@@ -469,6 +414,7 @@ impl Ck<'_> {
                 limit,
                 over_runs: None,
                 rule: DecisionRule::Simple,
+                within: false,
             });
         }
         self.walk.verify_from.extend(v.from.iter().cloned());

@@ -14,6 +14,7 @@
 //! `check::loop_arity`, `check::expansion_too_large`, `check::unobservable`,
 //! `check::station_limit`, `check::import`, `check::structure`, `check::missing_runs`.
 
+mod accept;
 mod header;
 mod motion;
 mod observe;
@@ -138,6 +139,8 @@ pub(crate) struct Ck<'a> {
     pub(crate) station: Option<StationLimits>,
     pub(crate) geometry: Geometry,
     pub(crate) walk: steps::Walk,
+    /// Checks on calibrated parameters, matched against the fits at the end.
+    pub(crate) fitted_checks: Vec<accept::FittedCheck>,
     import_stack: Vec<String>,
 }
 
@@ -161,6 +164,7 @@ impl<'a> Ck<'a> {
                 max_list_len,
                 ..Default::default()
             },
+            fitted_checks: Vec::new(),
             import_stack: Vec::new(),
         }
     }
@@ -243,6 +247,7 @@ impl<'a> Ck<'a> {
             }
         }
         self.finish_segments();
+        self.fitted_against_model(&plan);
         self.observability(&plan);
         plan.estimated_duration_s = plan.steps.iter().map(|s| s.estimated_duration_s).sum();
         Some(plan)

@@ -140,6 +140,7 @@ pub fn accept(step: Option<&str>, quantity: &str, op: Cmp, limit: Quantity) -> A
         limit,
         over_runs: None,
         rule: DecisionRule::Simple,
+        within: false,
     }
 }
 

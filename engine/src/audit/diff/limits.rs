@@ -270,6 +270,9 @@ fn accept_str(a: &Accept) -> String {
     } else {
         ""
     };
+    if a.within {
+        return format!("within +-{}{runs}{rule}", fmt_q(&a.limit));
+    }
     format!("{} {}{runs}{rule}", op_str(a.op), fmt_q(&a.limit))
 }
 
@@ -301,6 +304,9 @@ fn limit_list(prefix: &str, old: &[Accept], new: &[Accept], out: &mut Vec<Change
                     direction::threshold(o.op, o.limit.value, n.op, n.limit.value),
                     direction::decision_rule(o.rule, n.rule),
                     (o.over_runs != n.over_runs).then_some(ChangeKind::Changed),
+                    // `<= L` and `within +-L` bound different things (|x| for a parameter
+                    // either way, but a derived or signed quantity not).
+                    (o.within != n.within).then_some(ChangeKind::Changed),
                 ]);
                 push(
                     out,
@@ -391,6 +397,7 @@ mod tests {
             limit: q(w, u, v),
             over_runs: None,
             rule: DecisionRule::Simple,
+            within: false,
         };
         let mut out = vec![];
         limit_list(
