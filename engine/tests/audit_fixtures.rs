@@ -89,6 +89,9 @@ fn each_case_reports_the_edit_it_made() {
             "step gyro_scale / accept gyro.residual.std",
             Loosened,
         ),
+        ("accept_within_abs", "accept accel.bias.y", Loosened),
+        ("accept_within_abs", "accept abs(accel.scale.x)", Tightened),
+        ("accept_within_abs", "accept norm(accel.bias)", Changed),
         (
             "accept_tightened",
             "step accel_static / accept accel.residual.std",
