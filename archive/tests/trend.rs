@@ -178,3 +178,55 @@ async fn one_date_leaves_the_drift_undetermined() {
     assert_eq!(none.calibrations, 0);
     assert!(none.parameters.is_empty());
 }
+
+/// `within +-L` bounds both sides: a bias drifting downwards reaches -L, and the interval
+/// is the mirror image's (the same data negated, against `<= L`), to the day.
+#[tokio::test]
+async fn a_within_limit_is_reached_from_below() {
+    let tmp = tempfile::tempdir().unwrap();
+    let t0 = 19_000.0;
+    let noise = normals(8);
+    let series = |sign: f64, prefix: &str, q: &str, op: &str| -> Vec<Folder> {
+        (0..8)
+            .map(|i| {
+                let day = t0 + 91.0 * i as f64;
+                let bias = sign * (0.01 + TRUE_RATE * (day - t0) / 365.25 + U * noise[i]);
+                let mut f = calibration("55", i, day, bias, false);
+                f.facts.id = format!("{prefix}{}", f.facts.id);
+                f.facts.limits = vec![LimitRow {
+                    quantity: q.into(),
+                    op: op.into(),
+                    limit: 0.05,
+                    unit: "m/s^2".into(),
+                }];
+                f
+            })
+            .collect()
+    };
+    let down = Archive::open(&Location::Folder(tmp.path().join("down")))
+        .await
+        .unwrap();
+    down.insert_many(&series(-1.0, "d", "accel.bias.x", "within"))
+        .await
+        .unwrap();
+    let t = down.trend("55", &opts(&["accel.bias.x"])).await.unwrap();
+    let p = &t.parameters[0];
+    assert!(p.drift.expect("determined").rate_per_year < 0.0);
+    let days = p.recalibration_days.expect("an interval from the lower side");
+    assert_eq!(
+        p.limit.as_ref().unwrap().text,
+        "accel.bias.x within +-0.05 m/s^2"
+    );
+    let (_, line) = t.recommended_interval().expect("a recommendation");
+    assert!(line.contains("reaches accel.bias.x within +-0.05 m/s^2"), "{line}");
+
+    let up = Archive::open(&Location::Folder(tmp.path().join("up")))
+        .await
+        .unwrap();
+    up.insert_many(&series(1.0, "u", "accel.bias.x", "<="))
+        .await
+        .unwrap();
+    let m = up.trend("55", &opts(&["accel.bias.x"])).await.unwrap();
+    let mirror = m.parameters[0].recalibration_days.expect("mirror interval");
+    assert!((mirror - days).abs() < 1e-6 * days, "{mirror} vs {days}");
+}
