@@ -373,7 +373,7 @@ fn a_draft_says_so_on_every_page_and_refusals_have_their_exit_codes() {
     // limit's unit, and stated on the certificate under the named decision rule.
     let accepting = support::MINI.replacen(
         "  step statics",
-        "  accept accel.bias.x <= 80 mg\n  accept gyro.scale.x <= 300000 ppm guarded\n\n  step statics",
+        "  accept accel.bias.x <= 80 mg\n  accept gyro.scale.x <= 300000 ppm guarded\n  accept accel.bias.z within ±80 mg\n  accept abs(gyro.scale.x) <= 300000 ppm\n  accept norm(accel.bias) <= 500 mg\n\n  step statics",
         1,
     );
     std::fs::write(dir.join("acc.rcal"), &accepting).unwrap();
@@ -423,6 +423,24 @@ fn a_draft_says_so_on_every_page_and_refusals_have_their_exit_codes() {
         conf["checks"].to_string().contains("accel.bias.x <= 80 mg"),
         "{conf}"
     );
+    // The new forms: `within` keeps the signed value and judges both sides; `abs` and
+    // `norm` are stated like any check.
+    let checks = conf["checks"].as_array().unwrap();
+    let within = checks
+        .iter()
+        .find(|c| c["name"] == "accel.bias.z within +-80 mg")
+        .unwrap_or_else(|| panic!("{conf}"));
+    assert_eq!(within["op"], "within");
+    let bz = res["parameters"]["accel.bias.z"]["value"].as_f64().unwrap() / 9.80665 * 1000.0;
+    assert!((within["value"].as_f64().unwrap() - bz).abs() < 1e-9 * bz.abs().max(1.0));
+    let conforms = bz.abs() <= 80.0;
+    assert_eq!(within["verdict"], if conforms { "pass" } else { "fail" });
+    for name in ["abs(gyro.scale.x) <= 300000 ppm", "norm(accel.bias) <= 500 mg"] {
+        assert!(checks.iter().any(|c| c["name"] == name), "{name}: {conf}");
+    }
+    let md = String::from_utf8_lossy(&certificate(dir, "acc", &["--format", "md"]).stdout)
+        .into_owned();
+    assert!(md.contains("within ±80 mg"), "{md}");
 
     // A run not in the archive: exit 1, help names `ratecal archive add`.
     std::fs::write(dir.join("s.yaml"), &station).unwrap();

@@ -145,7 +145,13 @@ impl Ck<'_> {
 
     /// Every check on calibrated parameters names parameters some fit of the procedure
     /// gives: a misalignment needs a full model, a gyro scale a scale or full gyro fit.
+    /// A procedure without fit statements leaves the model to the analysis (chosen by the
+    /// segments' kinds), so there is nothing to check against here.
     pub(crate) fn fitted_against_model(&mut self, plan: &Plan) {
+        if plan.fits.is_empty() {
+            self.fitted_checks.clear();
+            return;
+        }
         let given: Vec<&str> = plan.fits.iter().flat_map(|f| families(&f.model)).copied().collect();
         for c in std::mem::take(&mut self.fitted_checks) {
             let missing: Vec<&String> = c
