@@ -15,7 +15,13 @@
 //!   `u = 1e6 u_g / g`, sensitivity `1e6 / g` ppm per m/s^2;
 //! - `accel.misalignment.*`, `gyro.misalignment.*` (mrad or their unit): the table's
 //!   position accuracy (accelerometers only) and axis orthogonality, rectangular, sensitivity
-//!   1 rad/rad.
+//!   1 rad/rad;
+//! - `gyro.scale.*` (ppm): the DAQ clock's accuracy `a` (`daq.clock_accuracy`, a ratio): a
+//!   rate is an angle over a time, so rectangular, `u = a / sqrt(3)`, sensitivity 1;
+//! - `accel.bias.*`, `gyro.bias.*`, `accel.scale.*`, `gyro.scale.*`: temperature, the IMU's
+//!   stated coefficient `c` (`imu.temperature_coefficients`, per degC) times the lab's
+//!   temperature stability `dT` (`site.temperature_stability`, a bound): rectangular,
+//!   `u = |c| dT / sqrt(3)`, sensitivity `c`. Not stated unless both are.
 
 use crate::budget::{Budget, Evaluation, Term};
 
@@ -32,6 +38,25 @@ pub struct Stated {
     pub gravity_u_mps2: Option<f64>,
     /// `site.gravity_mps2`.
     pub gravity_mps2: f64,
+    /// `daq.clock_accuracy` as a ratio (20 ppm = 2e-5).
+    pub clock_accuracy: Option<f64>,
+    /// `site.temperature_stability`, degC (a bound of the deviation from the mean).
+    pub temperature_stability_c: Option<f64>,
+    /// `imu.temperature_coefficients`, per degC in the results' units.
+    pub temperature_coefficients: TemperatureCoefficients,
+}
+
+/// The IMU's temperature coefficients, per degC (`None`: not stated).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct TemperatureCoefficients {
+    /// m/s^2 per degC.
+    pub accel_bias: Option<f64>,
+    /// deg/s per degC.
+    pub gyro_bias: Option<f64>,
+    /// ppm per degC.
+    pub accel_scale: Option<f64>,
+    /// ppm per degC.
+    pub gyro_scale: Option<f64>,
 }
 
 const SQRT3: f64 = 1.732_050_807_568_877_2;
@@ -51,6 +76,13 @@ fn per_rad(unit: &str) -> Option<f64> {
 
 fn arcsec(rad: f64) -> String {
     format!("{} arcsec", short(rad / ARCSEC))
+}
+
+/// A coefficient with four significant digits (they may be small: 1e-4 m/s^2 per degC).
+fn short_sig(x: f64) -> String {
+    format!("{x:.4e}")
+        .parse::<f64>()
+        .map_or_else(|_| x.to_string(), |v| v.to_string())
 }
 
 fn short(x: f64) -> String {
@@ -76,15 +108,20 @@ pub fn budget(name: &str, value: f64, u_a: f64, unit: &str, nu_a: f64, s: &State
         }
     };
     let parts: Vec<&str> = name.split('.').collect();
-    match (parts.first().copied(), parts.get(1).copied()) {
+    let family = (parts.first().copied(), parts.get(1).copied());
+    match family {
         (Some("gyro"), Some("scale")) => {
-            let a = s.rate_accuracy;
-            terms.push(rect(
-                "table rate accuracy",
-                a.map(|a| format!("{} ppm", short(a * 1e6))),
-                "1 ppm/ppm".into(),
-                a.map(|a| a * 1e6 / SQRT3),
-            ));
+            for (source, a) in [
+                ("table rate accuracy", s.rate_accuracy),
+                ("DAQ clock accuracy", s.clock_accuracy),
+            ] {
+                terms.push(rect(
+                    source,
+                    a.map(|a| format!("{} ppm", short(a * 1e6))),
+                    "1 ppm/ppm".into(),
+                    a.map(|a| a * 1e6 / SQRT3),
+                ));
+            }
         }
         (Some("accel"), Some("bias")) => {
             for (source, a) in [
@@ -124,6 +161,27 @@ pub fn budget(name: &str, value: f64, u_a: f64, unit: &str, nu_a: f64, s: &State
         }
         _ => {}
     }
+    let tc = &s.temperature_coefficients;
+    let coefficient = match family {
+        (Some("accel"), Some("bias")) => Some((tc.accel_bias, "m/s^2")),
+        (Some("gyro"), Some("bias")) => Some((tc.gyro_bias, "deg/s")),
+        (Some("accel"), Some("scale")) => Some((tc.accel_scale, "ppm")),
+        (Some("gyro"), Some("scale")) => Some((tc.gyro_scale, "ppm")),
+        _ => None,
+    };
+    if let Some((c, per)) = coefficient {
+        let sens = match c {
+            Some(c) => format!("{} {per} per degC", short_sig(c)),
+            None => format!("not stated ({per} per degC)"),
+        };
+        let dt = s.temperature_stability_c;
+        terms.push(rect(
+            "temperature sensitivity",
+            dt.map(|dt| format!("{} degC", short(dt))),
+            sens,
+            c.zip(dt).map(|(c, dt)| c.abs() * dt / SQRT3),
+        ));
+    }
     Budget::combine(name, unit, value, terms)
 }
 
@@ -139,13 +197,36 @@ mod tests {
             ..Stated::default()
         };
         let b = budget("gyro.scale.x", 12.0, 3.0, "ppm", 28.0, &s);
-        assert_eq!(b.terms.len(), 2);
+        // fit, rate accuracy, clock accuracy, temperature
+        assert_eq!(b.terms.len(), 4);
         assert!((b.terms[1].u.unwrap() - 10.0 / SQRT3).abs() < 1e-12);
+        assert!(b.terms[2..].iter().all(|t| t.u.is_none()) && !b.complete);
         let b = budget("accel.bias.y", 0.01, 1e-5, "m/s^2", 12.0, &s);
-        assert_eq!(b.terms.len(), 3);
+        assert_eq!(b.terms.len(), 4);
         assert!(b.terms[1..].iter().all(|t| t.u.is_none()) && !b.complete);
         let b = budget("gyro.bias.x", 0.01, 1e-3, "deg/s", 28.0, &s);
-        assert_eq!(b.terms.len(), 1);
+        assert_eq!(b.terms.len(), 2);
+        assert_eq!(b.terms[1].source, "temperature sensitivity");
+        assert!(!b.complete);
+        // A coefficient without the lab's stability (or the reverse) is still not stated.
+        let half = Stated {
+            temperature_coefficients: TemperatureCoefficients {
+                gyro_bias: Some(1e-3),
+                ..Default::default()
+            },
+            ..s.clone()
+        };
+        let b = budget("gyro.bias.x", 0.01, 1e-3, "deg/s", 28.0, &half);
+        assert!(b.terms[1].u.is_none());
+        let both = Stated {
+            temperature_stability_c: Some(2.0),
+            ..half
+        };
+        let b = budget("gyro.bias.x", 0.01, 1e-3, "deg/s", 28.0, &both);
+        assert!((b.terms[1].u.unwrap() - 2e-3 / SQRT3).abs() < 1e-15);
         assert!(b.complete);
+        // Misalignments have no temperature term.
+        let b = budget("gyro.misalignment.xy", 0.1, 0.01, "mrad", 28.0, &both);
+        assert!(b.terms.iter().all(|t| t.source != "temperature sensitivity"));
     }
 }

@@ -10,7 +10,7 @@
 
 use miette::{Diagnostic, NamedSource, SourceSpan};
 use ratecal_archive::{Archive, Location, days_from_iso};
-use ratecal_certificate::terms::Stated;
+use ratecal_certificate::terms::{Stated, TemperatureCoefficients};
 use ratecal_certificate::{ApprovalBlock, Certificate, Input, Lab, StationId, render};
 use ratecal_drivers::Station;
 use ratecal_engine::audit::seal::{SEAL_FILE, Seal};
@@ -375,6 +375,21 @@ async fn issue(args: &Args) -> miette::Result<Certificate> {
             axis_orthogonality_rad: t.axis_orthogonality.map(|a| a.get() * deg),
             gravity_u_mps2: station.site.gravity_u_mps2,
             gravity_mps2: manifest.station.site.gravity_mps2,
+            clock_accuracy: station
+                .daq
+                .and_then(|d| d.clock_accuracy)
+                .map(|r| r.get()),
+            temperature_stability_c: station.site.temperature_stability.map(|t| t.get()),
+            temperature_coefficients: station
+                .imu
+                .temperature_coefficients
+                .map(|c| TemperatureCoefficients {
+                    accel_bias: c.accel_bias,
+                    gyro_bias: c.gyro_bias,
+                    accel_scale: c.accel_scale,
+                    gyro_scale: c.gyro_scale,
+                })
+                .unwrap_or_default(),
         },
         reference: match cal {
             Some(c) => [Some(c.certificate), Some(c.issued_by), Some(c.due)],

@@ -34,6 +34,9 @@ pub struct Station {
     /// Conditions measured once, recorded in the manifest.
     #[serde(default)]
     pub environment: Option<EnvironmentSpec>,
+    /// The data acquisition's timing (the certificate's budget).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub daq: Option<DaqSpec>,
     /// Faults to rehearse aborts with (simulated station only).
     #[serde(default)]
     pub faults: Vec<FaultSpec>,
@@ -55,6 +58,10 @@ pub struct SiteSpec {
     /// Standard uncertainty of `gravity_mps2`, m/s^2 (the certificate's budget).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gravity_u_mps2: Option<f64>,
+    /// The lab's temperature stability: bound of the deviation from the mean during a
+    /// calibration (the certificate's budget, rectangular).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub temperature_stability: Option<TempDelta>,
 }
 
 /// Settling behaviour of the table servo: a second-order loop.
@@ -159,6 +166,35 @@ pub struct TableSpec {
     pub calibration: Option<TableCalibration>,
 }
 
+/// The data acquisition (`daq`): what the certificate's budget needs of its timing.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DaqSpec {
+    /// Accuracy of the clock that times the samples, a ratio (bound of a rectangular
+    /// distribution): a rate is an angle over a time, so it enters every gyro scale factor.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clock_accuracy: Option<Ratio>,
+}
+
+/// An IMU's temperature coefficients (`imu.temperature_coefficients`), bare numbers per
+/// degC in the results' units; each absent one is "not stated" on a certificate.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TemperatureCoefficients {
+    /// Accelerometer bias, m/s^2 per degC.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub accel_bias: Option<f64>,
+    /// Gyro bias, deg/s per degC.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gyro_bias: Option<f64>,
+    /// Accelerometer scale factor, ppm per degC.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub accel_scale: Option<f64>,
+    /// Gyro scale factor, ppm per degC.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gyro_scale: Option<f64>,
+}
+
 /// The table's calibration certificate (`table.calibration`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -246,6 +282,9 @@ pub struct ImuSpec {
     /// Catalogue effects under their canonical ids.
     #[serde(default)]
     pub effects: EffectsSpec,
+    /// Temperature coefficients from the IMU's data sheet (the certificate's budget).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub temperature_coefficients: Option<TemperatureCoefficients>,
     /// User effects (`*.effect` files, docs/user-effects.md) by reference: id -> its file
     /// and parameter values. The CLI reads the files and hands the terms in
     /// ([`Station::user_terms`]); the simulator applies them as registry effects.

@@ -15,7 +15,8 @@ pub use effects::{EffectsSpec, TableEffectsSpec};
 pub use faults::{AxisName, DropoutMode, FaultSpec, LinkName, TableFaultMode};
 pub use file::{
     AmbientSpec, EnvironmentSpec, ImuSpec, ImuTemperatureSpec, MountSpec, SettlingSpec, SiteSpec,
-    Station, TableCalibration, TableSpec, TemperatureSpec, UserEffectRef, UserTerms,
+    Station, TableCalibration, TableSpec, TemperatureCoefficients, TemperatureSpec, UserEffectRef,
+    UserTerms, DaqSpec,
 };
 pub use quantity::{
     Accel, AccelDensity, Angle, Freq, Pressure, Rate, RateDensity, RateWalk, Ratio, Rotation, Temp,
