@@ -3,6 +3,8 @@
 //! refusals and their exit codes, and the numbering under concurrent processes.
 
 mod support;
+#[path = "support/pg.rs"]
+mod pg;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -503,11 +505,36 @@ fn a_draft_says_so_on_every_page_and_refusals_have_their_exit_codes() {
 #[test]
 fn numbers_are_unique_and_stable_across_concurrent_processes_and_an_amendment_replaces() {
     let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path();
+    concurrent_numbering(tmp.path(), "archive");
+}
+
+/// The same on a PostgreSQL archive (a real server the test starts): the sequence and the
+/// issued numbers live in the database, twelve processes race for them.
+#[test]
+fn numbers_are_unique_and_stable_on_a_postgresql_archive() {
+    let Some(pg) = pg::Cluster::start() else {
+        println!("skipped: postgresql not installed");
+        return;
+    };
+    let tmp = tempfile::tempdir().unwrap();
+    let url = pg.url();
+    let o = ratecal(&["archive", "check", "--archive", &url], tmp.path());
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    concurrent_numbering(tmp.path(), &url);
+}
+
+/// Four approved runs in `archive`, three concurrent `certificate` processes per run: one
+/// number per run, four distinct, `PREFIX-YYYY-000001` to `000004`; an amendment takes the
+/// fifth and names the one it replaces.
+fn concurrent_numbering(dir: &Path, archive: &str) {
     let station = certified_station("2099-12-31");
     // One run, approved into four different folders (four archive ids).
     mini(dir, "r0", &station, true);
     let runs = ["r0", "r1", "r2", "r3"];
+    if archive != "archive" {
+        let o = ratecal(&["archive", "add", "r0", "--archive", archive], dir);
+        assert_eq!(code(&o), 0, "{}", text(&o));
+    }
     for (i, r) in runs.iter().enumerate().skip(1) {
         copy_dir(&dir.join("r0"), &dir.join(r));
         let o = ratecal(
@@ -524,7 +551,7 @@ fn numbers_are_unique_and_stable_across_concurrent_processes_and_an_amendment_re
             dir,
         );
         assert_eq!(code(&o), 0, "{}", text(&o));
-        let o = ratecal(&["archive", "add", r, "--archive", "archive"], dir);
+        let o = ratecal(&["archive", "add", r, "--archive", archive], dir);
         assert_eq!(code(&o), 0, "{}", text(&o));
     }
     // Three processes per run, all at once.
@@ -538,11 +565,12 @@ fn numbers_are_unique_and_stable_across_concurrent_processes_and_an_amendment_re
                     "--lab",
                     &lab,
                     "--archive",
-                    "archive",
+                    archive,
                     "--format",
                     "json",
                 ])
                 .current_dir(dir)
+                .env_remove("RATECAL_ARCHIVE")
                 .stdout(std::process::Stdio::piped())
                 .stderr(std::process::Stdio::piped())
                 .spawn()
@@ -573,12 +601,17 @@ fn numbers_are_unique_and_stable_across_concurrent_processes_and_an_amendment_re
 
     // An amendment: the next number, naming the one it replaces.
     let old = by_run[0].iter().next().unwrap().clone();
-    let o = certificate(dir, "r0", &["--format", "json", "--amend"]);
+    let cert = |extra: &[&str]| {
+        let mut args = vec!["certificate", "r0", "--lab", &lab, "--archive", archive];
+        args.extend_from_slice(extra);
+        ratecal(&args, dir)
+    };
+    let o = cert(&["--format", "json", "--amend"]);
     assert_eq!(code(&o), 0, "{}", text(&o));
     let j = json_of(&o);
     assert_eq!(j["number"], format!("EICL-{year}-000005").as_str());
     assert_eq!(j["replaces"], old.as_str());
-    let o = certificate(dir, "r0", &["--format", "md"]);
+    let o = cert(&["--format", "md"]);
     let md = String::from_utf8_lossy(&o.stdout).to_string();
     assert!(
         md.contains(&format!("EICL-{year}-000005"))
