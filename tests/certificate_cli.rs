@@ -2,9 +2,9 @@
 //! folders: the PDF's text read back with a PDF library (lopdf, not our writer), the
 //! refusals and their exit codes, and the numbering under concurrent processes.
 
-mod support;
 #[path = "support/pg.rs"]
 mod pg;
+mod support;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -437,11 +437,14 @@ fn a_draft_says_so_on_every_page_and_refusals_have_their_exit_codes() {
     assert!((within["value"].as_f64().unwrap() - bz).abs() < 1e-9 * bz.abs().max(1.0));
     let conforms = bz.abs() <= 80.0;
     assert_eq!(within["verdict"], if conforms { "pass" } else { "fail" });
-    for name in ["abs(gyro.scale.x) <= 300000 ppm", "norm(accel.bias) <= 500 mg"] {
+    for name in [
+        "abs(gyro.scale.x) <= 300000 ppm",
+        "norm(accel.bias) <= 500 mg",
+    ] {
         assert!(checks.iter().any(|c| c["name"] == name), "{name}: {conf}");
     }
-    let md = String::from_utf8_lossy(&certificate(dir, "acc", &["--format", "md"]).stdout)
-        .into_owned();
+    let md =
+        String::from_utf8_lossy(&certificate(dir, "acc", &["--format", "md"]).stdout).into_owned();
     assert!(md.contains("within ±80 mg"), "{md}");
 
     // A run not in the archive: exit 1, help names `ratecal archive add`.
@@ -631,4 +634,54 @@ fn copy_dir(from: &Path, to: &Path) {
             std::fs::copy(e.path(), target).unwrap();
         }
     }
+}
+
+/// `logo` in LAB.yaml: a path relative to the lab file; a missing or non-image file is
+/// refused at the key (exit 1), a PNG is accepted.
+#[test]
+fn a_logo_that_cannot_be_read_is_refused_at_its_key() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    mini(dir, "run", &certified_station("2099-12-31"), false);
+    let base = std::fs::read_to_string(lab()).unwrap();
+    std::fs::create_dir_all(dir.join("lab")).unwrap();
+    let with_logo = |logo: &str| {
+        let path = dir.join("lab/lab.yaml");
+        std::fs::write(&path, format!("{base}logo: {logo}\n")).unwrap();
+        let lab = path.display().to_string();
+        ratecal(
+            &[
+                "certificate",
+                "run",
+                "--lab",
+                &lab,
+                "--archive",
+                "archive",
+                "--format",
+                "json",
+            ],
+            dir,
+        )
+    };
+    let o = with_logo("missing.png");
+    assert_eq!(code(&o), 1, "{}", text(&o));
+    let t = flat(&text(&o));
+    let line = base.lines().count() + 1;
+    assert!(t.contains("the logo `missing.png` cannot be used"), "{t}");
+    assert!(t.contains(&format!("lab.yaml:{line}:")), "{t}");
+    assert!(t.contains("PNG or JPEG"), "{t}");
+    std::fs::write(dir.join("lab/notes.png"), "not an image").unwrap();
+    let o = with_logo("notes.png");
+    assert_eq!(code(&o), 1, "{}", text(&o));
+    assert!(
+        text(&o).contains("neither a PNG nor a JPEG"),
+        "{}",
+        text(&o)
+    );
+    // A PNG beside the lab file (the path is relative to it, not to the working folder).
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    png.extend_from_slice(&[0; 16]);
+    std::fs::write(dir.join("lab/logo.png"), png).unwrap();
+    let o = with_logo("logo.png");
+    assert_eq!(code(&o), 0, "{}", text(&o));
 }

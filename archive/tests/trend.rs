@@ -212,13 +212,18 @@ async fn a_within_limit_is_reached_from_below() {
     let t = down.trend("55", &opts(&["accel.bias.x"])).await.unwrap();
     let p = &t.parameters[0];
     assert!(p.drift.expect("determined").rate_per_year < 0.0);
-    let days = p.recalibration_days.expect("an interval from the lower side");
+    let days = p
+        .recalibration_days
+        .expect("an interval from the lower side");
     assert_eq!(
         p.limit.as_ref().unwrap().text,
         "accel.bias.x within +-0.05 m/s^2"
     );
     let (_, line) = t.recommended_interval().expect("a recommendation");
-    assert!(line.contains("reaches accel.bias.x within +-0.05 m/s^2"), "{line}");
+    assert!(
+        line.contains("reaches accel.bias.x within +-0.05 m/s^2"),
+        "{line}"
+    );
 
     let up = Archive::open(&Location::Folder(tmp.path().join("up")))
         .await

@@ -227,6 +227,10 @@ mod tests {
         assert!(b.complete);
         // Misalignments have no temperature term.
         let b = budget("gyro.misalignment.xy", 0.1, 0.01, "mrad", 28.0, &both);
-        assert!(b.terms.iter().all(|t| t.source != "temperature sensitivity"));
+        assert!(
+            b.terms
+                .iter()
+                .all(|t| t.source != "temperature sensitivity")
+        );
     }
 }

@@ -66,7 +66,11 @@ fn gyro_scale_with_timing_and_temperature_by_hand() {
     let temp = by_source("temperature sensitivity");
     assert_eq!(temp.distribution, "rectangular");
     assert!((temp.u.unwrap() - 2.0).abs() < 1e-12);
-    assert!(temp.sensitivity.starts_with("-3 ppm per degC"), "{}", temp.sensitivity);
+    assert!(
+        temp.sensitivity.starts_with("-3 ppm per degC"),
+        "{}",
+        temp.sensitivity
+    );
     assert!((b.u_c - 13f64.sqrt()).abs() < 1e-12);
     assert!((b.nu_eff.unwrap() - 52.8125).abs() < 1e-9);
     assert!((b.k - 2.0058).abs() < 5e-4, "k {}", b.k);

@@ -169,7 +169,13 @@ mod tests {
             ["accel.misalignment.yx", "accel.misalignment.yz"]
         );
         assert_eq!(d.dim, Dim::Angle);
-        assert_eq!(derived(Some("norm"), "gyro.misalignment").unwrap().parameters.len(), 6);
+        assert_eq!(
+            derived(Some("norm"), "gyro.misalignment")
+                .unwrap()
+                .parameters
+                .len(),
+            6
+        );
         assert_eq!(
             derived(Some("abs"), "accel.bias"),
             Err(DerivedError::AbsOfVector)
@@ -190,7 +196,12 @@ mod tests {
     fn propagation_against_hand_values() {
         // |(3, 4)| = 5; c = (0.6, 0.8); u = (0.1, 0.2), r = 0.5:
         // var = 0.36*0.01 + 0.64*0.04 + 2*0.6*0.8*0.1*0.2*0.5 = 0.0036+0.0256+0.0096.
-        let (v, u) = evaluate(Some("norm"), &[3.0, 4.0], &[0.1, 0.2], &[1.0, 0.5, 0.5, 1.0]);
+        let (v, u) = evaluate(
+            Some("norm"),
+            &[3.0, 4.0],
+            &[0.1, 0.2],
+            &[1.0, 0.5, 0.5, 1.0],
+        );
         assert!((v - 5.0).abs() < 1e-12);
         assert!((u - 0.0388f64.sqrt()).abs() < 1e-12);
         let (v, u) = evaluate(Some("abs"), &[-2.0], &[0.3], &[1.0]);

@@ -225,7 +225,37 @@ fn read_lab(path: &Path) -> miette::Result<Lab> {
         }
         .into());
     }
+    if let Some(logo) = &lab.logo {
+        let file = path.parent().unwrap_or(Path::new(".")).join(logo);
+        if let Err(why) = logo_kind(&file) {
+            return Err(Located {
+                message: format!("the logo `{logo}` cannot be used"),
+                span: key_span(&text, None, "logo"),
+                src: NamedSource::new(name, text),
+                label: why,
+                help: "a PNG or JPEG file, its path relative to the laboratory file; or \
+                       remove the key"
+                    .into(),
+            }
+            .into());
+        }
+    }
     Ok(lab)
+}
+
+/// Whether `file` is a readable PNG or JPEG (by its signature), and which.
+fn logo_kind(file: &Path) -> Result<&'static str, String> {
+    let bytes = std::fs::read(file).map_err(|e| format!("{}: {e}", file.display()))?;
+    if bytes.starts_with(b"\x89PNG\r\n\x1a\n") {
+        Ok("png")
+    } else if bytes.starts_with(&[0xff, 0xd8, 0xff]) {
+        Ok("jpeg")
+    } else {
+        Err(format!(
+            "{} is neither a PNG nor a JPEG file",
+            file.display()
+        ))
+    }
 }
 
 async fn issue(args: &Args) -> miette::Result<Certificate> {
@@ -375,10 +405,7 @@ async fn issue(args: &Args) -> miette::Result<Certificate> {
             axis_orthogonality_rad: t.axis_orthogonality.map(|a| a.get() * deg),
             gravity_u_mps2: station.site.gravity_u_mps2,
             gravity_mps2: manifest.station.site.gravity_mps2,
-            clock_accuracy: station
-                .daq
-                .and_then(|d| d.clock_accuracy)
-                .map(|r| r.get()),
+            clock_accuracy: station.daq.and_then(|d| d.clock_accuracy).map(|r| r.get()),
             temperature_stability_c: station.site.temperature_stability.map(|t| t.get()),
             temperature_coefficients: station
                 .imu

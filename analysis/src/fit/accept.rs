@@ -349,7 +349,11 @@ pub(crate) fn judge(a: &Accept, v: f64, u: f64, name: Option<String>) -> Accepta
     let upper = matches!(a.op, Cmp::Le | Cmp::Lt);
     // `within +-L` bounds both sides: the margin is to the nearer one.
     let judged = if a.within { value.abs() } else { value };
-    let margin = if upper { limit - judged } else { judged - limit };
+    let margin = if upper {
+        limit - judged
+    } else {
+        judged - limit
+    };
     let meets = |m: f64| match a.op {
         Cmp::Le | Cmp::Ge => m >= 0.0,
         Cmp::Lt | Cmp::Gt => m > 0.0,

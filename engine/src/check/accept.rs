@@ -133,11 +133,7 @@ impl Ck<'_> {
                         c.name.span,
                     ),
                 };
-                self.err(
-                    Diagnostic::error(code, msg)
-                        .label(span, label)
-                        .help(help),
-                );
+                self.err(Diagnostic::error(code, msg).label(span, label).help(help));
                 None
             }
         }
@@ -152,7 +148,12 @@ impl Ck<'_> {
             self.fitted_checks.clear();
             return;
         }
-        let given: Vec<&str> = plan.fits.iter().flat_map(|f| families(&f.model)).copied().collect();
+        let given: Vec<&str> = plan
+            .fits
+            .iter()
+            .flat_map(|f| families(&f.model))
+            .copied()
+            .collect();
         for c in std::mem::take(&mut self.fitted_checks) {
             let missing: Vec<&String> = c
                 .parameters
