@@ -290,7 +290,9 @@ fn full_flow(procedure: &str, text_of: Option<&str>, label: &str, step: &str, gy
         assert!(g.get(key).is_some(), "budget entry lacks {key}: {g}");
     }
     // gyro.scale.x by hand: Type A from results.json with the fit's dof counted per
-    // segment, Type B the table's 10 ppm rate accuracy, rectangular.
+    // segment; Type B, all rectangular, from the example station: the table's 10 ppm rate
+    // accuracy, the DAQ clock's 2 ppm, and the temperature term, the data sheet's
+    // 10 ppm/degC gyro scale coefficient over the lab's +-1 degC.
     let u_a = results["parameters"][gyro]["u"].as_f64().unwrap();
     let segments = results["segments"].as_array().unwrap();
     let used = segments
@@ -317,7 +319,9 @@ fn full_flow(procedure: &str, text_of: Option<&str>, label: &str, step: &str, gy
         .count();
     let nu_a = (3 * used).saturating_sub(params).max(1) as f64;
     let u_b = 10.0 / 3f64.sqrt();
-    let u_c = (u_a * u_a + u_b * u_b).sqrt();
+    let u_clock = 2.0 / 3f64.sqrt();
+    let u_temp = 10.0 * 1.0 / 3f64.sqrt();
+    let u_c = (u_a * u_a + u_b * u_b + u_clock * u_clock + u_temp * u_temp).sqrt();
     let nu_eff = u_c.powi(4) / (u_a.powi(4) / nu_a);
     assert!((g["u_c"].as_f64().unwrap() - u_c).abs() < 1e-9 * u_c.max(1.0));
     assert!((g["nu_eff"].as_f64().unwrap() - nu_eff).abs() < 1e-6 * nu_eff);
@@ -333,6 +337,16 @@ fn full_flow(procedure: &str, text_of: Option<&str>, label: &str, step: &str, gy
     assert_eq!(terms[1]["source"], "table rate accuracy");
     assert_eq!(terms[1]["distribution"], "rectangular");
     assert_eq!(terms[1]["status"], "stated");
+    let by_source = |s: &str| {
+        terms
+            .iter()
+            .find(|t| t["source"] == s)
+            .unwrap_or_else(|| panic!("{s}: {g}"))
+    };
+    assert!((by_source("DAQ clock accuracy")["u"].as_f64().unwrap() - u_clock).abs() < 1e-12);
+    let temp = by_source("temperature sensitivity");
+    assert!((temp["u"].as_f64().unwrap() - u_temp).abs() < 1e-12);
+    assert_eq!(temp["distribution"], "rectangular");
 }
 
 #[test]
