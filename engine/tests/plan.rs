@@ -306,7 +306,7 @@ fn acceptance_checks_on_calibrated_parameters_carry_their_dimension() {
     let text = STANDARD.replacen(
         "  step accel_static",
         "  accept accel.bias.x <= 80 mg\n  accept gyro.scale.x <= 300 ppm\n  \
-         accept accel.misalignment.xy <= 1 mrad\n  accept gyro.bias.z <= 0.1 deg/s\n\n  step accel_static",
+         accept gyro.bias.z <= 0.1 deg/s\n\n  step accel_static",
         1,
     );
     let plan = check_text("p", &text, &NoImports, &CheckOptions::default())
@@ -315,7 +315,23 @@ fn acceptance_checks_on_calibrated_parameters_carry_their_dimension() {
     let accept = |q: &str| plan.accepts.iter().find(|a| a.quantity == q).expect(q);
     assert!((accept("accel.bias.x").limit.value - 0.080 * 9.80665).abs() < 1e-12);
     assert!((accept("gyro.scale.x").limit.value - 300e-6).abs() < 1e-18);
-    assert!((accept("accel.misalignment.xy").limit.value - 1e-3f64.to_degrees()).abs() < 1e-12);
+    // A misalignment limit on a full model, in mrad, resolved to degrees.
+    let full = STANDARD
+        .replacen("fit accel bias_scale", "fit accel full", 1)
+        .replacen(
+            "  step accel_static",
+            "  accept accel.misalignment.xy <= 1 mrad\n\n  step accel_static",
+            1,
+        );
+    let plan_full = check_text("p", &full, &NoImports, &CheckOptions::default())
+        .expect("a misalignment check on a full model")
+        .plan;
+    let mis = plan_full
+        .accepts
+        .iter()
+        .find(|a| a.quantity == "accel.misalignment.xy")
+        .unwrap();
+    assert!((mis.limit.value - 1e-3f64.to_degrees()).abs() < 1e-12);
     assert_eq!(accept("gyro.bias.z").limit.value, 0.1);
     // A parameter in the wrong unit, and one that does not exist: located errors.
     for (bad, code) in [
@@ -324,6 +340,11 @@ fn acceptance_checks_on_calibrated_parameters_carry_their_dimension() {
         (
             "accept accel.misalignment.xx <= 1 mrad",
             "check::unknown_name",
+        ),
+        // The standard fits `accel bias_scale`: no misalignment in its model.
+        (
+            "accept accel.misalignment.xy <= 1 mrad",
+            "check::not_fitted",
         ),
     ] {
         let text = STANDARD.replacen(
