@@ -31,7 +31,7 @@ impl Ck<'_> {
         if within && limit.value < 0.0 {
             self.err(
                 Diagnostic::error("check::bad_limit", "a `within` limit cannot be negative")
-                    .label(a.checked.span, "the bound of this check")
+                    .label(value.span, "a negative half-width")
                     .help("write the half-width of the band, e.g. `within +-1 mrad`"),
             );
             return None;
