@@ -295,29 +295,23 @@ fn full_flow(procedure: &str, text_of: Option<&str>, label: &str, step: &str, gy
     // 10 ppm/degC gyro scale coefficient over the lab's +-1 degC.
     let u_a = results["parameters"][gyro]["u"].as_f64().unwrap();
     let segments = results["segments"].as_array().unwrap();
-    let used = segments
-        .iter()
-        .filter(|s| {
-            s["used_for"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .any(|u| u == "gyro")
-        })
-        .count();
-    let params = results["parameters"]
-        .as_object()
-        .unwrap()
-        .iter()
-        .filter(|(n, p)| {
-            n.starts_with("gyro.")
-                && p.get("u").is_some()
-                && !n.contains(".noise.")
-                && !n.contains(".arw.")
-                && !n.contains(".bias_instability.")
-        })
-        .count();
-    let nu_a = (3 * used).saturating_sub(params).max(1) as f64;
+    // The gyro scale fit's own segments (`used_for` `gyro_scale`, else the full model's):
+    // one-second blocks less one per segment, as docs/certificate.md states the rule.
+    let count = |fit: &str| {
+        segments
+            .iter()
+            .filter(|s| s["used_for"].as_array().unwrap().iter().any(|u| u == fit))
+            .fold((0usize, 0.0f64), |(n, secs), s| {
+                let d = s["t_end"].as_f64().unwrap() - s["t_start"].as_f64().unwrap();
+                (n + 1, secs + d.round())
+            })
+    };
+    let (used, seconds) = ["gyro_scale", "gyro_full", "gyro"]
+        .into_iter()
+        .map(count)
+        .find(|c| c.0 > 0)
+        .expect("some segment is used for the gyro scale");
+    let nu_a = seconds - used as f64;
     let u_b = 10.0 / 3f64.sqrt();
     let u_clock = 2.0 / 3f64.sqrt();
     let u_temp = 10.0 * 1.0 / 3f64.sqrt();

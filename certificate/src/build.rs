@@ -52,23 +52,39 @@ fn reported(name: &str) -> bool {
         .any(|n| name.contains(n))
 }
 
-/// The fit's Type A degrees of freedom for `sensor`: one observation per channel per
-/// segment used, less the sensor's fitted parameters (at least 1).
-pub fn type_a_dof(results: &Results, sensor: &str) -> f64 {
-    let segments = results
-        .segments
-        .iter()
-        .filter(|s| s.used_for.iter().any(|u| u == sensor))
-        .count();
-    let prefix = format!("{sensor}.");
-    let params = results
-        .parameters
-        .iter()
-        .filter(|(n, p)| {
-            n.starts_with(&prefix) && reported(n) && matches!(p, Parameter::Estimate { .. })
-        })
-        .count();
-    (3 * segments).saturating_sub(params).max(1) as f64
+/// The fit's Type A degrees of freedom for `quantity` (`sensor.family.axis`): the fit's
+/// uncertainty rests on the noise it estimates from the one-second block means of the
+/// segments that determine the quantity (physics.md's noise model), so each of those
+/// segments gives its one-second blocks less one (its mean). The segments are those used
+/// for the quantity's own fit (`used_for` `gyro_bias` for `gyro.bias.x`), else for the
+/// sensor's full model (`gyro_full`, `gyro`), else any of the sensor's fits. At least 1.
+pub fn type_a_dof(results: &Results, quantity: &str) -> f64 {
+    let mut parts = quantity.split('.');
+    let sensor = parts.next().unwrap_or("");
+    let family = parts.next().unwrap_or("");
+    let own = format!("{sensor}_{family}");
+    let prefix = format!("{sensor}_");
+    let count = |wanted: &dyn Fn(&str) -> bool| -> (usize, f64) {
+        results
+            .segments
+            .iter()
+            .filter(|s| s.used_for.iter().any(|u| wanted(u)))
+            .fold((0, 0.0), |(n, blocks), s| {
+                (n + 1, blocks + (s.t_end - s.t_start).round().max(1.0))
+            })
+    };
+    let full = format!("{sensor}_full");
+    let mut used = count(&|u| u == own);
+    if used.0 == 0 {
+        used = count(&|u| u == full);
+    }
+    if used.0 == 0 {
+        used = count(&|u| u == sensor);
+    }
+    if used.0 == 0 {
+        used = count(&|u| u.starts_with(&prefix));
+    }
+    (used.1 - used.0 as f64).max(1.0)
 }
 
 /// `value +- U unit (k = 2.05, 95 %)`, `U` to two significant digits and the value to
@@ -94,8 +110,7 @@ pub fn build(input: Input<'_>) -> Certificate {
         if let Parameter::Estimate { value, u, unit } = p
             && reported(name)
         {
-            let sensor = name.split('.').next().unwrap_or("");
-            let nu = type_a_dof(r, sensor);
+            let nu = type_a_dof(r, name);
             budgets.push(budget(name, *value, *u, unit, nu, &input.stated));
         }
     }

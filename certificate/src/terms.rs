@@ -2,10 +2,9 @@
 //! (`docs/certificate.md`, The budget). A Type B figure the station file does not give is a
 //! term "not stated", never 0.
 //!
-//! - every quantity: the fit's Type A standard uncertainty, with the fit's degrees of
-//!   freedom counted per segment (each segment's mean is one observation per channel:
-//!   `3 x segments - fitted parameters of the sensor`, at least 1), since the samples within
-//!   a segment are correlated (low-pass filtered, bias noise);
+//! - every quantity: the fit's Type A standard uncertainty, with the degrees of freedom of
+//!   the noise estimate it rests on: the one-second block means of the segments that
+//!   determine the quantity, less one per segment ([`crate::type_a_dof`]);
 //! - `gyro.scale.*` (ppm): the table's rate accuracy `a` (a ratio of the rate),
 //!   rectangular, `u = a / sqrt(3)`, sensitivity 1;
 //! - `accel.bias.*` (m/s^2): the table's position accuracy and axis orthogonality (angles
