@@ -645,7 +645,7 @@ fn copy_dir(from: &Path, to: &Path) {
 }
 
 /// `logo` in LAB.yaml: a path relative to the lab file; a missing or non-image file is
-/// refused at the key (exit 1), a PNG is accepted.
+/// refused at the key (exit 1); a PNG is drawn on every page of the PDF.
 #[test]
 fn a_logo_that_cannot_be_read_is_refused_at_its_key() {
     let tmp = tempfile::tempdir().unwrap();
@@ -686,10 +686,83 @@ fn a_logo_that_cannot_be_read_is_refused_at_its_key() {
         "{}",
         text(&o)
     );
-    // A PNG beside the lab file (the path is relative to it, not to the working folder).
+    // A truncated PNG: the signature alone is not enough, the logo must decode.
     let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
     png.extend_from_slice(&[0; 16]);
-    std::fs::write(dir.join("lab/logo.png"), png).unwrap();
+    std::fs::write(dir.join("lab/broken.png"), png).unwrap();
+    let o = with_logo("broken.png");
+    assert_eq!(code(&o), 1, "{}", text(&o));
+    assert!(text(&o).contains("not a readable PNG"), "{}", text(&o));
+    // A real PNG (written by the png crate, with an alpha channel) beside the lab file: the
+    // path is relative to it, not to the working folder. The PDF draws it on every page.
+    let (w, h) = (40u32, 16u32);
+    let mut bytes = Vec::new();
+    {
+        let mut e = png::Encoder::new(&mut bytes, w, h);
+        e.set_color(png::ColorType::Rgba);
+        e.set_depth(png::BitDepth::Eight);
+        let mut writer = e.write_header().unwrap();
+        let pixels: Vec<u8> = (0..w * h)
+            .flat_map(|i| [(i % 251) as u8, 40, 200, if i % 2 == 0 { 255 } else { 0 }])
+            .collect();
+        writer.write_image_data(&pixels).unwrap();
+    }
+    std::fs::write(dir.join("lab/logo.png"), &bytes).unwrap();
     let o = with_logo("logo.png");
     assert_eq!(code(&o), 0, "{}", text(&o));
+    let lab = dir.join("lab/lab.yaml").display().to_string();
+    let o = ratecal(
+        &[
+            "certificate",
+            "run",
+            "--lab",
+            &lab,
+            "--archive",
+            "archive",
+            "--out",
+            "c.pdf",
+        ],
+        dir,
+    );
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let doc = lopdf::Document::load(dir.join("c.pdf")).unwrap();
+    let pages = doc.get_pages();
+    assert!(!pages.is_empty());
+    for (n, page) in pages {
+        let (res, ids) = doc.get_page_resources(page).unwrap();
+        let xobjects: Vec<&lopdf::Dictionary> = res
+            .into_iter()
+            .chain(ids.iter().filter_map(|id| doc.get_dictionary(*id).ok()))
+            .filter_map(|r| r.get(b"XObject").ok())
+            .filter_map(|x| match x {
+                lopdf::Object::Reference(id) => doc.get_dictionary(*id).ok(),
+                o => o.as_dict().ok(),
+            })
+            .collect();
+        let image = xobjects
+            .iter()
+            .flat_map(|x| x.iter())
+            .filter_map(|(_, v)| {
+                doc.get_object(v.as_reference().ok()?)
+                    .ok()?
+                    .as_stream()
+                    .ok()
+            })
+            .find(|s| s.dict.get(b"Subtype").and_then(|o| o.as_name()).ok() == Some(b"Image"))
+            .unwrap_or_else(|| panic!("page {n} draws no image"));
+        assert_eq!(
+            image.dict.get(b"Width").unwrap().as_i64().unwrap(),
+            i64::from(w)
+        );
+        assert_eq!(
+            image.dict.get(b"Height").unwrap().as_i64().unwrap(),
+            i64::from(h)
+        );
+        assert!(
+            image.dict.get(b"SMask").is_ok(),
+            "the alpha channel is a soft mask"
+        );
+        let content = String::from_utf8_lossy(&doc.get_page_content(page).unwrap()).into_owned();
+        assert!(content.contains("Do"), "page {n} never draws the logo");
+    }
 }

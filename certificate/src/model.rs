@@ -20,7 +20,8 @@ pub struct Lab {
     pub accreditation: String,
     /// The certificate numbers' prefix (`PREFIX-YYYY-NNNNNN`): letters, digits and dashes.
     pub certificate_prefix: String,
-    /// A logo image file, relative to `LAB.yaml` (shown by the HTML certificate).
+    /// A logo image file (PNG or JPEG), relative to `LAB.yaml`: drawn in the top margin of
+    /// every page of the PDF.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub logo: Option<String>,
 }

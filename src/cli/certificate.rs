@@ -150,19 +150,21 @@ pub fn main(args: Args) -> ExitCode {
         }
         Format::Md => render::markdown(&certificate).into_bytes(),
         Format::Html => render::html(&certificate).into_bytes(),
-        Format::Pdf => match render::pdf(&certificate) {
-            Ok(b) => b,
-            Err(e) => {
-                errln!(
-                    "{:?}",
-                    miette::miette!(
-                        code = "certificate::pdf",
-                        "cannot typeset the certificate: {e}"
-                    )
-                );
-                return ExitCode::from(1);
+        Format::Pdf => {
+            match render::pdf(&certificate, lab_logo(&args.lab, &certificate.lab).as_ref()) {
+                Ok(b) => b,
+                Err(e) => {
+                    errln!(
+                        "{:?}",
+                        miette::miette!(
+                            code = "certificate::pdf",
+                            "cannot typeset the certificate: {e}"
+                        )
+                    );
+                    return ExitCode::from(1);
+                }
             }
-        },
+        }
     };
     match &args.out {
         Some(path) => {
@@ -243,19 +245,16 @@ fn read_lab(path: &Path) -> miette::Result<Lab> {
     Ok(lab)
 }
 
-/// Whether `file` is a readable PNG or JPEG (by its signature), and which.
-fn logo_kind(file: &Path) -> Result<&'static str, String> {
+/// The logo `file`, read and decoded (a PNG or JPEG), or why it cannot be drawn.
+fn logo_kind(file: &Path) -> Result<render::Logo, String> {
     let bytes = std::fs::read(file).map_err(|e| format!("{}: {e}", file.display()))?;
-    if bytes.starts_with(b"\x89PNG\r\n\x1a\n") {
-        Ok("png")
-    } else if bytes.starts_with(&[0xff, 0xd8, 0xff]) {
-        Ok("jpeg")
-    } else {
-        Err(format!(
-            "{} is neither a PNG nor a JPEG file",
-            file.display()
-        ))
-    }
+    render::Logo::from_bytes(&bytes).map_err(|why| format!("{}: {why}", file.display()))
+}
+
+/// The laboratory's logo, when `LAB.yaml` names one (checked by [`read_lab`]).
+fn lab_logo(lab_file: &Path, lab: &Lab) -> Option<render::Logo> {
+    let logo = lab.logo.as_ref()?;
+    logo_kind(&lab_file.parent().unwrap_or(Path::new(".")).join(logo)).ok()
 }
 
 async fn issue(args: &Args) -> miette::Result<Certificate> {

@@ -2,9 +2,11 @@
 
 pub mod doc;
 mod html;
+mod logo;
 mod md;
 mod pdf;
 
 pub use html::html;
+pub use logo::Logo;
 pub use md::markdown;
 pub use pdf::{PdfError, pdf};

@@ -4,6 +4,7 @@
 //! M", and says DRAFT for an unapproved run; M comes from a first typesetting pass.
 
 use super::doc::{Block, blocks, header};
+use super::logo::Logo;
 use crate::model::Certificate;
 use genpdf::elements::{Break, FrameCellDecorator, LinearLayout, Paragraph, TableLayout};
 use genpdf::fonts::{FontData, FontFamily};
@@ -40,17 +41,19 @@ fn fonts() -> Result<FontFamily<FontData>, PdfError> {
     })
 }
 
-/// Typesets the certificate: two passes, the first to count the pages.
-pub fn pdf(c: &Certificate) -> Result<Vec<u8>, PdfError> {
+/// Typesets the certificate: two passes, the first to count the pages; the laboratory's
+/// logo, when given, in the top margin of every page.
+pub fn pdf(c: &Certificate, logo: Option<&Logo>) -> Result<Vec<u8>, PdfError> {
     let pages = Rc::new(Cell::new(0usize));
-    typeset(c, None, pages.clone())?;
-    typeset(c, Some(pages.get()), pages)
+    typeset(c, None, pages.clone(), None)?;
+    typeset(c, Some(pages.get()), pages, logo)
 }
 
 fn typeset(
     c: &Certificate,
     total: Option<usize>,
     seen: Rc<Cell<usize>>,
+    logo: Option<&Logo>,
 ) -> Result<Vec<u8>, PdfError> {
     let mut doc = Document::new(fonts()?);
     doc.set_title(format!("Certificate No. {}", c.number));
@@ -139,7 +142,11 @@ fn typeset(
     }
     let mut out = Vec::new();
     doc.render(&mut out).map_err(err)?;
-    if total.is_some() { tidy(&out) } else { Ok(out) }
+    if total.is_some() {
+        tidy(&out, logo)
+    } else {
+        Ok(out)
+    }
 }
 
 /// How many characters of DejaVu Sans at `pt` fit in `mm` (digits, hex and lower case are
@@ -171,8 +178,8 @@ fn breakable(text: &str, max: usize) -> String {
 /// Rewrites what printpdf 0.3 writes loosely, with lopdf: each font's ToUnicode map as a
 /// plain CMap (printpdf puts PostScript comments inside it and writes code points past
 /// U+FFFF as five hex digits, which stricter readers refuse), and every stream compressed
-/// (the embedded fonts shrink to about a third).
-fn tidy(pdf: &[u8]) -> Result<Vec<u8>, PdfError> {
+/// (the embedded fonts shrink to about a third); the logo stamped on every page.
+fn tidy(pdf: &[u8], logo: Option<&Logo>) -> Result<Vec<u8>, PdfError> {
     let mut doc = lopdf::Document::load_mem(pdf).map_err(err)?;
     let maps: Vec<lopdf::ObjectId> = doc
         .objects
@@ -187,6 +194,9 @@ fn tidy(pdf: &[u8]) -> Result<Vec<u8>, PdfError> {
             .map_err(err)?;
         let text = String::from_utf8_lossy(&stream.content).into_owned();
         stream.set_plain_content(clean_cmap(&text).into_bytes());
+    }
+    if let Some(logo) = logo {
+        super::logo::stamp(&mut doc, logo).map_err(err)?;
     }
     doc.compress();
     let mut out = Vec::new();
