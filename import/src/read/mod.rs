@@ -7,10 +7,10 @@ mod cells;
 mod mat;
 
 pub use cells::{sniff, split_cells};
-pub use mat::check_mat;
+pub use mat::{Matrix, read_mat};
 
 use crate::error::{ErrorKind, ImportError, Say};
-use crate::map::{Col, ColRef, Delimiter, ImportMap};
+use crate::map::{Col, ColRef, Delimiter, Format, ImportMap};
 use sha2::{Digest, Sha256};
 use std::fs::File;
 use std::io::{BufRead, BufReader, Read};
@@ -123,12 +123,25 @@ pub struct Rows {
     /// (source, column within it) of each slot.
     local: Vec<(usize, usize)>,
     sample: u64,
+    /// A MATLAB source instead of the text ones.
+    mat: Option<MatRows>,
+}
+
+/// A MATLAB matrix read whole, served a row at a time.
+struct MatRows {
+    name: String,
+    variable: String,
+    m: Matrix,
+    sha256: String,
 }
 
 impl Rows {
     /// Opens the sources, skips their leading lines, reads their headers, and resolves the
     /// map's `cols` (slot order) to columns.
     pub fn open(paths: &[&Path], map: &ImportMap, cols: &[&Col]) -> Res<Rows> {
+        if let Format::Mat { variable, .. } = &map.source.format {
+            return Self::open_mat(paths, map, variable, cols);
+        }
         let mut sources = Vec::with_capacity(paths.len());
         let mut names: Vec<String> = Vec::new();
         let mut offset = 0;
@@ -232,11 +245,105 @@ impl Rows {
             slots,
             local,
             sample: 0,
+            mat: None,
         })
+    }
+
+    /// One MATLAB file's matrix; the map's columns are 0-based indices into it.
+    fn open_mat(paths: &[&Path], map: &ImportMap, variable: &str, cols: &[&Col]) -> Res<Rows> {
+        let [path] = paths else {
+            return Err(ImportError::in_file(
+                ErrorKind::Format,
+                &paths
+                    .first()
+                    .map_or(String::new(), |p| p.display().to_string()),
+                &format!("{} MATLAB files given; one is read", paths.len()),
+                "import one .mat file (put the channels side by side in one matrix)",
+            ));
+        };
+        let name = path.display().to_string();
+        let bytes = std::fs::read(path).map_err(|e| io_error(&name, &e))?;
+        let m = read_mat(&bytes, &name, variable)?;
+        let mut slots = Vec::with_capacity(cols.len());
+        for c in cols {
+            let ColRef::Index(i) = c.col else {
+                // The map loader refuses names for a MATLAB source.
+                return Err(map_error(
+                    map,
+                    c,
+                    "a MATLAB matrix's columns are 0-based indices",
+                    "",
+                ));
+            };
+            if i >= m.cols {
+                let help = if m.rows <= i {
+                    format!(
+                        "one row per sample is read; if `{variable}` holds the samples as \
+                         columns, save its transpose: `{variable} = {variable}.'`"
+                    )
+                } else {
+                    format!("`{variable}` has columns 0 to {}", m.cols.saturating_sub(1))
+                };
+                return Err(map_error(
+                    map,
+                    c,
+                    &format!(
+                        "column {i}, but `{variable}` in {name} is {} x {} ({})",
+                        m.rows, m.cols, m.class
+                    ),
+                    &help,
+                ));
+            }
+            slots.push(i);
+        }
+        Ok(Rows {
+            sources: Vec::new(),
+            local: slots.iter().map(|&g| (0, g)).collect(),
+            slots,
+            sample: 0,
+            mat: Some(MatRows {
+                name,
+                variable: variable.to_string(),
+                m,
+                sha256: ratecal_recording::sha256_hex(&bytes),
+            }),
+        })
+    }
+
+    /// The next row of a MATLAB matrix.
+    fn next_mat(&mut self, out: &mut [f64]) -> Res<Option<RowAt>> {
+        let Some(mr) = &self.mat else {
+            return Ok(None);
+        };
+        let r = self.sample as usize;
+        if r >= mr.m.rows {
+            return Ok(None);
+        }
+        for (slot, &c) in self.slots.iter().enumerate() {
+            let v = mr.m.data[c * mr.m.rows + r];
+            if !v.is_finite() {
+                return Err(mat_cell_error(
+                    mr,
+                    r,
+                    c,
+                    "not a finite number (NaN or infinite)",
+                    "the importer does not fill gaps: remove or repair the row in the source",
+                ));
+            }
+            out[slot] = v;
+        }
+        self.sample += 1;
+        Ok(Some(RowAt {
+            sample: r as u64,
+            line: r as u64 + 1,
+        }))
     }
 
     /// Reads the next row's slots into `out`; `None` at the end of the sources.
     pub fn next(&mut self, out: &mut [f64]) -> Res<Option<RowAt>> {
+        if self.mat.is_some() {
+            return self.next_mat(out);
+        }
         let mut ended = None;
         for (k, s) in self.sources.iter_mut().enumerate() {
             let more = s.next_row()?;
@@ -291,6 +398,9 @@ impl Rows {
 
     /// Each source's SHA-256 (lowercase hex) once they were read to the end.
     pub fn finish(&mut self) -> Vec<String> {
+        if let Some(m) = &self.mat {
+            return vec![m.sha256.clone()];
+        }
         self.sources
             .iter_mut()
             .map(|s| {
@@ -303,7 +413,10 @@ impl Rows {
 
     /// The first source's name.
     pub fn name(&self) -> &str {
-        &self.sources[0].name
+        match &self.mat {
+            Some(m) => &m.name,
+            None => &self.sources[0].name,
+        }
     }
 
     /// An error at slot `slot` of the row just read.
@@ -315,10 +428,42 @@ impl Rows {
         help: &str,
     ) -> Box<ImportError> {
         let (k, c) = self.local[slot];
+        if let Some(m) = &self.mat {
+            return mat_cell_error(m, self.sample.saturating_sub(1) as usize, c, what, help);
+        }
         let s = &self.sources[k];
         let r = s.cells.get(c).cloned().unwrap_or(0..0);
         s.error(r, kind, what, help)
     }
+}
+
+/// An error at row `r`, column `c` (0-based) of a MATLAB matrix.
+fn mat_cell_error(m: &MatRows, r: usize, c: usize, what: &str, help: &str) -> Box<ImportError> {
+    ImportError::in_file(
+        ErrorKind::Cell,
+        &m.name,
+        &format!(
+            "row {} (sample {r}), column {c} of `{}`: {what}",
+            r + 1,
+            m.variable
+        ),
+        help,
+    )
+}
+
+/// An error at a column the map names.
+fn map_error(map: &ImportMap, c: &Col, what: &str, help: &str) -> Box<ImportError> {
+    ImportError::in_text(
+        ErrorKind::Map,
+        &map.file,
+        &map.text,
+        c.at.clone(),
+        Say {
+            what,
+            label: "this column",
+            help,
+        },
+    )
 }
 
 fn parse_cell(s: &LineSource, r: Range<usize>) -> Res<f64> {

@@ -9,8 +9,8 @@ pub use provenance::{Conversion, FileHash, Oblique, Provenance};
 
 use crate::check;
 use crate::error::{ErrorKind, ImportError};
-use crate::map::{Format, ImportMap, Segments, TimeSpec, Up};
-use crate::read::{self, Rows};
+use crate::map::{ImportMap, Segments, TimeSpec, Up};
+use crate::read::Rows;
 use crate::segment::table::{Pose, synthesize};
 use crate::segment::{Found, Stretch, Tracker, face_up, turn};
 use ratecal_recording::{
@@ -62,11 +62,6 @@ fn out_error(out: &Path, what: &str) -> Box<ImportError> {
 
 /// Imports `sources` with `map` into the new recording folder `out`.
 pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> {
-    if let Format::Mat { variable } = &map.source.format {
-        for s in sources {
-            read::check_mat(s, variable)?;
-        }
-    }
     if out.exists() {
         let empty = out.is_dir() && std::fs::read_dir(out).is_ok_and(|mut d| d.next().is_none());
         if !empty {
