@@ -118,9 +118,16 @@ fn print_summary(map: &ImportMap, s: &Summary) {
             s.oblique.len()
         );
     }
-    outln!(
-        "table: synthesized from the segments' attitudes ({} samples at 50 Hz; manifest \
-         provenance.table: synthesized)",
-        s.table_samples
-    );
+    match &map.table {
+        Some(f) => outln!(
+            "table: {} feedback samples from {} (manifest provenance.table: feedback)",
+            s.table_samples,
+            f.file
+        ),
+        None => outln!(
+            "table: synthesized from the segments' attitudes ({} samples at 50 Hz; manifest \
+             provenance.table: synthesized)",
+            s.table_samples
+        ),
+    }
 }

@@ -10,7 +10,7 @@ pub use cells::{sniff, split_cells};
 pub use mat::{Matrix, read_mat};
 
 use crate::error::{ErrorKind, ImportError, Say};
-use crate::map::{Col, ColRef, Delimiter, Format, ImportMap};
+use crate::map::{Col, ColRef, Delimiter, Format, ImportMap, SourceSpec};
 use sha2::{Digest, Sha256};
 use std::fs::File;
 use std::io::{BufRead, BufReader, Read};
@@ -136,10 +136,10 @@ struct MatRows {
 }
 
 impl Rows {
-    /// Opens the sources, skips their leading lines, reads their headers, and resolves the
-    /// map's `cols` (slot order) to columns.
-    pub fn open(paths: &[&Path], map: &ImportMap, cols: &[&Col]) -> Res<Rows> {
-        if let Format::Mat { variable, .. } = &map.source.format {
+    /// Opens the sources (read as `src` says), skips their leading lines, reads their
+    /// headers, and resolves the map's `cols` (slot order) to columns.
+    pub fn open(paths: &[&Path], src: &SourceSpec, map: &ImportMap, cols: &[&Col]) -> Res<Rows> {
+        if let Format::Mat { variable, .. } = &src.format {
             return Self::open_mat(paths, map, variable, cols);
         }
         let mut sources = Vec::with_capacity(paths.len());
@@ -159,22 +159,22 @@ impl Rows {
                 ),
                 buf: Vec::with_capacity(256),
                 line: 0,
-                delim: map.source.delimiter,
+                delim: src.delimiter,
                 cells: Vec::with_capacity(16),
                 width: None,
                 offset,
             };
-            for _ in 0..map.source.skip_lines {
+            for _ in 0..src.skip_lines {
                 if !s.next_line()? {
                     return Err(ImportError::in_file(
                         ErrorKind::Cell,
                         &s.name,
-                        &format!("ends before the {} lines to skip", map.source.skip_lines),
+                        &format!("ends before the {} lines to skip", src.skip_lines),
                         "check source.skip_lines in the map",
                     ));
                 }
             }
-            if map.source.header {
+            if src.header {
                 if !s.next_row()? {
                     return Err(ImportError::in_file(
                         ErrorKind::Cell,
@@ -185,7 +185,7 @@ impl Rows {
                     ));
                 }
                 for c in &s.cells {
-                    let (t, _, _) = map.source.encoding.decode(&s.buf[c.clone()]);
+                    let (t, _, _) = src.encoding.decode(&s.buf[c.clone()]);
                     names.push(unquote(t.trim()).to_string());
                 }
                 s.width = Some(s.cells.len());
@@ -196,16 +196,16 @@ impl Rows {
             }
             sources.push(s);
         }
-        if !map.source.header && sources.len() > 1 {
+        if !src.header && sources.len() > 1 {
             // Columns by index over several header-less files: peek each file's width.
             let mut off = 0;
             for s in &mut sources {
                 s.offset = off;
-                let w = peek_width(&s.name, map)?;
+                let w = peek_width(&s.name, src)?;
                 s.width = Some(w);
                 off += w;
             }
-        } else if !map.source.header {
+        } else if !src.header {
             sources[0].offset = 0;
         }
         let mut slots = Vec::with_capacity(cols.len());
@@ -494,7 +494,7 @@ fn unquote(t: &str) -> &str {
 }
 
 /// Cells in the first data row of a header-less source.
-fn peek_width(name: &str, map: &ImportMap) -> Res<usize> {
+fn peek_width(name: &str, src: &SourceSpec) -> Res<usize> {
     let f = File::open(name).map_err(|e| io_error(name, &e))?;
     let mut s = LineSource {
         name: name.to_string(),
@@ -504,12 +504,12 @@ fn peek_width(name: &str, map: &ImportMap) -> Res<usize> {
         }),
         buf: Vec::new(),
         line: 0,
-        delim: map.source.delimiter,
+        delim: src.delimiter,
         cells: Vec::new(),
         width: None,
         offset: 0,
     };
-    for _ in 0..map.source.skip_lines {
+    for _ in 0..src.skip_lines {
         s.next_line()?;
     }
     s.next_row()?;

@@ -3,6 +3,7 @@
 //! synthesize the table stream, write the manifest with its provenance and move the folder
 //! into place. A refusal removes the staging folder: nothing is written.
 
+mod feedback;
 mod provenance;
 
 pub use provenance::{Conversion, FileHash, Oblique, Provenance};
@@ -19,7 +20,7 @@ use ratecal_recording::{
 };
 use std::path::{Path, PathBuf};
 
-type Res<T> = Result<T, Box<ImportError>>;
+pub(crate) type Res<T> = Result<T, Box<ImportError>>;
 
 /// What an import wrote (printed for the engineer to confirm).
 #[derive(Debug, Clone)]
@@ -36,7 +37,7 @@ pub struct Summary {
     pub oblique: Vec<Found>,
     /// Whether the segments were detected.
     pub detected: bool,
-    /// Table samples synthesized.
+    /// Table samples synthesized or read from the feedback file.
     pub table_samples: u64,
 }
 
@@ -51,7 +52,7 @@ impl Drop for Staging {
     }
 }
 
-fn out_error(out: &Path, what: &str) -> Box<ImportError> {
+pub(crate) fn out_error(out: &Path, what: &str) -> Box<ImportError> {
     ImportError::in_file(
         ErrorKind::Io,
         &out.display().to_string(),
@@ -88,7 +89,7 @@ pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> 
         cols.push(col);
     }
     let paths: Vec<&Path> = sources.iter().map(PathBuf::as_path).collect();
-    let mut rows = Rows::open(&paths, map, &cols)?;
+    let mut rows = Rows::open(&paths, &map.source, map, &cols)?;
     let mut tracker = Tracker::new(map);
     let mut all = Stretch::default();
     let mut cells = [0f64; 7];
@@ -151,15 +152,22 @@ pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> 
 
     let (poses, segments) = poses(&kept);
     let mut table_samples = 0u64;
-    let mut werr = None;
-    synthesize(&poses, all.t.0, all.t.1, |s| {
-        table_samples += 1;
-        if let Err(e) = writer.write_table(&[s]) {
-            werr.get_or_insert(e);
+    let mut table_file = None;
+    if let Some(feed) = &map.table {
+        let (n, hash) = feedback::stream(map, feed, sources, &segments, &mut writer, out)?;
+        table_samples = n;
+        table_file = Some(hash);
+    } else {
+        let mut werr = None;
+        synthesize(&poses, all.t.0, all.t.1, |s| {
+            table_samples += 1;
+            if let Err(e) = writer.write_table(&[s]) {
+                werr.get_or_insert(e);
+            }
+        });
+        if let Some(e) = werr {
+            return Err(io(e));
         }
-    });
-    if let Some(e) = werr {
-        return Err(io(e));
     }
     writer.manifest_mut().segments = segments;
     writer.finish().map_err(io)?;
@@ -188,7 +196,14 @@ pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> 
             })
             .collect(),
         conversion: Conversion::of(map, all.n),
-        table: "synthesized".into(),
+        table: if map.table.is_some() {
+            "feedback"
+        } else {
+            "synthesized"
+        }
+        .into(),
+        table_file,
+        table_conversion: map.table.as_ref().map(provenance::table_conversion),
         segments: match map.segments {
             Segments::None => "none",
             Segments::List(_) => "declared",
@@ -230,10 +245,17 @@ fn manifest(map: &ImportMap, segments: Vec<Segment>) -> Manifest {
         format: FORMAT.to_string(),
         station: ManifestStation {
             site: map.site,
-            table: TableAxes {
-                outer_axis: [0.0, -1.0, 0.0],
-                inner_axis: [1.0, 0.0, 0.0],
-                model: Some("none: synthesized by ratecal import from the segments".into()),
+            table: match &map.table {
+                Some(f) => TableAxes {
+                    outer_axis: f.outer_axis,
+                    inner_axis: f.inner_axis,
+                    model: Some(format!("feedback: {} (ratecal import)", f.file)),
+                },
+                None => TableAxes {
+                    outer_axis: [0.0, -1.0, 0.0],
+                    inner_axis: [1.0, 0.0, 0.0],
+                    model: Some("none: synthesized by ratecal import from the segments".into()),
+                },
             },
             mount: None,
         },
