@@ -5,7 +5,7 @@
 
 use super::{RATE_RATIO, at_map, likely_unit};
 use crate::error::{ErrorKind, ImportError};
-use crate::map::{ImportMap, TableFeed};
+use crate::map::{ImportMap, Scale, TableFeed};
 use ratecal_physics::units::Dim;
 use ratecal_recording::{Segment, SegmentKind, TableSample};
 
@@ -74,10 +74,7 @@ impl<'a> Turns<'a> {
                     map,
                     feed.at.clone(),
                     ErrorKind::Segment,
-                    &format!(
-                        "segment `{}` ({span}) has no table feedback sample",
-                        seg.id
-                    ),
+                    &format!("segment `{}` ({span}) has no table feedback sample", seg.id),
                     "the feedback's time must cover the segments on the IMU's clock: check \
                      table.time and table.offset_s (added to the feedback's time)",
                 ));
@@ -88,57 +85,70 @@ impl<'a> Turns<'a> {
             let axis = seg.axis.as_deref().unwrap_or("outer");
             let mean = a.sum_rate / a.n as f64;
             let turned = (a.last.1 - a.first.1) / (a.last.0 - a.first.0);
-            if mean.abs() >= MIN_RATE_DPS && !ratio_ok(turned, mean) {
-                let looks = likely_unit(turned.abs() / feed.angle.factor, mean.abs(), Dim::Angle);
-                let help = match looks {
-                    Some(u) if u != feed.angle.unit => format!(
-                        "the angle columns look like {u}, not {}: set table.units.angle",
-                        feed.angle.unit
-                    ),
-                    _ => "check table.units.angle and table.units.rate, and that the columns \
-                          are the table's angle and rate"
-                        .into(),
+            // The declared rate says which column is off; without one, the angle is blamed
+            // against the rate column.
+            let declared = seg.rate_dps.filter(|r| r.abs() >= MIN_RATE_DPS);
+            let reference = declared.unwrap_or(mean);
+            if reference.abs() >= MIN_RATE_DPS && !ratio_ok(turned, reference) {
+                let against = match declared {
+                    Some(d) => format!("the map declares {d} deg/s"),
+                    None => format!("the {axis} rate column reads {mean:.4} deg/s"),
                 };
-                return Err(at_map(
+                return Err(unit_error(
                     map,
-                    feed.angle.at.clone(),
-                    ErrorKind::Units,
+                    &feed.angle,
+                    Dim::Angle,
+                    (turned, reference),
                     &format!(
                         "rate segment `{}` ({span}): the {axis} angle turns at {turned:.4} \
-                         deg/s, but the {axis} rate column reads {mean:.4} deg/s",
+                         deg/s, {against}",
                         seg.id
                     ),
-                    &help,
+                    "table.units.angle",
                 ));
             }
-            if let Some(declared) = seg.rate_dps.filter(|r| r.abs() >= MIN_RATE_DPS)
-                && !ratio_ok(mean, declared)
+            if let Some(d) = declared
+                && !ratio_ok(mean, d)
             {
-                let looks = likely_unit(mean.abs() / feed.rate.factor, declared.abs(), Dim::Rate);
-                let help = match looks {
-                    Some(u) if u != feed.rate.unit => format!(
-                        "the rate columns look like {u}, not {}: set table.units.rate",
-                        feed.rate.unit
-                    ),
-                    _ => "check table.units.rate, the segment's axis (outer or inner) and its \
-                          rate_dps"
-                        .into(),
-                };
-                return Err(at_map(
+                return Err(unit_error(
                     map,
-                    feed.rate.at.clone(),
-                    ErrorKind::Units,
+                    &feed.rate,
+                    Dim::Rate,
+                    (mean, d),
                     &format!(
                         "rate segment `{}` ({span}): the {axis} rate column reads {mean:.4} \
-                         deg/s, the map declares {declared} deg/s",
+                         deg/s, the map declares {d} deg/s",
                         seg.id
                     ),
-                    &help,
+                    "table.units.rate",
                 ));
             }
         }
         Ok(())
     }
+}
+
+/// A unit refusal at `scale`'s place in the map, naming the unit that would fit.
+fn unit_error(
+    map: &ImportMap,
+    scale: &Scale,
+    dim: Dim,
+    (got, want): (f64, f64),
+    what: &str,
+    key: &str,
+) -> Box<ImportError> {
+    let help = match likely_unit(got.abs() / scale.factor, want.abs(), dim) {
+        Some(u) if u != scale.unit => format!(
+            "the {} columns look like {u}, not {}: set {key}",
+            if dim == Dim::Angle { "angle" } else { "rate" },
+            scale.unit
+        ),
+        _ => format!(
+            "check {key}, the segment's axis (outer or inner) and its rate_dps, and that the \
+             columns are the table's angles and rates"
+        ),
+    };
+    at_map(map, scale.at.clone(), ErrorKind::Units, what, &help)
 }
 
 fn ratio_ok(a: f64, b: f64) -> bool {

@@ -242,7 +242,9 @@ impl<'de> Deserialize<'de> for RawTable {
         impl<'de> Visitor<'de> for V {
             type Value = RawTable;
             fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
-                f.write_str("`none` or `{ file: feedback.csv, time: ..., columns: ..., units: ... }`")
+                f.write_str(
+                    "`none` or `{ file: feedback.csv, time: ..., columns: ..., units: ... }`",
+                )
             }
             fn visit_str<E: de::Error>(self, v: &str) -> Result<Self::Value, E> {
                 if v == "none" {

@@ -146,35 +146,35 @@ impl Resolver<'_> {
 
     /// `time:` (of the IMU or of the table feedback).
     pub(super) fn time(&self, t: &Spanned<RawTime>) -> Res<TimeSpec> {
-    Ok(match (&t.value.rate_hz, &t.value.column) {
-        (Some(r), None) if r.value.is_finite() && r.value > 0.0 => TimeSpec::Rate(r.value),
-        (Some(r), None) => {
-            return Err(self.err(self.at(&r.referenced), "rate_hz must be above 0", HELP));
-        }
-        (None, Some(c)) => {
-            let to_s = match &t.value.unit {
-                None => 1.0,
-                Some(u) => seconds_per(&u.value).ok_or_else(|| {
-                    self.err(
-                        self.at(&u.referenced),
-                        &format!("`{}` is not a time unit", u.value),
-                        "a time column's unit is s, ms or us",
-                    )
-                })?,
-            };
-            TimeSpec::Column {
-                col: self.col(c)?,
-                to_s,
+        Ok(match (&t.value.rate_hz, &t.value.column) {
+            (Some(r), None) if r.value.is_finite() && r.value > 0.0 => TimeSpec::Rate(r.value),
+            (Some(r), None) => {
+                return Err(self.err(self.at(&r.referenced), "rate_hz must be above 0", HELP));
             }
-        }
-        _ => {
-            return Err(self.err(
-                self.at(&t.referenced),
-                "imu.time needs either `rate_hz` or `column` (and only one)",
-                "write `time: { rate_hz: 100 }` or `time: { column: \"Time [s]\", unit: s }`",
-            ));
-        }
-    })
+            (None, Some(c)) => {
+                let to_s = match &t.value.unit {
+                    None => 1.0,
+                    Some(u) => seconds_per(&u.value).ok_or_else(|| {
+                        self.err(
+                            self.at(&u.referenced),
+                            &format!("`{}` is not a time unit", u.value),
+                            "a time column's unit is s, ms or us",
+                        )
+                    })?,
+                };
+                TimeSpec::Column {
+                    col: self.col(c)?,
+                    to_s,
+                }
+            }
+            _ => {
+                return Err(self.err(
+                    self.at(&t.referenced),
+                    "imu.time needs either `rate_hz` or `column` (and only one)",
+                    "write `time: { rate_hz: 100 }` or `time: { column: \"Time [s]\", unit: s }`",
+                ));
+            }
+        })
     }
 
     pub(super) fn source(&self, s: &RawSource) -> Res<SourceSpec> {
