@@ -6,7 +6,7 @@
 mod feedback;
 mod provenance;
 
-pub use provenance::{Conversion, FileHash, Oblique, Provenance};
+pub use provenance::{Conversion, FileHash, Provenance};
 
 use crate::check;
 use crate::error::{ErrorKind, ImportError};
@@ -33,7 +33,7 @@ pub struct Summary {
     pub t: (f64, f64),
     /// The manifest's segments.
     pub segments: Vec<Found>,
-    /// Oblique static intervals (in the provenance, not among the segments).
+    /// The oblique static intervals among the segments (`up: oblique`).
     pub oblique: Vec<Found>,
     /// Whether the segments were detected.
     pub detected: bool,
@@ -146,9 +146,14 @@ pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> 
     let hashes = rows.finish();
     let found = tracker.finish(map, &all)?;
     check::check(map, &found, rows.name())?;
-    let (oblique, kept): (Vec<Found>, Vec<Found>) = found
-        .into_iter()
-        .partition(|f| f.kind == SegmentKind::Static && f.up == Some(Up::Oblique));
+    // Oblique poses stay among the segments, marked `up: oblique` (the six-position fits
+    // skip them); the summary lists them apart.
+    let oblique: Vec<Found> = found
+        .iter()
+        .filter(|f| f.kind == SegmentKind::Static && f.up == Some(Up::Oblique))
+        .cloned()
+        .collect();
+    let kept = found;
 
     let (poses, segments) = poses(&kept);
     let mut table_samples = 0u64;
@@ -210,15 +215,6 @@ pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> 
             Segments::Detect(_) => "detected",
         }
         .into(),
-        oblique_static: oblique
-            .iter()
-            .map(|f| Oblique {
-                id: f.id.clone(),
-                t_start: f.stretch.t.0,
-                t_end: f.stretch.t.1,
-                f_mean: f.stretch.mean_f(),
-            })
-            .collect(),
     };
     let mut text = ratecal_recording::manifest_yaml(&m).map_err(io)?;
     text.push_str(&provenance::yaml(&prov).map_err(|e| out_error(out, &e))?);
@@ -287,6 +283,10 @@ fn poses(kept: &[Found]) -> (Vec<Pose>, Vec<Segment>) {
             pitch_deg: None,
             roll_deg: None,
             mount: None,
+            up: match (f.kind, f.up) {
+                (SegmentKind::Static, Some(u)) => Some(u.name()),
+                _ => None,
+            },
         };
         let pose = match (f.up, f.rate) {
             (up, Some((axis, rate))) => {

@@ -29,10 +29,6 @@ pub struct Provenance {
     pub table_conversion: Option<String>,
     /// `declared` (map) or `detected` (from the signal) or `none`.
     pub segments: String,
-    /// Static intervals with no body axis near vertical: not among the segments (the
-    /// six-position fits cannot use them), kept here for a multi-position calibration.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub oblique_static: Vec<Oblique>,
 }
 
 /// A file and its hash.
@@ -57,19 +53,6 @@ pub struct Conversion {
     pub axes: String,
     /// Samples imported.
     pub samples: u64,
-}
-
-/// An oblique static interval.
-#[derive(Debug, Serialize)]
-pub struct Oblique {
-    /// Id.
-    pub id: String,
-    /// Start, s.
-    pub t_start: f64,
-    /// End, s.
-    pub t_end: f64,
-    /// Mean specific force, body axes, m/s^2.
-    pub f_mean: [f64; 3],
 }
 
 impl Conversion {
