@@ -221,7 +221,13 @@ impl Reader<'_> {
                 class: class_name(h.class),
             })));
         }
-        let limit = h.elements.saturating_mul(8).saturating_add(1 << 16);
+        // Deflate expands at most 1032:1: a stream cannot hold more (a damaged header
+        // claiming a huge matrix does not make us allocate it).
+        let limit = h
+            .elements
+            .saturating_mul(8)
+            .min((data.len() as u64).saturating_mul(1032))
+            .saturating_add(1 << 16);
         let mut all = Vec::new();
         ZlibDecoder::new(data)
             .take(limit)
