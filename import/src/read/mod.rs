@@ -5,9 +5,11 @@
 
 mod cells;
 mod mat;
+mod mat_rows;
 
 pub use cells::{sniff, split_cells};
 pub use mat::{Matrix, read_mat};
+use mat_rows::{MatRows, mat_cell_error};
 
 use crate::error::{ErrorKind, ImportError, Say};
 use crate::map::{Col, ColRef, Delimiter, Format, ImportMap, SourceSpec};
@@ -127,14 +129,6 @@ pub struct Rows {
     mat: Option<MatRows>,
 }
 
-/// A MATLAB matrix read whole, served a row at a time.
-struct MatRows {
-    name: String,
-    variable: String,
-    m: Matrix,
-    sha256: String,
-}
-
 impl Rows {
     /// Opens the sources (read as `src` says), skips their leading lines, reads their
     /// headers, and resolves the map's `cols` (slot order) to columns.
@@ -249,96 +243,6 @@ impl Rows {
         })
     }
 
-    /// One MATLAB file's matrix; the map's columns are 0-based indices into it.
-    fn open_mat(paths: &[&Path], map: &ImportMap, variable: &str, cols: &[&Col]) -> Res<Rows> {
-        let [path] = paths else {
-            return Err(ImportError::in_file(
-                ErrorKind::Format,
-                &paths
-                    .first()
-                    .map_or(String::new(), |p| p.display().to_string()),
-                &format!("{} MATLAB files given; one is read", paths.len()),
-                "import one .mat file (put the channels side by side in one matrix)",
-            ));
-        };
-        let name = path.display().to_string();
-        let bytes = std::fs::read(path).map_err(|e| io_error(&name, &e))?;
-        let m = read_mat(&bytes, &name, variable)?;
-        let mut slots = Vec::with_capacity(cols.len());
-        for c in cols {
-            let ColRef::Index(i) = c.col else {
-                // The map loader refuses names for a MATLAB source.
-                return Err(map_error(
-                    map,
-                    c,
-                    "a MATLAB matrix's columns are 0-based indices",
-                    "",
-                ));
-            };
-            if i >= m.cols {
-                let help = if m.rows <= i {
-                    format!(
-                        "one row per sample is read; if `{variable}` holds the samples as \
-                         columns, save its transpose: `{variable} = {variable}.'`"
-                    )
-                } else {
-                    format!("`{variable}` has columns 0 to {}", m.cols.saturating_sub(1))
-                };
-                return Err(map_error(
-                    map,
-                    c,
-                    &format!(
-                        "column {i}, but `{variable}` in {name} is {} x {} ({})",
-                        m.rows, m.cols, m.class
-                    ),
-                    &help,
-                ));
-            }
-            slots.push(i);
-        }
-        Ok(Rows {
-            sources: Vec::new(),
-            local: slots.iter().map(|&g| (0, g)).collect(),
-            slots,
-            sample: 0,
-            mat: Some(MatRows {
-                name,
-                variable: variable.to_string(),
-                m,
-                sha256: ratecal_recording::sha256_hex(&bytes),
-            }),
-        })
-    }
-
-    /// The next row of a MATLAB matrix.
-    fn next_mat(&mut self, out: &mut [f64]) -> Res<Option<RowAt>> {
-        let Some(mr) = &self.mat else {
-            return Ok(None);
-        };
-        let r = self.sample as usize;
-        if r >= mr.m.rows {
-            return Ok(None);
-        }
-        for (slot, &c) in self.slots.iter().enumerate() {
-            let v = mr.m.data[c * mr.m.rows + r];
-            if !v.is_finite() {
-                return Err(mat_cell_error(
-                    mr,
-                    r,
-                    c,
-                    "not a finite number (NaN or infinite)",
-                    "the importer does not fill gaps: remove or repair the row in the source",
-                ));
-            }
-            out[slot] = v;
-        }
-        self.sample += 1;
-        Ok(Some(RowAt {
-            sample: r as u64,
-            line: r as u64 + 1,
-        }))
-    }
-
     /// Reads the next row's slots into `out`; `None` at the end of the sources.
     pub fn next(&mut self, out: &mut [f64]) -> Res<Option<RowAt>> {
         if self.mat.is_some() {
@@ -437,22 +341,8 @@ impl Rows {
     }
 }
 
-/// An error at row `r`, column `c` (0-based) of a MATLAB matrix.
-fn mat_cell_error(m: &MatRows, r: usize, c: usize, what: &str, help: &str) -> Box<ImportError> {
-    ImportError::in_file(
-        ErrorKind::Cell,
-        &m.name,
-        &format!(
-            "row {} (sample {r}), column {c} of `{}`: {what}",
-            r + 1,
-            m.variable
-        ),
-        help,
-    )
-}
-
 /// An error at a column the map names.
-fn map_error(map: &ImportMap, c: &Col, what: &str, help: &str) -> Box<ImportError> {
+pub(super) fn map_error(map: &ImportMap, c: &Col, what: &str, help: &str) -> Box<ImportError> {
     ImportError::in_text(
         ErrorKind::Map,
         &map.file,
