@@ -16,7 +16,7 @@ use crate::segment::table::{Pose, synthesize};
 use crate::segment::{Found, Stretch, Tracker, face_up, turn};
 use ratecal_recording::{
     Columns, FORMAT, ImuSample, Manifest, ManifestStation, RecordingWriter, Segment, SegmentKind,
-    TableAxes,
+    TableAxes, WrittenFile,
 };
 use std::path::{Path, PathBuf};
 
@@ -39,6 +39,9 @@ pub struct Summary {
     pub detected: bool,
     /// Table samples synthesized or read from the feedback file.
     pub table_samples: u64,
+    /// The data files as written (name, SHA-256, length), for the seal of the new folder
+    /// (`ratecal_recording::hash_folder_known`).
+    pub files: Vec<WrittenFile>,
 }
 
 /// Removes the staging folder unless the import completed.
@@ -82,7 +85,7 @@ pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> 
     let io = |e: std::io::Error| out_error(out, &format!("cannot write: {e}"));
 
     let mut writer =
-        RecordingWriter::create_exact(&stage, manifest(map, Vec::new()), Columns::default())
+        RecordingWriter::create_exact_unchained(&stage, manifest(map, Vec::new()), Columns::default())
             .map_err(io)?;
     let mut cols: Vec<&crate::map::Col> = map.columns.iter().collect();
     if let TimeSpec::Column { col, .. } = &map.time {
@@ -176,6 +179,10 @@ pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> 
     }
     writer.manifest_mut().segments = segments;
     writer.finish().map_err(io)?;
+    if let Some(f) = writer.write_failure() {
+        return Err(out_error(out, &format!("cannot write {}: {}", f.file, f.error)));
+    }
+    let files = writer.written().to_vec();
     let m = writer.manifest().clone();
     let dropped = writer.close();
     if dropped > 0 {
@@ -232,6 +239,7 @@ pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> 
         oblique,
         detected: matches!(map.segments, Segments::Detect(_)),
         table_samples,
+        files,
     })
 }
 
