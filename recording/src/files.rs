@@ -121,19 +121,18 @@ pub fn hash_folder_known(
                         Err(e) => FileState::Unreadable(e.to_string()),
                     }
                 }
-                Ok(m) if m.is_file() => match known
-                    .iter()
-                    .find(|k| k.name == name && k.len == m.len())
-                {
-                    Some(k) => FileState::Hashed {
-                        sha256: k.sha256.clone(),
-                        size: k.len,
-                    },
-                    None => match sha256_file(&path) {
-                        Ok((sha256, size)) => FileState::Hashed { sha256, size },
-                        Err(e) => FileState::Unreadable(e.to_string()),
-                    },
-                },
+                Ok(m) if m.is_file() => {
+                    match known.iter().find(|k| k.name == name && k.len == m.len()) {
+                        Some(k) => FileState::Hashed {
+                            sha256: k.sha256.clone(),
+                            size: k.len,
+                        },
+                        None => match sha256_file(&path) {
+                            Ok((sha256, size)) => FileState::Hashed { sha256, size },
+                            Err(e) => FileState::Unreadable(e.to_string()),
+                        },
+                    }
+                }
                 Ok(m) => FileState::Unreadable(format!("not a regular file ({})", kind_of(&m))),
                 Err(e) => FileState::Unreadable(why_unreadable(&path, &e)),
             };

@@ -75,7 +75,10 @@ fn unchained_streams_are_the_same_bytes_and_reported_as_written() {
     let fa = write(&a, true);
     let fb = write(&b, false);
     for f in ["imu.csv", "table.csv"] {
-        let (x, y) = (std::fs::read(a.join(f)).unwrap(), std::fs::read(b.join(f)).unwrap());
+        let (x, y) = (
+            std::fs::read(a.join(f)).unwrap(),
+            std::fs::read(b.join(f)).unwrap(),
+        );
         assert!(x.len() > 1000, "{f} holds rows");
         assert!(x == y, "{f} differs between the writers");
     }
@@ -86,7 +89,12 @@ fn unchained_streams_are_the_same_bytes_and_reported_as_written() {
     assert_eq!(names, ["imu.csv", "table.csv"]);
     for f in &fb {
         let (sha, len) = sha256_file(&b.join(&f.name)).unwrap();
-        assert_eq!((sha.as_str(), len), (f.sha256.as_str(), f.len), "{}", f.name);
+        assert_eq!(
+            (sha.as_str(), len),
+            (f.sha256.as_str(), f.len),
+            "{}",
+            f.name
+        );
     }
 }
 

@@ -8,9 +8,7 @@ use ratecal_engine::audit::seal::{SEAL_FILE, SEAL_HASH_FILE, Seal, is_unsealed_f
 use ratecal_engine::recording::commit::{
     Intent, commit, crash_point, pending_dir, recover, write_synced,
 };
-use ratecal_engine::recording::{
-    FileState, WrittenFile, hash_folder, hash_folder_known, rfc3339,
-};
+use ratecal_engine::recording::{FileState, WrittenFile, hash_folder, hash_folder_known, rfc3339};
 use std::collections::BTreeMap;
 use std::path::Path;
 

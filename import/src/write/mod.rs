@@ -84,9 +84,12 @@ pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> 
     let mut guard = Staging(Some(stage.clone()));
     let io = |e: std::io::Error| out_error(out, &format!("cannot write: {e}"));
 
-    let mut writer =
-        RecordingWriter::create_exact_unchained(&stage, manifest(map, Vec::new()), Columns::default())
-            .map_err(io)?;
+    let mut writer = RecordingWriter::create_exact_unchained(
+        &stage,
+        manifest(map, Vec::new()),
+        Columns::default(),
+    )
+    .map_err(io)?;
     let mut cols: Vec<&crate::map::Col> = map.columns.iter().collect();
     if let TimeSpec::Column { col, .. } = &map.time {
         cols.push(col);
@@ -180,7 +183,10 @@ pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> 
     writer.manifest_mut().segments = segments;
     writer.finish().map_err(io)?;
     if let Some(f) = writer.write_failure() {
-        return Err(out_error(out, &format!("cannot write {}: {}", f.file, f.error)));
+        return Err(out_error(
+            out,
+            &format!("cannot write {}: {}", f.file, f.error),
+        ));
     }
     let files = writer.written().to_vec();
     let m = writer.manifest().clone();

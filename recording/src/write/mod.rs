@@ -115,7 +115,9 @@ fn writer_thread(mut st: Streams, rx: mpsc::Receiver<Msg>) -> u64 {
                 // A failed stream write is recorded and sealed as cut; any other failure
                 // (the journal, an fsync) leaves the recording unfinished.
                 let r = match (&failed, st.failure()) {
-                    (Some(_), Some(f)) => Ok((st.imu.written(), st.table.written(), Some(f.clone()))),
+                    (Some(_), Some(f)) => {
+                        Ok((st.imu.written(), st.table.written(), Some(f.clone())))
+                    }
                     (Some(e), None) => Err(copy_err(e)),
                     (None, _) => Ok((st.imu.written(), st.table.written(), None)),
                 };
@@ -376,8 +378,10 @@ impl RecordingWriter {
         self.send(Msg::Hashes(tx))?;
         let (imu, table, failure) = rx.recv().map_err(|_| gone())??;
         if let Some(run) = self.manifest.run.as_mut() {
-            run.files_sha256.insert("imu.csv".into(), imu.sha256.clone());
-            run.files_sha256.insert("table.csv".into(), table.sha256.clone());
+            run.files_sha256
+                .insert("imu.csv".into(), imu.sha256.clone());
+            run.files_sha256
+                .insert("table.csv".into(), table.sha256.clone());
             run.ended = Some(rfc3339(std::time::SystemTime::now()));
             if failure.is_some() {
                 run.write_failure = failure.clone();
