@@ -53,5 +53,5 @@ mod write;
 pub use check::{GRAVITY_RANGE, GYRO_REST_MAX_DPS, RATE_RATIO, UP_TOLERANCE_DEG};
 pub use error::{ErrorKind, ImportError, Say};
 pub use map::{ImportMap, load_map};
-pub use read::{sniff, split_cells};
-pub use write::{Conversion, FileHash, Oblique, Provenance, Summary, import};
+pub use read::{Matrix, read_mat, sniff, split_cells};
+pub use write::{Conversion, FileHash, Provenance, Summary, import};

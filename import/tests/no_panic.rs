@@ -123,3 +123,38 @@ proptest! {
         }
     }
 }
+
+/// The MATLAB fixtures (written by scipy.io.savemat), compressed and not.
+fn mat_fixture(which: usize) -> Vec<u8> {
+    let name = ["mpu6050_single_v6.mat", "mpu6050_int16.mat"][which];
+    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/fixtures/import_mat")
+        .join(name);
+    std::fs::read(p).unwrap()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+
+    #[test]
+    fn a_damaged_mat_file_reads_or_is_refused_naming_it(
+        which in 0usize..2,
+        cut in 0usize..100_000,
+        edits in proptest::collection::vec((0usize..600, any::<u8>()), 0..6),
+    ) {
+        let mut bytes = mat_fixture(which);
+        for (at, b) in edits {
+            if let Some(x) = bytes.get_mut(at) {
+                *x = b;
+            }
+        }
+        bytes.truncate(cut.max(1));
+        match ratecal_import::read_mat(&bytes, "src.mat", "cal_data") {
+            Ok(m) => prop_assert_eq!(m.data.len(), m.rows * m.cols),
+            Err(e) => prop_assert!(
+                !e.help.is_empty() && e.message.starts_with("src.mat: "),
+                "{:?}", e
+            ),
+        }
+    }
+}

@@ -57,12 +57,36 @@ pub fn regular(path: &Path) -> io::Result<()> {
     }
 }
 
+/// A file a writer just wrote: its `/`-separated relative path, SHA-256 (lowercase hex)
+/// and length in bytes, hashed as it was written.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct WrittenFile {
+    /// Relative path (`imu.csv`).
+    pub name: String,
+    /// Lowercase hex SHA-256 of the bytes written.
+    pub sha256: String,
+    /// Bytes written.
+    pub len: u64,
+}
+
 /// Every file under `dir` by `/`-separated relative path, symlinks followed, each hashed
 /// streaming; `skip` leaves out names (relative paths) that are not part of the folder's
 /// content. Errs only when `dir` itself cannot be listed.
 pub fn hash_folder(
     dir: &Path,
     skip: impl Fn(&str) -> bool,
+) -> io::Result<BTreeMap<String, FileState>> {
+    hash_folder_known(dir, skip, &[])
+}
+
+/// As [`hash_folder`], but the regular files in `known` (relative path, SHA-256, length:
+/// what [`crate::RecordingWriter::written`] returns for the files it just wrote) are not
+/// read again when their length is still the one written; `verify` and the archive read
+/// everything ([`hash_folder`]).
+pub fn hash_folder_known(
+    dir: &Path,
+    skip: impl Fn(&str) -> bool,
+    known: &[WrittenFile],
 ) -> io::Result<BTreeMap<String, FileState>> {
     let mut out = BTreeMap::new();
     let mut seen = BTreeSet::new();
@@ -97,10 +121,18 @@ pub fn hash_folder(
                         Err(e) => FileState::Unreadable(e.to_string()),
                     }
                 }
-                Ok(m) if m.is_file() => match sha256_file(&path) {
-                    Ok((sha256, size)) => FileState::Hashed { sha256, size },
-                    Err(e) => FileState::Unreadable(e.to_string()),
-                },
+                Ok(m) if m.is_file() => {
+                    match known.iter().find(|k| k.name == name && k.len == m.len()) {
+                        Some(k) => FileState::Hashed {
+                            sha256: k.sha256.clone(),
+                            size: k.len,
+                        },
+                        None => match sha256_file(&path) {
+                            Ok((sha256, size)) => FileState::Hashed { sha256, size },
+                            Err(e) => FileState::Unreadable(e.to_string()),
+                        },
+                    }
+                }
                 Ok(m) => FileState::Unreadable(format!("not a regular file ({})", kind_of(&m))),
                 Err(e) => FileState::Unreadable(why_unreadable(&path, &e)),
             };

@@ -53,7 +53,7 @@ pub use cadence::{Cadence, CadenceReport};
 pub use data::{ImuSample, ImuStream, Recording, TableSample, TableStream};
 pub use error::{RecordingError, yaml_offset};
 pub use excerpt::Excerpt;
-pub use files::{FileState, hash_folder, regular, sha256_file};
+pub use files::{FileState, WrittenFile, hash_folder, hash_folder_known, regular, sha256_file};
 pub use manifest::{
     AbortRecord, EnvironmentRecord, FORMAT, LinkRecord, Manifest, ManifestStation, Mount,
     ProcedureRef, ResumeRecord, RunInfo, Segment, SegmentKind, SyncRecord, TableAxes, WriteFailure,

@@ -119,6 +119,18 @@ pub struct Segment {
     /// Remount before this segment; holds until another segment says otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mount: Option<Mount>,
+    /// A static segment's up body axis when the recording says it (`+x`, `-z`), or
+    /// `oblique` (no body axis near vertical: a multi-position pose, which the six-position
+    /// fits skip). Written by `ratecal import`; absent in a station's recordings.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub up: Option<String>,
+}
+
+impl Segment {
+    /// Whether the segment is an oblique static pose (`up: oblique`).
+    pub fn is_oblique(&self) -> bool {
+        self.up.as_deref() == Some("oblique")
+    }
 }
 
 /// `environment:` block.

@@ -51,7 +51,7 @@ pub fn main(args: Args) -> ExitCode {
         Ok(s) => {
             // Sealed as written, like a run folder: `verify` shows it unaltered and
             // `archive add` accepts it.
-            if let Err(e) = super::seal::write(&s.out, None) {
+            if let Err(e) = super::seal::write_known(&s.out, None, &s.files) {
                 errln!("error: cannot seal {}: {e}", s.out.display());
                 return ExitCode::from(1);
             }
@@ -90,9 +90,7 @@ fn print_summary(map: &ImportMap, s: &Summary) {
         "up / axis",
         "|f| m/s^2"
     );
-    let mut all: Vec<_> = s.segments.iter().chain(&s.oblique).collect();
-    all.sort_by(|a, b| a.stretch.t.0.total_cmp(&b.stretch.t.0));
-    for f in all {
+    for f in &s.segments {
         let st = &f.stretch;
         let what = match (f.kind, f.up, f.rate) {
             (SegmentKind::Static, Some(u), _) => u.name(),
@@ -112,15 +110,21 @@ fn print_summary(map: &ImportMap, s: &Summary) {
     }
     if !s.oblique.is_empty() {
         outln!(
-            "note: {} oblique static interval(s) (no body axis within 10 deg of vertical) are \
-             kept in the manifest's provenance.oblique_static, not among the segments: the \
-             six-position fits cannot use them",
+            "note: {} oblique static segment(s) (no body axis within 10 deg of vertical) are \
+             marked `up: oblique` in the manifest: the six-position fits skip them",
             s.oblique.len()
         );
     }
-    outln!(
-        "table: synthesized from the segments' attitudes ({} samples at 50 Hz; manifest \
-         provenance.table: synthesized)",
-        s.table_samples
-    );
+    match &map.table {
+        Some(f) => outln!(
+            "table: {} feedback samples from {} (manifest provenance.table: feedback)",
+            s.table_samples,
+            f.file
+        ),
+        None => outln!(
+            "table: synthesized from the segments' attitudes ({} samples at 50 Hz; manifest \
+             provenance.table: synthesized)",
+            s.table_samples
+        ),
+    }
 }

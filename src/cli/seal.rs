@@ -8,7 +8,7 @@ use ratecal_engine::audit::seal::{SEAL_FILE, SEAL_HASH_FILE, Seal, is_unsealed_f
 use ratecal_engine::recording::commit::{
     Intent, commit, crash_point, pending_dir, recover, write_synced,
 };
-use ratecal_engine::recording::{FileState, hash_folder, rfc3339};
+use ratecal_engine::recording::{FileState, WrittenFile, hash_folder, hash_folder_known, rfc3339};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -22,8 +22,19 @@ pub fn folder_files(dir: &Path) -> std::io::Result<BTreeMap<String, FileState>> 
 /// Seals every file of a run folder, signed with `key` if given; written last. Refused
 /// when an entry cannot be read (it could not be shown unaltered later).
 pub fn write(dir: &Path, key: Option<&SigningKey>) -> std::io::Result<()> {
+    write_known(dir, key, &[])
+}
+
+/// As [`write`], for a folder just written: the files in `known` (hashed as they were
+/// written, `RecordingWriter::written`) are not read again while their length is the one
+/// written. `verify` still reads every file.
+pub fn write_known(
+    dir: &Path,
+    key: Option<&SigningKey>,
+    known: &[WrittenFile],
+) -> std::io::Result<()> {
     recover(dir)?;
-    let files = folder_files(dir)?;
+    let files = hash_folder_known(dir, is_unsealed_file, known)?;
     let mut hashes = Vec::with_capacity(files.len());
     for (path, state) in &files {
         match state {

@@ -198,8 +198,23 @@ pub(crate) fn select(m: &Manifest, plan: Option<&Plan>, opts: &Options) -> Selec
         }
         None => {
             sel.model.selection = "by_kind".into();
+            // The six-position fits take the faces; an oblique pose (`up: oblique`, written
+            // by `ratecal import`) is left to a multi-position calibration.
+            let oblique: Vec<&str> = segs
+                .iter()
+                .filter(|s| s.kind == SegmentKind::Static && s.is_oblique())
+                .map(|s| s.id.as_str())
+                .collect();
+            if !oblique.is_empty() {
+                sel.warnings.push(format!(
+                    "{} oblique static segment(s) skipped (up: oblique): the six-position fits \
+                     use the faces only ({})",
+                    oblique.len(),
+                    oblique.join(", ")
+                ));
+            }
             let st: Vec<usize> = (0..segs.len())
-                .filter(|&i| segs[i].kind == SegmentKind::Static)
+                .filter(|&i| segs[i].kind == SegmentKind::Static && !segs[i].is_oblique())
                 .collect();
             let rt: Vec<usize> = (0..segs.len())
                 .filter(|&i| segs[i].kind == SegmentKind::Rate)

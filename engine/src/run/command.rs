@@ -143,6 +143,7 @@ impl CmdState {
             pitch_deg: None,
             roll_deg: None,
             mount: None,
+            up: None,
         };
         let pick = |want: fn(&AxisCmd) -> bool| -> Option<Axis> {
             match self.last_axis {

@@ -199,6 +199,7 @@ pub fn record(x: &Experiment, imu: &ImuErrors) -> Recording {
                 pitch_deg: None,
                 roll_deg: None,
                 mount: first.then_some(mount),
+                up: None,
             };
             match period {
                 None if first => seg.id = format!("align/{name}"),

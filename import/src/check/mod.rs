@@ -2,6 +2,8 @@
 //! anything is written. Each check names the segment, its lines in the source, and the
 //! map key to fix.
 
+pub mod feedback;
+
 use crate::error::{ErrorKind, ImportError, Say};
 use crate::map::{DeclSegment, ImportMap, RateAxis, Segments, Up};
 use crate::segment::{Found, detect::up_of, norm};
@@ -147,9 +149,10 @@ fn check_up(
 
 /// The unit (of `dim`, the language's) in which `raw` (the column's own magnitude) would be
 /// `expect` (in internal units) within 30 %, if one is.
-fn likely_unit(raw: f64, expect: f64, dim: Dim) -> Option<&'static str> {
+pub(crate) fn likely_unit(raw: f64, expect: f64, dim: Dim) -> Option<&'static str> {
     let names: &[&str] = match dim {
         Dim::Accel => &["m/s^2", "g", "mg", "ug"],
+        Dim::Angle => &["deg", "rad", "mrad"],
         _ => &["deg/s", "rad/s", "deg/h"],
     };
     names.iter().copied().find(|n| {
@@ -160,7 +163,7 @@ fn likely_unit(raw: f64, expect: f64, dim: Dim) -> Option<&'static str> {
     })
 }
 
-fn at_map(
+pub(crate) fn at_map(
     map: &ImportMap,
     at: Range<usize>,
     kind: ErrorKind,

@@ -4,9 +4,12 @@
 
 mod raw;
 mod resolve;
+mod segments;
+mod table;
 mod units;
 
 pub use resolve::load_map;
+pub use table::TableFeed;
 pub use units::{scale_of, seconds_per};
 
 use ratecal_physics::Site;
@@ -39,6 +42,8 @@ pub struct ImportMap {
     pub segments: Segments,
     /// The site.
     pub site: Site,
+    /// The table's feedback file (`None`: `table: none`, the stream is synthesized).
+    pub table: Option<TableFeed>,
     /// Free-form IMU description for the manifest.
     pub device: BTreeMap<String, String>,
 }

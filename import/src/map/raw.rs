@@ -16,7 +16,7 @@ pub struct RawMap {
     #[serde(default)]
     pub segments: Option<Spanned<RawSegments>>,
     #[serde(default)]
-    pub table: Option<Spanned<String>>,
+    pub table: Option<Spanned<RawTable>>,
     pub site: RawSite,
     /// Free-form IMU description copied to the manifest's `imu:` (model, serial, grade).
     #[serde(default)]
@@ -185,6 +185,77 @@ impl<'de> Deserialize<'de> for RawSegments {
             fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<Self::Value, A::Error> {
                 let w = RawDetectWrap::deserialize(de::value::MapAccessDeserializer::new(map))?;
                 Ok(RawSegments::Detect(Box::new(w.detect)))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// `table:`: `none`, or the feedback file with its own map.
+#[derive(Debug)]
+pub enum RawTable {
+    None,
+    Feed(Box<RawFeed>),
+}
+
+/// `table: { file, source, time, offset_s, columns, units, outer_axis, inner_axis }`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawFeed {
+    /// Relative to the first source's folder.
+    pub file: Spanned<String>,
+    #[serde(default)]
+    pub source: Option<RawSource>,
+    pub time: Spanned<RawTime>,
+    /// Added to the feedback's time to put it on the IMU's time base, s.
+    #[serde(default)]
+    pub offset_s: Option<Spanned<f64>>,
+    pub columns: RawFeedColumns,
+    pub units: RawFeedUnits,
+    #[serde(default)]
+    pub outer_axis: Option<Spanned<[f64; 3]>>,
+    #[serde(default)]
+    pub inner_axis: Option<Spanned<[f64; 3]>>,
+}
+
+/// `table.columns:`, named as `table.csv`'s.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawFeedColumns {
+    pub outer: Spanned<RawCol>,
+    pub inner: Spanned<RawCol>,
+    pub outer_rate: Spanned<RawCol>,
+    pub inner_rate: Spanned<RawCol>,
+}
+
+/// `table.units:`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawFeedUnits {
+    pub angle: Spanned<String>,
+    pub rate: Spanned<String>,
+}
+
+impl<'de> Deserialize<'de> for RawTable {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = RawTable;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str(
+                    "`none` or `{ file: feedback.csv, time: ..., columns: ..., units: ... }`",
+                )
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<Self::Value, E> {
+                if v == "none" {
+                    Ok(RawTable::None)
+                } else {
+                    Err(E::invalid_value(de::Unexpected::Str(v), &self))
+                }
+            }
+            fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<Self::Value, A::Error> {
+                let f = RawFeed::deserialize(de::value::MapAccessDeserializer::new(map))?;
+                Ok(RawTable::Feed(Box::new(f)))
             }
         }
         d.deserialize_any(V)

@@ -1,14 +1,14 @@
 //! From the map's text to an [`ImportMap`]: serde-saphyr's errors and every value check
 //! become diagnostics located in the map file.
 
-use super::raw::{RawCol, RawMap, RawSegment, RawSegments, RawTriple};
+use super::raw::{RawCol, RawMap, RawSegments, RawSource, RawTable, RawTime, RawTriple};
 use super::*;
 use crate::error::{ErrorKind, ImportError, Say};
 use ratecal_physics::units::{Dim, parse_quantity};
 use ratecal_recording::yaml_offset;
 use serde_saphyr::{Location, Spanned};
 
-const HELP: &str = "docs/import.md lists every key of an import map";
+pub(super) const HELP: &str = "docs/import.md lists every key of an import map";
 
 /// Reads and checks a map; `file` names it in diagnostics.
 pub fn load_map(text: &str, file: &str) -> Result<ImportMap, Box<ImportError>> {
@@ -16,15 +16,15 @@ pub fn load_map(text: &str, file: &str) -> Result<ImportMap, Box<ImportError>> {
     Resolver { text, file }.map(raw)
 }
 
-struct Resolver<'a> {
-    text: &'a str,
-    file: &'a str,
+pub(super) struct Resolver<'a> {
+    pub(super) text: &'a str,
+    pub(super) file: &'a str,
 }
 
-type Res<T> = Result<T, Box<ImportError>>;
+pub(super) type Res<T> = Result<T, Box<ImportError>>;
 
 impl Resolver<'_> {
-    fn at(&self, loc: &Location) -> Range<usize> {
+    pub(super) fn at(&self, loc: &Location) -> Range<usize> {
         if loc.line() == 0 {
             return 0..0;
         }
@@ -37,7 +37,7 @@ impl Resolver<'_> {
         start..(start + len).min(self.text.len())
     }
 
-    fn err(&self, at: Range<usize>, what: &str, help: &str) -> Box<ImportError> {
+    pub(super) fn err(&self, at: Range<usize>, what: &str, help: &str) -> Box<ImportError> {
         ImportError::in_text(
             ErrorKind::Map,
             self.file,
@@ -52,36 +52,8 @@ impl Resolver<'_> {
     }
 
     fn map(&self, raw: RawMap) -> Res<ImportMap> {
-        let source = self.source(&raw)?;
-        let time = match (&raw.imu.time.value.rate_hz, &raw.imu.time.value.column) {
-            (Some(r), None) if r.value.is_finite() && r.value > 0.0 => TimeSpec::Rate(r.value),
-            (Some(r), None) => {
-                return Err(self.err(self.at(&r.referenced), "rate_hz must be above 0", HELP));
-            }
-            (None, Some(c)) => {
-                let to_s = match &raw.imu.time.value.unit {
-                    None => 1.0,
-                    Some(u) => seconds_per(&u.value).ok_or_else(|| {
-                        self.err(
-                            self.at(&u.referenced),
-                            &format!("`{}` is not a time unit", u.value),
-                            "a time column's unit is s, ms or us",
-                        )
-                    })?,
-                };
-                TimeSpec::Column {
-                    col: self.col(c)?,
-                    to_s,
-                }
-            }
-            _ => {
-                return Err(self.err(
-                    self.at(&raw.imu.time.referenced),
-                    "imu.time needs either `rate_hz` or `column` (and only one)",
-                    "write `time: { rate_hz: 100 }` or `time: { column: \"Time [s]\", unit: s }`",
-                ));
-            }
-        };
+        let source = self.source(&raw.source)?;
+        let time = self.time(&raw.imu.time)?;
         let c = &raw.imu.columns;
         let columns = [
             self.col(&c.ax)?,
@@ -118,20 +90,17 @@ impl Resolver<'_> {
         )?;
         let axes = self.axes(raw.imu.axes.as_ref())?;
         let site = self.site(&raw)?;
-        if let Some(t) = &raw.table
-            && t.value != "none"
-        {
-            return Err(self.err(
-                self.at(&t.referenced),
-                &format!("table `{}`: only `table: none` is supported", t.value),
-                "without feedback the importer synthesizes the table stream from the segments' \
-                 declared attitudes; a feedback file cannot be imported yet",
-            ));
-        }
+        let table = match &raw.table {
+            Some(t) => match &t.value {
+                RawTable::None => None,
+                RawTable::Feed(f) => Some(self.feed(f, self.at(&t.referenced))?),
+            },
+            None => None,
+        };
         let segments = match &raw.segments {
             None => Segments::None,
             Some(s) => match &s.value {
-                RawSegments::List(v) => Segments::List(self.segments(v)?),
+                RawSegments::List(v) => Segments::List(self.segments(v, table.is_some())?),
                 RawSegments::Detect(d) => {
                     let static_min_s = self.time_q(&d.static_min)?;
                     let window_s = match &d.window {
@@ -170,12 +139,45 @@ impl Resolver<'_> {
             axes,
             segments,
             site,
+            table,
             device: raw.device,
         })
     }
 
-    fn source(&self, raw: &RawMap) -> Res<SourceSpec> {
-        let s = &raw.source;
+    /// `time:` (of the IMU or of the table feedback).
+    pub(super) fn time(&self, t: &Spanned<RawTime>) -> Res<TimeSpec> {
+        Ok(match (&t.value.rate_hz, &t.value.column) {
+            (Some(r), None) if r.value.is_finite() && r.value > 0.0 => TimeSpec::Rate(r.value),
+            (Some(r), None) => {
+                return Err(self.err(self.at(&r.referenced), "rate_hz must be above 0", HELP));
+            }
+            (None, Some(c)) => {
+                let to_s = match &t.value.unit {
+                    None => 1.0,
+                    Some(u) => seconds_per(&u.value).ok_or_else(|| {
+                        self.err(
+                            self.at(&u.referenced),
+                            &format!("`{}` is not a time unit", u.value),
+                            "a time column's unit is s, ms or us",
+                        )
+                    })?,
+                };
+                TimeSpec::Column {
+                    col: self.col(c)?,
+                    to_s,
+                }
+            }
+            _ => {
+                return Err(self.err(
+                    self.at(&t.referenced),
+                    "imu.time needs either `rate_hz` or `column` (and only one)",
+                    "write `time: { rate_hz: 100 }` or `time: { column: \"Time [s]\", unit: s }`",
+                ));
+            }
+        })
+    }
+
+    pub(super) fn source(&self, s: &RawSource) -> Res<SourceSpec> {
         let format = match s.format.value.as_str() {
             "csv" => Format::Csv,
             "mat" => Format::Mat {
@@ -262,7 +264,7 @@ impl Resolver<'_> {
         })
     }
 
-    fn col(&self, c: &Spanned<RawCol>) -> Res<Col> {
+    pub(super) fn col(&self, c: &Spanned<RawCol>) -> Res<Col> {
         let at = self.at(&c.referenced);
         let col = match &c.value {
             RawCol::Index(i) => ColRef::Index(usize::try_from(*i).unwrap_or(usize::MAX)),
@@ -366,150 +368,6 @@ impl Resolver<'_> {
                 "write a time with its unit, e.g. \"2 s\"",
             )),
         }
-    }
-
-    fn segments(&self, list: &[Spanned<RawSegment>]) -> Res<Vec<DeclSegment>> {
-        let mut out: Vec<DeclSegment> = Vec::with_capacity(list.len());
-        for s in list {
-            let d = self.segment(s)?;
-            if let Some(o) = out.iter().find(|o| o.id == d.id) {
-                let _ = o;
-                return Err(self.err(
-                    d.at.clone(),
-                    &format!("segment id `{}` is used twice", d.id),
-                    "segment ids name one segment each",
-                ));
-            }
-            if let Some(prev) = out.last() {
-                let order = match (prev.range, d.range) {
-                    (SegRange::Samples(_, a), SegRange::Samples(b, _)) => Some(b >= a),
-                    (SegRange::Time(_, a), SegRange::Time(b, _)) => Some(b >= a),
-                    _ => None,
-                };
-                if order == Some(false) {
-                    return Err(self.err(
-                        d.range_at.clone(),
-                        &format!(
-                            "segment `{}` starts before `{}` ends: overlapping or out of order",
-                            d.id, prev.id
-                        ),
-                        "list segments in time order, each ending at or before the next starts",
-                    ));
-                }
-            }
-            out.push(d);
-        }
-        Ok(out)
-    }
-
-    fn segment(&self, s: &Spanned<RawSegment>) -> Res<DeclSegment> {
-        let v = &s.value;
-        let at = self.at(&s.referenced);
-        let kind = match v.kind.value.as_str() {
-            "static" => SegmentKind::Static,
-            "rate" => SegmentKind::Rate,
-            k => {
-                return Err(self.err(
-                    self.at(&v.kind.referenced),
-                    &format!("segment kind `{k}` cannot be imported"),
-                    "kind is `static` or `rate` (an oscillation needs the table's feedback)",
-                ));
-            }
-        };
-        let (range, range_at) = match (&v.samples, &v.time) {
-            (Some(r), None) => {
-                let at = self.at(&r.referenced);
-                if r.value[0] >= r.value[1] {
-                    return Err(self.err(at, "samples [from, to) needs from < to", HELP));
-                }
-                (SegRange::Samples(r.value[0], r.value[1]), at)
-            }
-            (None, Some(r)) => {
-                let at = self.at(&r.referenced);
-                if r.value[0].partial_cmp(&r.value[1]) != Some(std::cmp::Ordering::Less)
-                    || !r.value[1].is_finite()
-                {
-                    return Err(self.err(at, "time [t0, t1) needs t0 < t1", HELP));
-                }
-                (SegRange::Time(r.value[0], r.value[1]), at)
-            }
-            _ => {
-                return Err(self.err(
-                    at,
-                    &format!(
-                        "segment `{}` needs `samples` or `time` (one of them)",
-                        v.id.value
-                    ),
-                    "samples: [from, to) (0-based, to excluded) or time: [t0, t1) in seconds",
-                ));
-            }
-        };
-        let up_at = v.up.as_ref().map_or(at.clone(), |u| self.at(&u.referenced));
-        let up = match &v.up {
-            None => None,
-            Some(u) if u.value == "oblique" => Some(Up::Oblique),
-            Some(u) => Some(
-                signed_axis(&u.value)
-                    .map(|(i, s)| Up::Axis(i, s))
-                    .ok_or_else(|| {
-                        self.err(
-                            up_at.clone(),
-                            &format!("`{}` is not an axis", u.value),
-                            "up is a body axis with its sign (+x, -z...) or `oblique`",
-                        )
-                    })?,
-            ),
-        };
-        let rate = match kind {
-            SegmentKind::Static => {
-                if up.is_none() {
-                    return Err(self.err(
-                        at,
-                        &format!("static segment `{}` needs `up`", v.id.value),
-                        "without table feedback the attitude comes from `up`: the body axis \
-                         that points up (+x, -z...) or `oblique`",
-                    ));
-                }
-                None
-            }
-            _ => {
-                let (Some(axis), Some(r)) = (&v.axis, &v.rate_dps) else {
-                    return Err(self.err(
-                        at,
-                        &format!("rate segment `{}` needs `axis` and `rate_dps`", v.id.value),
-                        "axis: a body axis (x, -y...) or the table's outer/inner; rate_dps: the \
-                         mean rate over the segment, deg/s",
-                    ));
-                };
-                let ax = match axis.value.as_str() {
-                    "outer" => RateAxis::Outer,
-                    "inner" => RateAxis::Inner,
-                    a => signed_axis(a)
-                        .map(|(i, s)| RateAxis::Body(i, s))
-                        .ok_or_else(|| {
-                            self.err(
-                                self.at(&axis.referenced),
-                                &format!("`{a}` is not an axis"),
-                                "axis is a body axis (x, -y...) or outer/inner",
-                            )
-                        })?,
-                };
-                if !r.value.is_finite() {
-                    return Err(self.err(self.at(&r.referenced), "rate_dps must be finite", HELP));
-                }
-                Some((ax, r.value))
-            }
-        };
-        Ok(DeclSegment {
-            id: v.id.value.clone(),
-            kind,
-            range,
-            up,
-            rate,
-            at,
-            range_at,
-            up_at,
-        })
     }
 }
 

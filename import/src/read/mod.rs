@@ -5,12 +5,14 @@
 
 mod cells;
 mod mat;
+mod mat_rows;
 
 pub use cells::{sniff, split_cells};
-pub use mat::check_mat;
+pub use mat::{Matrix, read_mat};
+use mat_rows::{MatRows, mat_cell_error};
 
 use crate::error::{ErrorKind, ImportError, Say};
-use crate::map::{Col, ColRef, Delimiter, ImportMap};
+use crate::map::{Col, ColRef, Delimiter, Format, ImportMap, SourceSpec};
 use sha2::{Digest, Sha256};
 use std::fs::File;
 use std::io::{BufRead, BufReader, Read};
@@ -123,12 +125,17 @@ pub struct Rows {
     /// (source, column within it) of each slot.
     local: Vec<(usize, usize)>,
     sample: u64,
+    /// A MATLAB source instead of the text ones.
+    mat: Option<MatRows>,
 }
 
 impl Rows {
-    /// Opens the sources, skips their leading lines, reads their headers, and resolves the
-    /// map's `cols` (slot order) to columns.
-    pub fn open(paths: &[&Path], map: &ImportMap, cols: &[&Col]) -> Res<Rows> {
+    /// Opens the sources (read as `src` says), skips their leading lines, reads their
+    /// headers, and resolves the map's `cols` (slot order) to columns.
+    pub fn open(paths: &[&Path], src: &SourceSpec, map: &ImportMap, cols: &[&Col]) -> Res<Rows> {
+        if let Format::Mat { variable, .. } = &src.format {
+            return Self::open_mat(paths, map, variable, cols);
+        }
         let mut sources = Vec::with_capacity(paths.len());
         let mut names: Vec<String> = Vec::new();
         let mut offset = 0;
@@ -146,22 +153,22 @@ impl Rows {
                 ),
                 buf: Vec::with_capacity(256),
                 line: 0,
-                delim: map.source.delimiter,
+                delim: src.delimiter,
                 cells: Vec::with_capacity(16),
                 width: None,
                 offset,
             };
-            for _ in 0..map.source.skip_lines {
+            for _ in 0..src.skip_lines {
                 if !s.next_line()? {
                     return Err(ImportError::in_file(
                         ErrorKind::Cell,
                         &s.name,
-                        &format!("ends before the {} lines to skip", map.source.skip_lines),
+                        &format!("ends before the {} lines to skip", src.skip_lines),
                         "check source.skip_lines in the map",
                     ));
                 }
             }
-            if map.source.header {
+            if src.header {
                 if !s.next_row()? {
                     return Err(ImportError::in_file(
                         ErrorKind::Cell,
@@ -172,7 +179,7 @@ impl Rows {
                     ));
                 }
                 for c in &s.cells {
-                    let (t, _, _) = map.source.encoding.decode(&s.buf[c.clone()]);
+                    let (t, _, _) = src.encoding.decode(&s.buf[c.clone()]);
                     names.push(unquote(t.trim()).to_string());
                 }
                 s.width = Some(s.cells.len());
@@ -183,16 +190,16 @@ impl Rows {
             }
             sources.push(s);
         }
-        if !map.source.header && sources.len() > 1 {
+        if !src.header && sources.len() > 1 {
             // Columns by index over several header-less files: peek each file's width.
             let mut off = 0;
             for s in &mut sources {
                 s.offset = off;
-                let w = peek_width(&s.name, map)?;
+                let w = peek_width(&s.name, src)?;
                 s.width = Some(w);
                 off += w;
             }
-        } else if !map.source.header {
+        } else if !src.header {
             sources[0].offset = 0;
         }
         let mut slots = Vec::with_capacity(cols.len());
@@ -232,11 +239,15 @@ impl Rows {
             slots,
             local,
             sample: 0,
+            mat: None,
         })
     }
 
     /// Reads the next row's slots into `out`; `None` at the end of the sources.
     pub fn next(&mut self, out: &mut [f64]) -> Res<Option<RowAt>> {
+        if self.mat.is_some() {
+            return self.next_mat(out);
+        }
         let mut ended = None;
         for (k, s) in self.sources.iter_mut().enumerate() {
             let more = s.next_row()?;
@@ -291,6 +302,9 @@ impl Rows {
 
     /// Each source's SHA-256 (lowercase hex) once they were read to the end.
     pub fn finish(&mut self) -> Vec<String> {
+        if let Some(m) = &self.mat {
+            return vec![m.sha256.clone()];
+        }
         self.sources
             .iter_mut()
             .map(|s| {
@@ -303,7 +317,10 @@ impl Rows {
 
     /// The first source's name.
     pub fn name(&self) -> &str {
-        &self.sources[0].name
+        match &self.mat {
+            Some(m) => &m.name,
+            None => &self.sources[0].name,
+        }
     }
 
     /// An error at slot `slot` of the row just read.
@@ -315,10 +332,28 @@ impl Rows {
         help: &str,
     ) -> Box<ImportError> {
         let (k, c) = self.local[slot];
+        if let Some(m) = &self.mat {
+            return mat_cell_error(m, self.sample.saturating_sub(1) as usize, c, what, help);
+        }
         let s = &self.sources[k];
         let r = s.cells.get(c).cloned().unwrap_or(0..0);
         s.error(r, kind, what, help)
     }
+}
+
+/// An error at a column the map names.
+pub(super) fn map_error(map: &ImportMap, c: &Col, what: &str, help: &str) -> Box<ImportError> {
+    ImportError::in_text(
+        ErrorKind::Map,
+        &map.file,
+        &map.text,
+        c.at.clone(),
+        Say {
+            what,
+            label: "this column",
+            help,
+        },
+    )
 }
 
 fn parse_cell(s: &LineSource, r: Range<usize>) -> Res<f64> {
@@ -349,7 +384,7 @@ fn unquote(t: &str) -> &str {
 }
 
 /// Cells in the first data row of a header-less source.
-fn peek_width(name: &str, map: &ImportMap) -> Res<usize> {
+fn peek_width(name: &str, src: &SourceSpec) -> Res<usize> {
     let f = File::open(name).map_err(|e| io_error(name, &e))?;
     let mut s = LineSource {
         name: name.to_string(),
@@ -359,12 +394,12 @@ fn peek_width(name: &str, map: &ImportMap) -> Res<usize> {
         }),
         buf: Vec::new(),
         line: 0,
-        delim: map.source.delimiter,
+        delim: src.delimiter,
         cells: Vec::new(),
         width: None,
         offset: 0,
     };
-    for _ in 0..map.source.skip_lines {
+    for _ in 0..src.skip_lines {
         s.next_line()?;
     }
     s.next_row()?;

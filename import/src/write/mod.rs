@@ -3,23 +3,24 @@
 //! synthesize the table stream, write the manifest with its provenance and move the folder
 //! into place. A refusal removes the staging folder: nothing is written.
 
+mod feedback;
 mod provenance;
 
-pub use provenance::{Conversion, FileHash, Oblique, Provenance};
+pub use provenance::{Conversion, FileHash, Provenance};
 
 use crate::check;
 use crate::error::{ErrorKind, ImportError};
-use crate::map::{Format, ImportMap, Segments, TimeSpec, Up};
-use crate::read::{self, Rows};
+use crate::map::{ImportMap, Segments, TimeSpec, Up};
+use crate::read::Rows;
 use crate::segment::table::{Pose, synthesize};
 use crate::segment::{Found, Stretch, Tracker, face_up, turn};
 use ratecal_recording::{
     Columns, FORMAT, ImuSample, Manifest, ManifestStation, RecordingWriter, Segment, SegmentKind,
-    TableAxes,
+    TableAxes, WrittenFile,
 };
 use std::path::{Path, PathBuf};
 
-type Res<T> = Result<T, Box<ImportError>>;
+pub(crate) type Res<T> = Result<T, Box<ImportError>>;
 
 /// What an import wrote (printed for the engineer to confirm).
 #[derive(Debug, Clone)]
@@ -32,12 +33,15 @@ pub struct Summary {
     pub t: (f64, f64),
     /// The manifest's segments.
     pub segments: Vec<Found>,
-    /// Oblique static intervals (in the provenance, not among the segments).
+    /// The oblique static intervals among the segments (`up: oblique`).
     pub oblique: Vec<Found>,
     /// Whether the segments were detected.
     pub detected: bool,
-    /// Table samples synthesized.
+    /// Table samples synthesized or read from the feedback file.
     pub table_samples: u64,
+    /// The data files as written (name, SHA-256, length), for the seal of the new folder
+    /// (`ratecal_recording::hash_folder_known`).
+    pub files: Vec<WrittenFile>,
 }
 
 /// Removes the staging folder unless the import completed.
@@ -51,7 +55,7 @@ impl Drop for Staging {
     }
 }
 
-fn out_error(out: &Path, what: &str) -> Box<ImportError> {
+pub(crate) fn out_error(out: &Path, what: &str) -> Box<ImportError> {
     ImportError::in_file(
         ErrorKind::Io,
         &out.display().to_string(),
@@ -62,11 +66,6 @@ fn out_error(out: &Path, what: &str) -> Box<ImportError> {
 
 /// Imports `sources` with `map` into the new recording folder `out`.
 pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> {
-    if let Format::Mat { variable } = &map.source.format {
-        for s in sources {
-            read::check_mat(s, variable)?;
-        }
-    }
     if out.exists() {
         let empty = out.is_dir() && std::fs::read_dir(out).is_ok_and(|mut d| d.next().is_none());
         if !empty {
@@ -85,15 +84,18 @@ pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> 
     let mut guard = Staging(Some(stage.clone()));
     let io = |e: std::io::Error| out_error(out, &format!("cannot write: {e}"));
 
-    let mut writer =
-        RecordingWriter::create_exact(&stage, manifest(map, Vec::new()), Columns::default())
-            .map_err(io)?;
+    let mut writer = RecordingWriter::create_exact_unchained(
+        &stage,
+        manifest(map, Vec::new()),
+        Columns::default(),
+    )
+    .map_err(io)?;
     let mut cols: Vec<&crate::map::Col> = map.columns.iter().collect();
     if let TimeSpec::Column { col, .. } = &map.time {
         cols.push(col);
     }
     let paths: Vec<&Path> = sources.iter().map(PathBuf::as_path).collect();
-    let mut rows = Rows::open(&paths, map, &cols)?;
+    let mut rows = Rows::open(&paths, &map.source, map, &cols)?;
     let mut tracker = Tracker::new(map);
     let mut all = Stretch::default();
     let mut cells = [0f64; 7];
@@ -150,24 +152,43 @@ pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> 
     let hashes = rows.finish();
     let found = tracker.finish(map, &all)?;
     check::check(map, &found, rows.name())?;
-    let (oblique, kept): (Vec<Found>, Vec<Found>) = found
-        .into_iter()
-        .partition(|f| f.kind == SegmentKind::Static && f.up == Some(Up::Oblique));
+    // Oblique poses stay among the segments, marked `up: oblique` (the six-position fits
+    // skip them); the summary lists them apart.
+    let oblique: Vec<Found> = found
+        .iter()
+        .filter(|f| f.kind == SegmentKind::Static && f.up == Some(Up::Oblique))
+        .cloned()
+        .collect();
+    let kept = found;
 
     let (poses, segments) = poses(&kept);
     let mut table_samples = 0u64;
-    let mut werr = None;
-    synthesize(&poses, all.t.0, all.t.1, |s| {
-        table_samples += 1;
-        if let Err(e) = writer.write_table(&[s]) {
-            werr.get_or_insert(e);
+    let mut table_file = None;
+    if let Some(feed) = &map.table {
+        let (n, hash) = feedback::stream(map, feed, sources, &segments, &mut writer, out)?;
+        table_samples = n;
+        table_file = Some(hash);
+    } else {
+        let mut werr = None;
+        synthesize(&poses, all.t.0, all.t.1, |s| {
+            table_samples += 1;
+            if let Err(e) = writer.write_table(&[s]) {
+                werr.get_or_insert(e);
+            }
+        });
+        if let Some(e) = werr {
+            return Err(io(e));
         }
-    });
-    if let Some(e) = werr {
-        return Err(io(e));
     }
     writer.manifest_mut().segments = segments;
     writer.finish().map_err(io)?;
+    if let Some(f) = writer.write_failure() {
+        return Err(out_error(
+            out,
+            &format!("cannot write {}: {}", f.file, f.error),
+        ));
+    }
+    let files = writer.written().to_vec();
     let m = writer.manifest().clone();
     let dropped = writer.close();
     if dropped > 0 {
@@ -193,22 +214,20 @@ pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> 
             })
             .collect(),
         conversion: Conversion::of(map, all.n),
-        table: "synthesized".into(),
+        table: if map.table.is_some() {
+            "feedback"
+        } else {
+            "synthesized"
+        }
+        .into(),
+        table_file,
+        table_conversion: map.table.as_ref().map(provenance::table_conversion),
         segments: match map.segments {
             Segments::None => "none",
             Segments::List(_) => "declared",
             Segments::Detect(_) => "detected",
         }
         .into(),
-        oblique_static: oblique
-            .iter()
-            .map(|f| Oblique {
-                id: f.id.clone(),
-                t_start: f.stretch.t.0,
-                t_end: f.stretch.t.1,
-                f_mean: f.stretch.mean_f(),
-            })
-            .collect(),
     };
     let mut text = ratecal_recording::manifest_yaml(&m).map_err(io)?;
     text.push_str(&provenance::yaml(&prov).map_err(|e| out_error(out, &e))?);
@@ -226,6 +245,7 @@ pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> 
         oblique,
         detected: matches!(map.segments, Segments::Detect(_)),
         table_samples,
+        files,
     })
 }
 
@@ -235,10 +255,17 @@ fn manifest(map: &ImportMap, segments: Vec<Segment>) -> Manifest {
         format: FORMAT.to_string(),
         station: ManifestStation {
             site: map.site,
-            table: TableAxes {
-                outer_axis: [0.0, -1.0, 0.0],
-                inner_axis: [1.0, 0.0, 0.0],
-                model: Some("none: synthesized by ratecal import from the segments".into()),
+            table: match &map.table {
+                Some(f) => TableAxes {
+                    outer_axis: f.outer_axis,
+                    inner_axis: f.inner_axis,
+                    model: Some(format!("feedback: {} (ratecal import)", f.file)),
+                },
+                None => TableAxes {
+                    outer_axis: [0.0, -1.0, 0.0],
+                    inner_axis: [1.0, 0.0, 0.0],
+                    model: Some("none: synthesized by ratecal import from the segments".into()),
+                },
             },
             mount: None,
         },
@@ -270,6 +297,10 @@ fn poses(kept: &[Found]) -> (Vec<Pose>, Vec<Segment>) {
             pitch_deg: None,
             roll_deg: None,
             mount: None,
+            up: match (f.kind, f.up) {
+                (SegmentKind::Static, Some(u)) => Some(u.name()),
+                _ => None,
+            },
         };
         let pose = match (f.up, f.rate) {
             (up, Some((axis, rate))) => {

@@ -18,14 +18,17 @@ pub struct Provenance {
     pub sources: Vec<FileHash>,
     /// How the samples were converted.
     pub conversion: Conversion,
-    /// `synthesized`: the table stream was made from the segments' declared attitudes.
+    /// `synthesized`: the table stream was made from the segments' declared attitudes;
+    /// `feedback`: read from the lab's feedback file.
     pub table: String,
+    /// The feedback file and its SHA-256.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub table_file: Option<FileHash>,
+    /// How the feedback was converted.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub table_conversion: Option<String>,
     /// `declared` (map) or `detected` (from the signal) or `none`.
     pub segments: String,
-    /// Static intervals with no body axis near vertical: not among the segments (the
-    /// six-position fits cannot use them), kept here for a multi-position calibration.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub oblique_static: Vec<Oblique>,
 }
 
 /// A file and its hash.
@@ -50,19 +53,6 @@ pub struct Conversion {
     pub axes: String,
     /// Samples imported.
     pub samples: u64,
-}
-
-/// An oblique static interval.
-#[derive(Debug, Serialize)]
-pub struct Oblique {
-    /// Id.
-    pub id: String,
-    /// Start, s.
-    pub t_start: f64,
-    /// End, s.
-    pub t_end: f64,
-    /// Mean specific force, body axes, m/s^2.
-    pub f_mean: [f64; 3],
 }
 
 impl Conversion {
@@ -100,6 +90,18 @@ impl Conversion {
             samples,
         }
     }
+}
+
+/// The feedback's conversion, written out.
+pub fn table_conversion(f: &crate::map::TableFeed) -> String {
+    let time = match &f.time {
+        TimeSpec::Rate(hz) => format!("t = i / {hz} Hz"),
+        TimeSpec::Column { col, to_s } => format!("t = column {:?} x {to_s} s", col.col),
+    };
+    format!(
+        "{time} + offset {} s; angles x {} deg (`{}`), rates x {} deg/s (`{}`)",
+        f.offset_s, f.angle.factor, f.angle.unit, f.rate.factor, f.rate.unit
+    )
 }
 
 /// `provenance:` as YAML, to follow the manifest.

@@ -13,7 +13,7 @@ pub use fixed::push_fixed;
 pub use streams::Columns;
 
 use crate::commit::crash_point;
-use crate::{FORMAT, ImuSample, Manifest, TableSample, WriteFailure};
+use crate::{FORMAT, ImuSample, Manifest, TableSample, WriteFailure, WrittenFile};
 use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
 use std::fs::{File, OpenOptions};
@@ -36,8 +36,9 @@ enum Msg {
     Hashes(mpsc::Sender<io::Result<Hashes>>),
 }
 
-/// The streams' SHA-256 at the end, and the write that failed, if one did.
-type Hashes = (String, String, Option<WriteFailure>);
+/// The streams as written (imu, table: SHA-256 and length), and the write that failed, if
+/// one did.
+type Hashes = (WrittenFile, WrittenFile, Option<WriteFailure>);
 
 /// Batches in flight before `write_*` waits: bounds memory if the disk is slow.
 const QUEUE: usize = 64;
@@ -65,6 +66,9 @@ pub struct RecordingWriter {
     pending_imu: Vec<ImuSample>,
     pending_table: Vec<TableSample>,
     cut: BTreeMap<String, u64>,
+    /// The streams as [`RecordingWriter::finish`] left them.
+    written: Vec<WrittenFile>,
+    failure: Option<WriteFailure>,
 }
 
 fn copy_err(e: &io::Error) -> io::Error {
@@ -111,9 +115,11 @@ fn writer_thread(mut st: Streams, rx: mpsc::Receiver<Msg>) -> u64 {
                 // A failed stream write is recorded and sealed as cut; any other failure
                 // (the journal, an fsync) leaves the recording unfinished.
                 let r = match (&failed, st.failure()) {
-                    (Some(_), Some(f)) => Ok((st.imu.sha256(), st.table.sha256(), Some(f.clone()))),
+                    (Some(_), Some(f)) => {
+                        Ok((st.imu.written(), st.table.written(), Some(f.clone())))
+                    }
                     (Some(e), None) => Err(copy_err(e)),
-                    (None, _) => Ok((st.imu.sha256(), st.table.sha256(), None)),
+                    (None, _) => Ok((st.imu.written(), st.table.written(), None)),
                 };
                 let _ = reply.send(r);
             }
@@ -142,19 +148,33 @@ impl RecordingWriter {
             pending_imu: Vec::with_capacity(BATCH_IMU),
             pending_table: Vec::with_capacity(BATCH_TABLE),
             cut: BTreeMap::new(),
+            written: Vec::new(),
+            failure: None,
         })
     }
 
     /// Creates `dir` (if needed) and the recording's files; writes the manifest once.
     pub fn create(dir: &Path, manifest: Manifest, columns: Columns) -> io::Result<Self> {
-        Self::create_with(dir, manifest, columns, false)
+        Self::create_with(dir, manifest, columns, false, true)
     }
 
     /// As [`RecordingWriter::create`], but the IMU stream's times and values are written in
     /// their shortest form that reads back to the same `f64` (an import: another system's
     /// samples kept exactly, not rounded to the format's usual decimals).
     pub fn create_exact(dir: &Path, manifest: Manifest, columns: Columns) -> io::Result<Self> {
-        Self::create_with(dir, manifest, columns, true)
+        Self::create_with(dir, manifest, columns, true, true)
+    }
+
+    /// As [`RecordingWriter::create_exact`], but the journal gets no running hash of the
+    /// streams (no `block` lines, [`crate::chain`]): for a caller that deletes
+    /// `journal.jsonl` when done (an import), so the folder is never resumed. The files
+    /// written are byte for byte those of [`RecordingWriter::create_exact`].
+    pub fn create_exact_unchained(
+        dir: &Path,
+        manifest: Manifest,
+        columns: Columns,
+    ) -> io::Result<Self> {
+        Self::create_with(dir, manifest, columns, true, false)
     }
 
     fn create_with(
@@ -162,10 +182,13 @@ impl RecordingWriter {
         manifest: Manifest,
         columns: Columns,
         exact: bool,
+        chained: bool,
     ) -> io::Result<Self> {
         std::fs::create_dir_all(dir)?;
-        let imu = Stream::create(&dir.join("imu.csv"), &columns.imu_header())?;
-        let table = Stream::create(&dir.join("table.csv"), &columns.table_header())?;
+        let mut imu = Stream::create(&dir.join("imu.csv"), &columns.imu_header())?;
+        let mut table = Stream::create(&dir.join("table.csv"), &columns.table_header())?;
+        imu.chained = chained;
+        table.chained = chained;
         let journal = File::create(dir.join("journal.jsonl"))?;
         let mut manifest = manifest;
         manifest.format = FORMAT.to_string();
@@ -231,6 +254,19 @@ impl RecordingWriter {
     /// crash), by file name.
     pub fn cut_tails(&self) -> &BTreeMap<String, u64> {
         &self.cut
+    }
+
+    /// The streams as [`RecordingWriter::finish`] left them (name, SHA-256, length), hashed
+    /// as they were written: a seal of the freshly written folder can take them instead of
+    /// reading the files again ([`crate::hash_folder_known`]). Empty before `finish`.
+    pub fn written(&self) -> &[WrittenFile] {
+        &self.written
+    }
+
+    /// The stream write that failed, as [`RecordingWriter::finish`] found it (the stream
+    /// then ends cut after its last full line).
+    pub fn write_failure(&self) -> Option<&WriteFailure> {
+        self.failure.as_ref()
     }
 
     /// The folder being written.
@@ -342,13 +378,17 @@ impl RecordingWriter {
         self.send(Msg::Hashes(tx))?;
         let (imu, table, failure) = rx.recv().map_err(|_| gone())??;
         if let Some(run) = self.manifest.run.as_mut() {
-            run.files_sha256.insert("imu.csv".into(), imu);
-            run.files_sha256.insert("table.csv".into(), table);
+            run.files_sha256
+                .insert("imu.csv".into(), imu.sha256.clone());
+            run.files_sha256
+                .insert("table.csv".into(), table.sha256.clone());
             run.ended = Some(rfc3339(std::time::SystemTime::now()));
             if failure.is_some() {
-                run.write_failure = failure;
+                run.write_failure = failure.clone();
             }
         }
+        self.written = vec![imu, table];
+        self.failure = failure;
         self.write_manifest()?;
         crash_point("after-manifest");
         Ok(())

@@ -91,6 +91,9 @@ pub(crate) struct Stream {
     buf: Vec<u8>,
     hash: Sha256,
     chain: Chain,
+    /// The chain is kept (its blocks recorded in the journal); off for a caller that keeps
+    /// no journal (an import), where it would be hashing for nothing.
+    pub(crate) chained: bool,
     written: u64,
     pub(crate) last_t: Option<f64>,
     /// The first write that failed: the stream takes no more.
@@ -105,6 +108,7 @@ impl Stream {
             buf: Vec::with_capacity(CHUNK + 512),
             hash,
             chain,
+            chained: true,
             written,
             last_t: None,
             failure: None,
@@ -204,7 +208,9 @@ impl Stream {
                 .map_or(0, |i| i + 1),
         };
         self.hash.update(&self.buf[..keep]);
-        self.chain.update(&self.buf[..keep]);
+        if self.chained {
+            self.chain.update(&self.buf[..keep]);
+        }
         self.written += keep as u64;
         self.buf.clear();
         let Some(e) = failed else {
@@ -236,7 +242,7 @@ impl Stream {
 
     /// The block written since the last record, when it is due (a full chunk, or `force`).
     pub(crate) fn due_record(&mut self, force: bool) -> Option<(BlockRecord, f64)> {
-        if !force && self.chain.open_len() < CHUNK as u64 {
+        if !self.chained || (!force && self.chain.open_len() < CHUNK as u64) {
             return None;
         }
         let t = self.last_t.unwrap_or(0.0);
@@ -245,6 +251,15 @@ impl Stream {
 
     pub(crate) fn sha256(&self) -> String {
         hex::encode(self.hash.clone().finalize())
+    }
+
+    /// The file as written so far: its name, SHA-256 and length.
+    pub(crate) fn written(&self) -> crate::WrittenFile {
+        crate::WrittenFile {
+            name: self.name.clone(),
+            sha256: self.sha256(),
+            len: self.written,
+        }
     }
 }
 
