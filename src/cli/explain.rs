@@ -219,6 +219,15 @@ pub fn main(args: Args) -> ExitCode {
             .map(|p| p.display().to_string())
             .unwrap_or_default();
         if let Some(out) = &args.write_twin {
+            // Discovered physics joins the twin as its draft effect file, written beside
+            // the corrected twin and referenced from it.
+            if let Err(e) = super::twin::write_drafts(&x, &mut r.changes, out, &args.run) {
+                errln!(
+                    "error: cannot write the draft effect beside {}: {e}",
+                    out.display()
+                );
+                return ExitCode::from(2);
+            }
             match super::twin::corrected(f, &r.changes, out) {
                 Ok((text, diff)) => {
                     if let Err(e) = std::fs::write(out, &text) {
@@ -298,6 +307,10 @@ pub fn main(args: Args) -> ExitCode {
             .collect();
     if let Some(svg) = twin.as_ref().and_then(|r| twin_figure(r, &value)) {
         figures.push(("explain-twin.svg".into(), svg));
+    }
+    // The twin's time series, one figure per kind of segment where it disagrees.
+    for (kind, svg) in render::twin_figures(&value) {
+        figures.push((format!("explain-twin-{kind}.svg"), svg));
     }
     // Kept in a ratecal run folder (not in another system's recording): its report shows it.
     if in_run {

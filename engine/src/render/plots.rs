@@ -15,6 +15,9 @@ pub struct Plots {
     pub findings: Vec<Option<String>>,
     /// Residuals before/after, one per explain.json finding.
     pub explain: Vec<Option<String>>,
+    /// The twin's time series, one per kind of segment where it disagrees (explain.json's
+    /// `twin.series`).
+    pub twin: Vec<String>,
 }
 
 /// Draws every plot the input has data for.
@@ -48,10 +51,19 @@ pub fn draw(input: &ReportInput) -> Plots {
         .into_iter()
         .map(|(_, svg)| svg)
         .collect();
+    let twin = input
+        .explain
+        .as_ref()
+        .map(super::twin::twin_figures)
+        .unwrap_or_default()
+        .into_iter()
+        .map(|(_, svg)| svg)
+        .collect();
     Plots {
         named,
         findings,
         explain,
+        twin,
     }
 }
 
