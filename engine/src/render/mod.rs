@@ -28,7 +28,7 @@ mod views;
 pub use context::CONTEXT_FORMAT;
 pub use error::{RenderError, TemplateError};
 pub use finding::{explain_figures, figure};
-pub use twin::twin_figures;
+pub use twin::{twin_figures, twin_residual_figure};
 
 use crate::fit::Source;
 use crate::plan::Plan;

@@ -15,8 +15,8 @@ pub struct Plots {
     pub findings: Vec<Option<String>>,
     /// Residuals before/after, one per explain.json finding.
     pub explain: Vec<Option<String>>,
-    /// The twin's time series, one per kind of segment where it disagrees (explain.json's
-    /// `twin.series`).
+    /// The twin's residual figure and its time series, one per kind of segment where it
+    /// disagrees (explain.json's `twin`).
     pub twin: Vec<String>,
 }
 
@@ -51,14 +51,14 @@ pub fn draw(input: &ReportInput) -> Plots {
         .into_iter()
         .map(|(_, svg)| svg)
         .collect();
-    let twin = input
-        .explain
-        .as_ref()
-        .map(super::twin::twin_figures)
-        .unwrap_or_default()
-        .into_iter()
-        .map(|(_, svg)| svg)
-        .collect();
+    // The twin's residual figure, then its time series per segment kind.
+    let twin = match &input.explain {
+        Some(x) => super::twin::twin_residual_figure(x)
+            .into_iter()
+            .chain(super::twin::twin_figures(x).into_iter().map(|(_, svg)| svg))
+            .collect(),
+        None => Vec::new(),
+    };
     Plots {
         named,
         findings,

@@ -42,6 +42,39 @@ pub fn twin_figures(explain: &Value) -> Vec<(String, String)> {
         .collect()
 }
 
+/// The twin's residual figure of an explain.json with `twin`: every segment's residual RMS
+/// against the twin as it is (orange) and updated (green), on the channels of the sensors
+/// where it disagrees (every channel when it agrees), the final model's noise floor in
+/// grey: explain's finding figure.
+pub fn twin_residual_figure(explain: &Value) -> Option<String> {
+    let twin = explain.get("twin")?;
+    let segments = |k: &str| {
+        twin.get(k)
+            .and_then(|p| p.get("segments"))
+            .and_then(Value::as_array)
+            .cloned()
+            .unwrap_or_default()
+    };
+    let rows: Vec<Value> = segments("before")
+        .iter()
+        .zip(&segments("after"))
+        .map(|(b, a)| {
+            serde_json::json!({ "segment": b["segment"], "channel": b["channel"],
+                "rms_before": b["rms"], "rms_after": a["rms"], "held_out": false })
+        })
+        .collect();
+    let located: Vec<Value> = twin
+        .get("before")
+        .and_then(|p| p.get("disagree"))
+        .and_then(Value::as_array)
+        .into_iter()
+        .flatten()
+        .map(|d| serde_json::json!({ "channel": d["channel"] }))
+        .collect();
+    let f = serde_json::json!({ "title": "twin", "residuals": rows, "located": located });
+    super::finding::figure(&f, explain.get("final").and_then(|f| f.get("noise_floor")))
+}
+
 fn text<'a>(v: &'a Value, key: &str) -> Option<&'a str> {
     v.get(key).and_then(Value::as_str)
 }

@@ -110,8 +110,8 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
         .map(|(x, y)| x * y)
         .sum();
     for (x, y) in ca.zip(cb) {
-        for i in 0..4 {
-            s[i] += x[i] * y[i];
+        for ((s, x), y) in s.iter_mut().zip(x).zip(y) {
+            *s += x * y;
         }
     }
     (s[0] + s[1]) + (s[2] + s[3]) + tail
