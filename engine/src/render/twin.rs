@@ -31,7 +31,7 @@ pub fn twin_figures(explain: &Value) -> Vec<(String, String)> {
             let charts: Vec<Chart> = series
                 .iter()
                 .filter(|s| text(s, "kind") == Some(kind))
-                .filter_map(|s| panel(s))
+                .filter_map(|&s| panel(s))
                 .collect();
             let svg = stack(
                 &format!("The twin against the recording: {kind} segments"),

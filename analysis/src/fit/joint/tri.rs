@@ -87,8 +87,7 @@ fn fold(stack: &mut DMatrix<f64>, cols: usize, rows: usize) {
         let beta = 2.0 / (v0 * v0 + sigma);
         cj[j] = alpha;
         let x = &cj[k..k + r];
-        for l in 0..k - j - 1 {
-            let cl = &mut tail[l * ld..(l + 1) * ld];
+        for cl in tail.chunks_exact_mut(ld).take(k - j - 1) {
             let f = beta * (v0 * cl[j] + dot(x, &cl[k..k + r]));
             cl[j] -= f * v0;
             for (xi, ai) in x.iter().zip(&mut cl[k..k + r]) {
