@@ -261,6 +261,7 @@ fn a_simulated_station_against_the_twin_of_another_station_file() {
         assert!(svg.starts_with("<svg") && svg.contains("twin"), "{f}");
     }
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    twin_series_follow_the_recording(dir, &v);
     let ch = changes(&v);
     let names: Vec<&str> = ch.iter().map(|c| c.0.as_str()).collect();
     assert_eq!(
@@ -284,6 +285,14 @@ fn a_simulated_station_against_the_twin_of_another_station_file() {
         "{report}"
     );
     assert!(report.contains("\n- `lever_arm.rzz_mm`: 0"), "{report}");
+    // The HTML report draws the twin's time series too.
+    let o = ratecal(&["report", "real", "--format", "html"], dir);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let html = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        html.contains("The twin against the recording: rate segments"),
+        "no time-series figure in the report"
+    );
     assert!(report.contains(" (the twin lacked it)\n"), "{report}");
     assert!(
         report.contains("Corrected station file: `updated.yaml`."),
@@ -505,4 +514,60 @@ fn a_user_effect_is_simulated_found_and_written_by_reference() {
         dir,
     );
     assert_eq!(code(&o), 0, "{}", text(&o));
+}
+
+/// The twin's time series (`twin.series`, `explain-twin-<kind>.svg`): the lever arm shows
+/// on the rate segments, where the twin as it is misses the centripetal acceleration the
+/// recording holds and the updated twin follows it; the figures are in `figs/` and in the
+/// run folder, with the three series.
+fn twin_series_follow_the_recording(dir: &Path, v: &serde_json::Value) {
+    let series = v["twin"]["series"].as_array().unwrap();
+    assert!(!series.is_empty(), "no series");
+    let kinds: Vec<&str> = series.iter().map(|s| s["kind"].as_str().unwrap()).collect();
+    assert!(kinds.contains(&"rate"), "{kinds:?}");
+    for s in series {
+        let get = |k: &str| -> Vec<f64> {
+            s[k].as_array()
+                .unwrap()
+                .iter()
+                .map(|x| x.as_f64().unwrap())
+                .collect()
+        };
+        let (t, real, before, after) = (get("t_s"), get("real"), get("before"), get("after"));
+        assert!(t.len() > 5 && t.len() <= 240, "{}", t.len());
+        assert!(real.len() == t.len() && before.len() == t.len() && after.len() == t.len());
+        let off = |p: &[f64]| -> f64 {
+            (real
+                .iter()
+                .zip(p)
+                .map(|(r, p)| (r - p).powi(2))
+                .sum::<f64>()
+                / t.len() as f64)
+                .sqrt()
+        };
+        // Elsewhere a disagreement may be the gyro bias's wander, which no twin predicts.
+        if s["kind"] != "rate" {
+            continue;
+        }
+        assert!(
+            off(&after) < 0.2 * off(&before),
+            "{} {}: the updated twin is {} off, the twin as it is {}",
+            s["segment"],
+            s["channel"],
+            off(&after),
+            off(&before)
+        );
+    }
+    for kind in kinds {
+        for f in [
+            format!("figs/explain-twin-{kind}.svg"),
+            format!("real/explain-twin-{kind}.svg"),
+        ] {
+            let svg = std::fs::read_to_string(dir.join(&f)).unwrap();
+            assert!(svg.starts_with("<svg"), "{f}");
+            for name in ["recording", "twin as it is", "twin updated"] {
+                assert!(svg.contains(name), "{f}: no {name}");
+            }
+        }
+    }
 }

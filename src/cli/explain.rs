@@ -219,6 +219,15 @@ pub fn main(args: Args) -> ExitCode {
             .map(|p| p.display().to_string())
             .unwrap_or_default();
         if let Some(out) = &args.write_twin {
+            // Discovered physics joins the twin as its draft effect file, written beside
+            // the corrected twin and referenced from it.
+            if let Err(e) = super::twin::write_drafts(&x, &mut r.changes, out, &args.run) {
+                errln!(
+                    "error: cannot write the draft effect beside {}: {e}",
+                    out.display()
+                );
+                return ExitCode::from(2);
+            }
             match super::twin::corrected(f, &r.changes, out) {
                 Ok((text, diff)) => {
                     if let Err(e) = std::fs::write(out, &text) {
@@ -296,8 +305,15 @@ pub fn main(args: Args) -> ExitCode {
             .into_iter()
             .filter_map(|(effect, svg)| Some((format!("explain-{effect}.svg"), svg?)))
             .collect();
-    if let Some(svg) = twin.as_ref().and_then(|r| twin_figure(r, &value)) {
+    if let Some(svg) = twin
+        .as_ref()
+        .and_then(|_| render::twin_residual_figure(&value))
+    {
         figures.push(("explain-twin.svg".into(), svg));
+    }
+    // The twin's time series, one figure per kind of segment where it disagrees.
+    for (kind, svg) in render::twin_figures(&value) {
+        figures.push((format!("explain-twin-{kind}.svg"), svg));
     }
     // Kept in a ratecal run folder (not in another system's recording): its report shows it.
     if in_run {
@@ -392,28 +408,4 @@ fn same_dir(a: &Path, b: &Path) -> bool {
         (Ok(a), Ok(b)) => a == b,
         _ => false,
     }
-}
-
-/// The twin's figure: every segment's residual RMS against the twin as it is (orange) and
-/// updated (green), on the channels of the sensors where it disagrees (every channel when
-/// it agrees), the final model's noise floor in grey: explain's finding figure.
-fn twin_figure(r: &ratecal_engine::twin::TwinReport, x: &serde_json::Value) -> Option<String> {
-    let rows: Vec<serde_json::Value> = r
-        .before
-        .segments
-        .iter()
-        .zip(&r.after.segments)
-        .map(|(b, a)| {
-            serde_json::json!({ "segment": b.segment, "channel": b.channel,
-                "rms_before": b.rms, "rms_after": a.rms, "held_out": false })
-        })
-        .collect();
-    let located: Vec<serde_json::Value> = r
-        .before
-        .disagree
-        .iter()
-        .map(|d| serde_json::json!({ "channel": d.channel }))
-        .collect();
-    let f = serde_json::json!({ "title": "twin", "residuals": rows, "located": located });
-    render::figure(&f, x.get("final").and_then(|f| f.get("noise_floor")))
 }

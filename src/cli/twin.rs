@@ -206,3 +206,30 @@ fn relative_to(file: &Path, out: &Path) -> String {
         _ => file.display().to_string(),
     }
 }
+
+/// Writes the draft `.effect` file of every discovered finding the changes add beside
+/// `out` (the corrected twin), and points those changes at it (`defined_in`), so that the
+/// corrected file references it under `imu.user_effects`.
+pub fn write_drafts(
+    x: &ratecal_engine::explain::Explanation,
+    changes: &mut [Change],
+    out: &Path,
+    run: &Path,
+) -> std::io::Result<()> {
+    use ratecal_engine::explain::draft;
+    let dir = out.parent().unwrap_or(Path::new(""));
+    for f in x.findings.iter().filter(|f| f.discovered) {
+        if !changes.iter().any(|c| c.effect == f.effect) {
+            continue;
+        }
+        let Some(text) = draft::effect_file(f, &run.display().to_string()) else {
+            continue;
+        };
+        let path = dir.join(draft::file_name(f));
+        std::fs::write(&path, text)?;
+        for c in changes.iter_mut().filter(|c| c.effect == f.effect) {
+            c.defined_in = Some(path.display().to_string());
+        }
+    }
+    Ok(())
+}

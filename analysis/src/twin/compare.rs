@@ -43,12 +43,19 @@ pub(super) fn report(
         .filter(|(e, _)| !own.contains(e))
         .collect();
     let earth = lay.index("earth_rate").expect("a registry id");
+    let discovered = super::discovered::terms(data, x);
+    let mut effects: Vec<usize> = own
+        .iter()
+        .chain(found.iter().map(|f| &f.0))
+        .copied()
+        .collect();
+    for d in &discovered {
+        if !effects.contains(&d.probe) {
+            effects.push(d.probe);
+        }
+    }
     let terms = Terms {
-        effects: own
-            .iter()
-            .chain(found.iter().map(|f| &f.0))
-            .copied()
-            .collect(),
+        effects,
         fixed: vec![(
             earth,
             ratecal_physics::effects::EarthRate::values(m.station.site.latitude_deg).to_vec(),
@@ -154,14 +161,33 @@ pub(super) fn report(
             });
         }
     }
+    // A discovered form is the draft effect's parameter `k_<channel>`, added (`from` 0).
+    let mut th_discovered = Vec::new();
+    for d in &discovered {
+        let g = d.column;
+        if !ok(g) {
+            continue;
+        }
+        th_discovered.push((g, f.theta[g]));
+        changes.push(Change {
+            effect: d.effect.clone(),
+            parameter: format!("k_{}", d.channel),
+            from: 0.0,
+            to: f.theta[g],
+            u: f.u(g),
+            unit: d.unit.clone(),
+            standard_errors: (f.theta[g] / f.u(g)).abs(),
+            added: true,
+            defined_in: None,
+        });
+    }
     let updated = update::updated(twin, &changes, lay);
-    let after = predict(
-        m,
-        data,
-        &updated,
-        &theta(m, data, &updated, t_ref_data),
-        &white,
-    );
+    let mut th_updated = theta(m, data, &updated, t_ref_data);
+    for (g, v) in th_discovered {
+        th_updated[g] = v;
+    }
+    let after = predict(m, data, &updated, &th_updated, &white);
+    let series = super::series::pick(m, data, &before, &th_twin, &th_updated);
     let needs_change = !changes.is_empty() || !x.findings.is_empty() || !x.unexplained.is_empty();
     TwinReport {
         station: String::new(),
@@ -171,5 +197,6 @@ pub(super) fn report(
         needs_change,
         written: None,
         diff: None,
+        series,
     }
 }

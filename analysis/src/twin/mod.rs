@@ -7,12 +7,14 @@
 //! hands its terms in. Everything is solved from explain's single pass over the samples.
 
 mod compare;
+mod discovered;
 mod output;
 mod predict;
+mod series;
 mod text;
 mod update;
 
-pub use output::{Change, Prediction, SegmentResidual, TwinReport};
+pub use output::{Change, Prediction, SegmentResidual, Series, TwinReport};
 pub use text::render_text;
 
 use crate::explain::{self, Explanation, NominalModel, Options};

@@ -24,6 +24,31 @@ pub struct TwinReport {
     /// The unified diff from the twin to the written file.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub diff: Option<String>,
+    /// Time series of the segments where the twin disagrees most (a few per segment kind):
+    /// what the twin's figures per kind draw.
+    #[serde(default)]
+    pub series: Vec<Series>,
+}
+
+/// One segment's channel in time: the recording's output and the twin's prediction as it is
+/// and updated, each minus the ideal input (the IMU model's part of the output), in means
+/// over one second or more.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Series {
+    /// Segment id.
+    pub segment: String,
+    /// Its kind (`static`, `rate`, `oscillation`).
+    pub kind: String,
+    /// Channel, `ax` ... `gz`.
+    pub channel: String,
+    /// Mean stamp of each point, s since the segment's start.
+    pub t_s: Vec<f64>,
+    /// The recording (m/s^2 or deg/s).
+    pub real: Vec<f64>,
+    /// The twin as it is.
+    pub before: Vec<f64>,
+    /// The twin updated.
+    pub after: Vec<f64>,
 }
 
 /// A twin's prediction of every sample of the recording's segments, against the samples.

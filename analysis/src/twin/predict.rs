@@ -170,7 +170,7 @@ pub(super) fn predict(
     }
 }
 
-fn kind_name(k: crate::recording::SegmentKind) -> &'static str {
+pub(super) fn kind_name(k: crate::recording::SegmentKind) -> &'static str {
     use crate::recording::SegmentKind as K;
     match k {
         K::Static => "static",

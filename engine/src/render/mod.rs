@@ -22,11 +22,13 @@ mod finding;
 mod plots;
 mod process;
 pub mod svg;
+mod twin;
 mod views;
 
 pub use context::CONTEXT_FORMAT;
 pub use error::{RenderError, TemplateError};
 pub use finding::{explain_figures, figure};
+pub use twin::{twin_figures, twin_residual_figure};
 
 use crate::fit::Source;
 use crate::plan::Plan;
@@ -320,6 +322,16 @@ fn context(input: &ReportInput, template: &str) -> Value {
     p.insert(
         "explain".into(),
         Value::from(plots.explain.into_iter().map(safe).collect::<Vec<_>>()),
+    );
+    p.insert(
+        "twin".into(),
+        Value::from(
+            plots
+                .twin
+                .into_iter()
+                .map(|s| safe(Some(s)))
+                .collect::<Vec<_>>(),
+        ),
     );
     map.insert("plots".into(), Value::from(p));
     map.insert("template".into(), Value::from(template));

@@ -15,6 +15,9 @@ pub struct Plots {
     pub findings: Vec<Option<String>>,
     /// Residuals before/after, one per explain.json finding.
     pub explain: Vec<Option<String>>,
+    /// The twin's residual figure and its time series, one per kind of segment where it
+    /// disagrees (explain.json's `twin`).
+    pub twin: Vec<String>,
 }
 
 /// Draws every plot the input has data for.
@@ -48,10 +51,19 @@ pub fn draw(input: &ReportInput) -> Plots {
         .into_iter()
         .map(|(_, svg)| svg)
         .collect();
+    // The twin's residual figure, then its time series per segment kind.
+    let twin = match &input.explain {
+        Some(x) => super::twin::twin_residual_figure(x)
+            .into_iter()
+            .chain(super::twin::twin_figures(x).into_iter().map(|(_, svg)| svg))
+            .collect(),
+        None => Vec::new(),
+    };
     Plots {
         named,
         findings,
         explain,
+        twin,
     }
 }
 

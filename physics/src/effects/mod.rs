@@ -98,6 +98,7 @@ pub struct Partials {
 
 impl Partials {
     /// `v` on axis `i` of `sensor`, zero on every other output.
+    #[inline]
     pub fn axis(sensor: Sensor, i: usize, v: f64) -> Self {
         let mut p = Partials::default();
         match sensor {
@@ -108,6 +109,7 @@ impl Partials {
     }
 
     /// The partials of one sensor.
+    #[inline]
     pub fn of(&self, s: Sensor) -> &Vec3 {
         match s {
             Sensor::Accel => &self.accel,

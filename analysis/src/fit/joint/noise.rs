@@ -17,11 +17,14 @@ pub(crate) struct ChannelNoise {
     pub q: f64,
 }
 
-/// Residual mean of a block for coefficients `theta_c` (the channel's own columns).
-fn block_mean(b: &Block, c: usize, theta_c: &[f64]) -> f64 {
+/// Residual mean of a block for the channel's coefficients `nonzero` (`(column within the
+/// channel, coefficient)`, the zero ones left out: a model holds a few of the channel's
+/// many columns, and skipping a zero term leaves the sum as it was).
+fn block_mean(b: &Block, c: usize, nonzero: &[(usize, f64)]) -> f64 {
     let mut s = b.sy[c];
-    for (x, th) in b.sx[c].iter().zip(theta_c) {
-        s -= x * th;
+    let sx = &b.sx[c];
+    for &(k, th) in nonzero {
+        s -= sx[k] * th;
     }
     s / b.n as f64
 }
@@ -33,11 +36,17 @@ pub(crate) fn estimate(accs: &[&SegAcc], c: usize, theta_c: &[f64], sigma: f64) 
     // Random walk from ten-second groups.
     let mut groups: Vec<(f64, f64, usize, f64)> = Vec::new(); // (span in blocks, t, n, mean)
     let mut pairs = Vec::new();
+    let nonzero: Vec<(usize, f64)> = theta_c
+        .iter()
+        .enumerate()
+        .filter(|(_, th)| **th != 0.0)
+        .map(|(k, th)| (k, *th))
+        .collect();
     for acc in accs {
         let means: Vec<(f64, usize, f64)> = acc
             .blocks
             .iter()
-            .map(|b| (b.t, b.n, block_mean(b, c, theta_c)))
+            .map(|b| (b.t, b.n, block_mean(b, c, &nonzero)))
             .collect();
         for w in means.windows(2) {
             let (n1, n2) = (w[0].1 as f64, w[1].1 as f64);
@@ -93,13 +102,17 @@ pub(crate) fn random_walk_gram(
     blocks.sort_by(|a, b| a.t.total_cmp(&b.t));
     let mut m = DMatrix::zeros(p, p);
     let mut suffix = DVector::zeros(p);
+    // The channel's columns in the model: the model holds few of them.
+    let used: Vec<(usize, usize)> = local
+        .iter()
+        .enumerate()
+        .filter_map(|(k, l)| Some((k, (*l)?)))
+        .collect();
     // Walk backwards: suffix sums of the regressors after each gap.
     for w in (1..blocks.len()).rev() {
         let b = blocks[w];
-        for (k, x) in b.sx[c].iter().enumerate() {
-            if let Some(l) = local[k] {
-                suffix[l] += x;
-            }
+        for &(k, l) in &used {
+            suffix[l] += b.sx[c][k];
         }
         let gap = b.t - blocks[w - 1].t;
         m.ger(gap, &suffix, &suffix, 1.0);
