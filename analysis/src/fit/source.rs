@@ -155,6 +155,9 @@ impl Source for Recording {
 #[derive(Debug, Clone)]
 pub struct Streamed {
     open: OpenRecording,
+    /// The IMU's mean temperature once read: a whole pass over the stream, which explain's
+    /// accumulation and the twin's comparison both ask for.
+    mean_temp: std::sync::OnceLock<f64>,
 }
 
 impl Streamed {
@@ -164,6 +167,7 @@ impl Streamed {
     pub fn open(dir: &Path) -> Result<Self, RecordingError> {
         Ok(Streamed {
             open: Recording::open(dir)?,
+            mean_temp: std::sync::OnceLock::new(),
         })
     }
 }
@@ -196,7 +200,11 @@ impl Source for Streamed {
     }
 
     fn mean_temp(&self) -> Result<f64, RecordingError> {
-        Ok(self.open.imu_mean_temp()?.unwrap_or(0.0))
+        if let Some(&t) = self.mean_temp.get() {
+            return Ok(t);
+        }
+        let t = self.open.imu_mean_temp()?.unwrap_or(0.0);
+        Ok(*self.mean_temp.get_or_init(|| t))
     }
 
     fn rows<R>(
