@@ -238,7 +238,7 @@ pub(crate) fn explain_data(
             .iter()
             .map(|d| discovered::finding(m, data, d, &registry_terms, &whole.0)),
     );
-    let mut unexplained = unexplained::leftover(m, data, &terms, opts.alpha);
+    let mut unexplained = unexplained::leftover(m, data, &terms, &whole.0, opts.alpha);
     if debug {
         eprintln!("leftover tested in {:?}", clock.elapsed());
     }

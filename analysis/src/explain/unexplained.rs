@@ -36,13 +36,18 @@ struct Test {
     fit: usize,
 }
 
-/// Tests the final model `terms` for leftover structure; `alpha` is the family-wise
-/// threshold over every test.
-pub(crate) fn leftover(m: &Manifest, data: &Data, terms: &Terms, alpha: f64) -> Vec<Unexplained> {
+/// Tests the final model `terms` for leftover structure; `base` is its fit on every
+/// segment (explain has it already), `alpha` the family-wise threshold over every test.
+pub(crate) fn leftover(
+    m: &Manifest,
+    data: &Data,
+    terms: &Terms,
+    base: &Fit,
+    alpha: f64,
+) -> Vec<Unexplained> {
     use rayon::prelude::*;
     let lay = &data.layout;
     let all: Vec<usize> = (0..data.accs.len()).collect();
-    let (base, _) = fit(data, terms, &all, &all);
     // Screened with white noise alone; the strongest of each sensor get the honest
     // covariance. The correction still counts every probe's every column.
     let short = super::probe::screen(data, terms, &all, SCREEN);
@@ -98,7 +103,7 @@ pub(crate) fn leftover(m: &Manifest, data: &Data, terms: &Terms, alpha: f64) -> 
         let mut forms: Vec<(f64, f64, Signature)> = Vec::new();
         for &c in &channels {
             let sigma = base.noise[c].sigma.max(1e-300);
-            let before = misfit(data, &base, c, &all, sigma);
+            let before = misfit(data, base, c, &all, sigma);
             let drops: Vec<(&Test, f64)> = tests
                 .iter()
                 .filter(|t| t.c == c)
