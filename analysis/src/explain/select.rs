@@ -46,6 +46,11 @@ pub(crate) fn wald(fit: &Fit, cols: &[usize]) -> (f64, usize) {
     }
     let cov = DMatrix::from_fn(k, k, |i, j| fit.cov[(est[i], est[j])]);
     let th = nalgebra::DVector::from_fn(k, |i, _| fit.theta[est[i]]);
+    // A non-finite covariance or value says nothing (and nalgebra's SVD of a non-finite
+    // matrix never converges).
+    if cov.iter().chain(th.iter()).any(|v| !v.is_finite()) {
+        return (0.0, 0);
+    }
     // Pseudo-inverse: a direction the covariance cannot resolve adds nothing.
     let Ok(pinv) = cov.clone().pseudo_inverse(1e-12 * cov.norm()) else {
         return (0.0, 0);
