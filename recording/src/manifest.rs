@@ -127,6 +127,26 @@ pub struct Segment {
 }
 
 impl Segment {
+    /// A segment of `kind` over `[t_start, t_end]` with none of the optional keys: callers
+    /// set the ones their motion has.
+    pub fn new(id: String, kind: SegmentKind, t_start: f64, t_end: f64) -> Self {
+        Segment {
+            id,
+            kind,
+            t_start,
+            t_end,
+            axis: None,
+            rate_dps: None,
+            amplitude_deg: None,
+            period_s: None,
+            center_deg: None,
+            pitch_deg: None,
+            roll_deg: None,
+            mount: None,
+            up: None,
+        }
+    }
+
     /// Whether the segment is an oblique static pose (`up: oblique`).
     pub fn is_oblique(&self) -> bool {
         self.up.as_deref() == Some("oblique")

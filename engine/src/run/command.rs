@@ -130,21 +130,7 @@ impl CmdState {
         t_end: f64,
         last: Option<&TableSample>,
     ) -> Segment {
-        let mut seg = Segment {
-            id,
-            kind: SegmentKind::Static,
-            t_start,
-            t_end,
-            axis: None,
-            rate_dps: None,
-            amplitude_deg: None,
-            period_s: None,
-            center_deg: None,
-            pitch_deg: None,
-            roll_deg: None,
-            mount: None,
-            up: None,
-        };
+        let mut seg = Segment::new(id, SegmentKind::Static, t_start, t_end);
         let pick = |want: fn(&AxisCmd) -> bool| -> Option<Axis> {
             match self.last_axis {
                 Some(a) if want(&self.axis(a)) => Some(a),

@@ -186,21 +186,8 @@ pub fn record(x: &Experiment, imu: &ImuErrors) -> Recording {
             }
             t_now = t0 + n as f64 * dt;
             let name = ["x", "y", "z"][axis];
-            let mut seg = Segment {
-                id: String::new(),
-                kind: SegmentKind::Static,
-                t_start: t0 + 1.0,
-                t_end: t_now - 1.0,
-                axis: None,
-                rate_dps: None,
-                amplitude_deg: None,
-                period_s: None,
-                center_deg: None,
-                pitch_deg: None,
-                roll_deg: None,
-                mount: first.then_some(mount),
-                up: None,
-            };
+            let mut seg = Segment::new(String::new(), SegmentKind::Static, t0 + 1.0, t_now - 1.0);
+            seg.mount = first.then_some(mount);
             match period {
                 None if first => seg.id = format!("align/{name}"),
                 None => continue,

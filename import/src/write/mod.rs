@@ -284,23 +284,10 @@ fn poses(kept: &[Found]) -> (Vec<Pose>, Vec<Segment>) {
     let mut last = (0.0, 0.0);
     for f in kept {
         let (t0, t1) = f.stretch.t;
-        let mut seg = Segment {
-            id: f.id.clone(),
-            kind: f.kind,
-            t_start: t0,
-            t_end: t1,
-            axis: None,
-            rate_dps: None,
-            amplitude_deg: None,
-            period_s: None,
-            center_deg: None,
-            pitch_deg: None,
-            roll_deg: None,
-            mount: None,
-            up: match (f.kind, f.up) {
-                (SegmentKind::Static, Some(u)) => Some(u.name()),
-                _ => None,
-            },
+        let mut seg = Segment::new(f.id.clone(), f.kind, t0, t1);
+        seg.up = match (f.kind, f.up) {
+            (SegmentKind::Static, Some(u)) => Some(u.name()),
+            _ => None,
         };
         let pose = match (f.up, f.rate) {
             (up, Some((axis, rate))) => {
