@@ -51,12 +51,26 @@ pub(crate) fn wald(fit: &Fit, cols: &[usize]) -> (f64, usize) {
     if cov.iter().chain(th.iter()).any(|v| !v.is_finite()) {
         return (0.0, 0);
     }
-    // Pseudo-inverse: a direction the covariance cannot resolve adds nothing.
-    let Ok(pinv) = cov.clone().pseudo_inverse(1e-12 * cov.norm()) else {
+    // Pseudo-inverse by the symmetric eigen-decomposition, with a bounded number of
+    // sweeps (nalgebra's `pseudo_inverse` runs an SVD with no bound, which on an
+    // ill-conditioned matrix can run forever): a direction the covariance cannot resolve
+    // adds nothing.
+    let tol = 1e-12 * cov.norm();
+    let Some(eig) = nalgebra::SymmetricEigen::try_new(cov, f64::EPSILON, EIGEN_SWEEPS) else {
         return (0.0, 0);
     };
-    ((th.transpose() * pinv * &th)[(0, 0)], k)
+    let proj = eig.eigenvectors.transpose() * &th;
+    let chi2 = proj
+        .iter()
+        .zip(eig.eigenvalues.iter())
+        .filter(|(_, l)| **l > tol)
+        .map(|(p, l)| p * p / l)
+        .sum();
+    (chi2, k)
 }
+
+/// Iterations allowed to an eigen-decomposition before it is given up as not converging.
+const EIGEN_SWEEPS: usize = 10_000;
 
 /// Upper-tail probability of a chi-square statistic.
 pub(crate) fn p_value(chi2: f64, dof: usize) -> f64 {

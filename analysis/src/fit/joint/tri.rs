@@ -1,5 +1,5 @@
 //! Least squares kept as a triangle: rows are folded into an upper-triangular factor by
-//! Householder QR (nalgebra), a block at a time, so a design matrix of any length is never
+//! Householder reflections, a block at a time, so a design matrix of any length is never
 //! held whole and the normal equations are never formed.
 
 use nalgebra::DMatrix;
@@ -50,15 +50,7 @@ impl Tri {
         if self.rows == 0 {
             return;
         }
-        let c = self.cols;
-        let full = std::mem::replace(&mut self.stack, DMatrix::zeros(c + BLOCK, c));
-        let used = if self.rows == BLOCK {
-            full
-        } else {
-            full.rows(0, c + self.rows).into_owned()
-        };
-        let r = triangle(used, c);
-        self.stack.view_mut((0, 0), (c, c)).copy_from(&r);
+        fold(&mut self.stack, self.cols, self.rows);
         self.rows = 0;
     }
 
@@ -68,6 +60,91 @@ impl Tri {
         let c = self.cols;
         self.stack.rows(0, c).into_owned()
     }
+}
+
+/// Folds the `rows` rows below the upper-triangular `R` (the first `cols` rows of
+/// `stack`) into it by Householder reflections, in place. A reflection of column `j`
+/// involves `R`'s row `j` and the new rows only (the rest of the column is zero), so a fold
+/// costs `2 rows cols^2` flops, and the stack is never copied. The rows below `R` are left
+/// as scratch.
+///
+/// Each reflection is LAPACK's (`dlarfg`/`dlarf`): `H = I - tau u u^T` with `u = [1; x /
+/// v0]` and `tau` in `[1, 2]`, so no step divides by a square of the column's size. A
+/// column of tiny values (a decay long gone, 1e-150) would otherwise underflow `|v|^2` to a
+/// subnormal or zero and make its `2 / |v|^2` infinite: every later column of the factor,
+/// and every fit that uses it, would be NaN.
+fn fold(stack: &mut DMatrix<f64>, cols: usize, rows: usize) {
+    let (k, r) = (cols, rows);
+    let ld = stack.nrows();
+    let a = stack.as_mut_slice();
+    for j in 0..k {
+        let (head, tail) = a.split_at_mut((j + 1) * ld);
+        let cj = &mut head[j * ld..];
+        let x0 = cj[j];
+        let x = &mut cj[k..k + r];
+        let Some(norm) = column_norm(x0, x) else {
+            continue;
+        };
+        let alpha = if x0 > 0.0 { -norm } else { norm };
+        // |v0| is between |alpha| and 2 |alpha|: x / v0 stays within [-1, 1].
+        let v0 = x0 - alpha;
+        let tau = -v0 / alpha;
+        let inv = 1.0 / v0;
+        for xi in x.iter_mut() {
+            *xi *= inv;
+        }
+        cj[j] = alpha;
+        let u = &cj[k..k + r];
+        for cl in tail.chunks_exact_mut(ld).take(k - j - 1) {
+            let f = tau * (cl[j] + dot(u, &cl[k..k + r]));
+            cl[j] -= f;
+            for (ui, ai) in u.iter().zip(&mut cl[k..k + r]) {
+                *ai -= f * ui;
+            }
+        }
+    }
+}
+
+/// `|[x0; x]|` when `x` has something to fold (`None` when it is all zeros, or so small
+/// that the column is zero to within what a double holds), computed without underflow
+/// or overflow.
+fn column_norm(x0: f64, x: &[f64]) -> Option<f64> {
+    let sigma = dot(x, x);
+    let norm = if sigma > 1e-200 && sigma < 1e200 {
+        (x0 * x0 + sigma).sqrt()
+    } else if sigma.is_nan() {
+        f64::NAN
+    } else {
+        // Scaled by the largest entry: nothing squared leaves the range of a double.
+        let amax = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if amax == 0.0 {
+            return None;
+        }
+        let amax = amax.max(x0.abs());
+        let s = (x0 / amax).powi(2) + x.iter().map(|v| (v / amax).powi(2)).sum::<f64>();
+        amax * s.sqrt()
+    };
+    // A column below the smallest normal double folds nothing a fit could see.
+    (!(norm < f64::MIN_POSITIVE)).then_some(norm)
+}
+
+/// `a . b` in four running sums, which the compiler keeps in vector registers (one
+/// running sum is a chain of dependent additions).
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut s = [0.0f64; 4];
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let tail: f64 = ca
+        .remainder()
+        .iter()
+        .zip(cb.remainder())
+        .map(|(x, y)| x * y)
+        .sum();
+    for (x, y) in ca.zip(cb) {
+        for ((s, x), y) in s.iter_mut().zip(x).zip(y) {
+            *s += x * y;
+        }
+    }
+    (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
 /// The `cols x cols` upper-triangular factor of a stack of rows.
@@ -98,5 +175,76 @@ mod tests {
         let g = a.transpose() * &a;
         let h = r.transpose() * &r;
         assert!((g - h).norm() < 1e-8 * 1000.0);
+    }
+
+    #[test]
+    fn folding_agrees_with_a_full_qr_up_to_row_signs() {
+        let mut t = Tri::new(5);
+        let mut rows = Vec::new();
+        for i in 0..700 {
+            let x = i as f64 * 0.013;
+            let row = [1.0, x, x * x, (3.0 * x).cos(), 0.2 - x + (x * 11.0).sin()];
+            t.push(&row);
+            rows.extend_from_slice(&row);
+        }
+        let a = DMatrix::from_row_slice(700, 5, &rows);
+        let (r, q) = (t.finish(), triangle(a, 5));
+        for i in 0..5 {
+            let s = (r[(i, i)] * q[(i, i)]).signum();
+            for j in 0..5 {
+                assert!(
+                    (r[(i, j)] - s * q[(i, j)]).abs() < 1e-9 * q.norm(),
+                    "{i} {j}"
+                );
+                if j < i {
+                    assert_eq!(r[(i, j)], 0.0);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn columns_of_tiny_values_fold_without_nan() {
+        // A decay long gone (1e-160) beside ordinary columns: its squares are subnormal,
+        // and `2 / |v|^2` would be infinite.
+        let mut t = Tri::new(4);
+        let mut rows = Vec::new();
+        for i in 0..600 {
+            let x = i as f64 * 0.01;
+            let row = [1.0, 1e-160 * (1.0 + x), 1e-170 * x.cos(), 0.3 + x];
+            t.push(&row);
+            rows.extend_from_slice(&row);
+        }
+        let r = t.finish();
+        assert!(r.iter().all(|v| v.is_finite()), "{r}");
+        // Columns 0 and 3 are as a full QR gives them.
+        let a = DMatrix::from_row_slice(600, 4, &rows);
+        let g = a.transpose() * &a;
+        let h = r.transpose() * &r;
+        for (i, j) in [(0, 0), (0, 3), (3, 3)] {
+            assert!(
+                (g[(i, j)] - h[(i, j)]).abs() < 1e-12 * g[(i, j)].abs(),
+                "{i} {j}"
+            );
+        }
+        // The tiny column keeps its length (compared scaled up, out of the subnormals).
+        let want = (0..600)
+            .map(|i| (1.0 + i as f64 * 0.01).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let got = (r.column(1) * 1e160).norm();
+        assert!((got / want - 1.0).abs() < 1e-12, "{got} {want}");
+    }
+
+    #[test]
+    fn an_all_zero_column_stays_zero() {
+        let mut t = Tri::new(3);
+        for i in 0..300 {
+            t.push(&[1.0, 0.0, i as f64]);
+        }
+        let r = t.finish();
+        assert!(r.iter().all(|v| v.is_finite()));
+        assert_eq!(r.column(1).norm(), 0.0);
+        assert_eq!(r.row(1).norm(), 0.0);
     }
 }

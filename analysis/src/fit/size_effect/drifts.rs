@@ -206,7 +206,11 @@ fn run(rec: &Recording, ci: usize, cycle: &Cycle, out: &mut Runs) -> Result<(), 
         let cov = w_t[k0..k1]
             .iter()
             .fold(Mat3::zeros(), |m, w| m + w * w.transpose());
-        let eig = cov.symmetric_eigen();
+        // Bounded (nalgebra's plain `symmetric_eigen` iterates without limit).
+        let Some(eig) = nalgebra::SymmetricEigen::try_new(cov, f64::EPSILON, 10_000) else {
+            leave(out, "the table's rate in this segment is not finite".into());
+            continue;
+        };
         let imax = eig.eigenvalues.imax();
         let axis_b: Vec3 = eig.eigenvectors.column(imax).into();
         let axis_l = nav.c_lb[(k0 + k1) / 2] * axis_b;

@@ -192,7 +192,13 @@ pub(crate) fn solve(drifts: Vec<SegmentDrift>, rests: Vec<RestDrift>, est: &mut 
     let (x, cov, keep, shifts) = loop {
         let keep: Vec<usize> = coords.iter().chain(&instr).copied().collect();
         let ak = a.select_columns(&keep);
-        let svd = ak.clone().svd(true, true);
+        // Bounded: nalgebra's plain `svd` iterates without limit on a matrix it cannot
+        // converge on.
+        let Some(svd) = ak.clone().try_svd(true, true, f64::EPSILON, 10_000) else {
+            est.warnings
+                .push("size effect: the least-squares decomposition did not converge".into());
+            return;
+        };
         let sv = &svd.singular_values;
         let smax = sv.max();
         let tol = 1e-9 * smax;
