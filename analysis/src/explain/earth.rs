@@ -40,6 +40,10 @@ static PARAMS: [Param; 2] = [
 ];
 
 impl Effect for EarthHeld {
+    fn varies_at_rest(&self) -> bool {
+        false
+    }
+
     fn id(&self) -> &'static str {
         "earth_rate"
     }

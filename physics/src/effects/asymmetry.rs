@@ -55,6 +55,10 @@ impl Asymmetry {
 }
 
 impl Effect for Asymmetry {
+    fn varies_at_rest(&self) -> bool {
+        false
+    }
+
     fn id(&self) -> &'static str {
         match self.sensor {
             Sensor::Accel => "accel_scale_asymmetry",

@@ -31,6 +31,10 @@ pub static GYRO_BIAS: Bias = Bias {
 };
 
 impl Effect for Bias {
+    fn varies_at_rest(&self) -> bool {
+        false
+    }
+
     fn id(&self) -> &'static str {
         match self.sensor {
             Sensor::Accel => "accel_bias",

@@ -60,6 +60,10 @@ impl EarthRate {
 }
 
 impl Effect for EarthRate {
+    fn varies_at_rest(&self) -> bool {
+        false
+    }
+
     fn id(&self) -> &'static str {
         "earth_rate"
     }

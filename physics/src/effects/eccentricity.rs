@@ -81,6 +81,10 @@ impl Eccentricity {
 }
 
 impl Effect for Eccentricity {
+    fn varies_at_rest(&self) -> bool {
+        false
+    }
+
     fn id(&self) -> &'static str {
         "table_encoder_eccentricity"
     }

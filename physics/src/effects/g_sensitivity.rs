@@ -37,6 +37,10 @@ static PARAMS: [Param; 9] = [
 ];
 
 impl Effect for GSensitivity {
+    fn varies_at_rest(&self) -> bool {
+        false
+    }
+
     fn id(&self) -> &'static str {
         "g_sensitivity"
     }

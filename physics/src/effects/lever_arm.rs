@@ -65,6 +65,10 @@ static PARAMS: [Param; 9] = [
 ];
 
 impl Effect for LeverArm {
+    fn varies_at_rest(&self) -> bool {
+        false
+    }
+
     fn id(&self) -> &'static str {
         "lever_arm"
     }

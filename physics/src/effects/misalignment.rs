@@ -84,6 +84,10 @@ pub static GYRO_MISALIGNMENT: Misalignment = Misalignment {
 };
 
 impl Effect for Misalignment {
+    fn varies_at_rest(&self) -> bool {
+        false
+    }
+
     fn id(&self) -> &'static str {
         match self.sensor {
             Sensor::Accel => "accel_misalignment",

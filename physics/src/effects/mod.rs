@@ -177,6 +177,13 @@ pub trait Effect: Send + Sync + std::fmt::Debug {
     fn uses_temperature(&self) -> bool {
         false
     }
+    /// Whether its regressors can change while the motion does not: they read the time
+    /// stamp or the temperature (`Signals::t_s`, `Signals::dtemp_c`). The analysis
+    /// evaluates a term that says no once for a stretch at rest. The default, yes, is always
+    /// right; a term that says no must be a function of the motion alone.
+    fn varies_at_rest(&self) -> bool {
+        true
+    }
 }
 
 /// Every effect, the nominal terms first, then the catalogue in physics.md's order, then

@@ -23,6 +23,10 @@ static PARAMS: [Param; 3] = per_axis!(
 );
 
 impl Effect for Nonlinearity {
+    fn varies_at_rest(&self) -> bool {
+        false
+    }
+
     fn id(&self) -> &'static str {
         "gyro_scale_nonlinearity"
     }

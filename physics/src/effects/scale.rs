@@ -40,6 +40,10 @@ pub static GYRO_SCALE: Scale = Scale {
 };
 
 impl Effect for Scale {
+    fn varies_at_rest(&self) -> bool {
+        false
+    }
+
     fn id(&self) -> &'static str {
         match self.sensor {
             Sensor::Accel => "accel_scale",

@@ -24,6 +24,10 @@ static PARAMS: [Param; 3] = per_axis!(
 );
 
 impl Effect for SecondOrder {
+    fn varies_at_rest(&self) -> bool {
+        false
+    }
+
     fn id(&self) -> &'static str {
         "accel_second_order"
     }

@@ -351,3 +351,30 @@ fn every_parameter_has_a_plausible_range() {
         .collect();
     assert_eq!(station, ["table_encoder_eccentricity"]);
 }
+
+#[test]
+fn a_term_that_says_it_is_constant_at_rest_ignores_time_and_temperature() {
+    // The analysis evaluates such a term once for a stretch at rest: its regressors must
+    // not read the time stamp or the temperature, at rest or moving.
+    let mut constant = 0;
+    for e in catalogue() {
+        for base in [signals(0.0), signals(0.9)] {
+            let n = e.params().len();
+            let (mut a, mut b) = (vec![Partials::default(); n], vec![Partials::default(); n]);
+            let mut later = base.at(base.t_s + 1234.5);
+            later.dtemp_c = base.dtemp_c + 17.0;
+            e.regressors(&base, &mut a);
+            e.regressors(&later, &mut b);
+            let same = a.iter().zip(&b).all(|(x, y)| x == y);
+            if !e.varies_at_rest() {
+                assert!(same, "{} reads the time or the temperature", e.id());
+            }
+        }
+        constant += usize::from(!e.varies_at_rest());
+    }
+    // The terms that do read them say so.
+    for id in ["clock_rate", "accel_thermal_drift", "gyro_scale_thermal"] {
+        assert!(effect(id).unwrap().varies_at_rest(), "{id}");
+    }
+    assert!(constant >= 10, "{constant}");
+}

@@ -21,6 +21,10 @@ static PARAMS: [Param; 1] = [Param {
 }];
 
 impl Effect for TimeOffset {
+    fn varies_at_rest(&self) -> bool {
+        false
+    }
+
     fn id(&self) -> &'static str {
         "time_offset"
     }

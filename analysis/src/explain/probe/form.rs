@@ -98,36 +98,66 @@ impl Form {
         }
     }
 
-    /// The scaled regressor on axis `i` (what [`Form::expression`] evaluates to).
-    pub(crate) fn value(self, sensor: Sensor, s: &Signals, i: usize) -> f64 {
+    /// The scaled regressor on each axis (what [`Form::expression`] evaluates to there),
+    /// what the axes share computed once.
+    pub(crate) fn values(self, sensor: Sensor, s: &Signals) -> [f64; 3] {
         let gyro = sensor == Sensor::Gyro;
         let f = s.f_b;
-        let w = s.w_ib_dps();
         let g = s.g;
-        let bias = |x: f64| if gyro { x / 3600.0 } else { 1e-6 * g * x };
-        let input = if gyro { w[i] } else { f[i] };
+        let bias = |x: f64| [if gyro { x / 3600.0 } else { 1e-6 * g * x }; 3];
         let hours = |t0: f64| (s.t_s - t0) / 3600.0;
+        let each = |v: &dyn Fn(usize) -> f64| [v(0), v(1), v(2)];
+        let input = || if gyro { s.w_ib_dps() } else { f };
         match self {
-            Form::ForceSquare if gyro => f[i] * f[i] / (g * g) / 3600.0,
-            Form::ForceSquare => 1e-6 * f[i] * f[i] / g,
-            Form::ForceProduct(j, k) if gyro => f[j] * f[k] / (g * g) / 3600.0,
-            Form::ForceProduct(j, k) => 1e-6 * f[j] * f[k] / g,
-            Form::ForceAbs if gyro => f[i].abs() / g / 3600.0,
-            Form::ForceAbs => 1e-6 * f[i].abs(),
-            Form::ForceCube => 1e-6 * f[i].powi(3) / (g * g),
+            Form::ForceSquare if gyro => each(&|i| f[i] * f[i] / (g * g) / 3600.0),
+            Form::ForceSquare => each(&|i| 1e-6 * f[i] * f[i] / g),
+            Form::ForceProduct(j, k) if gyro => [f[j] * f[k] / (g * g) / 3600.0; 3],
+            Form::ForceProduct(j, k) => [1e-6 * f[j] * f[k] / g; 3],
+            Form::ForceAbs if gyro => each(&|i| f[i].abs() / g / 3600.0),
+            Form::ForceAbs => each(&|i| 1e-6 * f[i].abs()),
+            Form::ForceCube => each(&|i| 1e-6 * f[i].powi(3) / (g * g)),
             Form::ForceRateSquare => {
-                1e-6 * (f[i] * s.w_b.norm_squared() - s.w_b[i] * s.w_b.dot(&f))
+                let (w2, wf) = (s.w_b.norm_squared(), s.w_b.dot(&f));
+                each(&|i| 1e-6 * (f[i] * w2 - s.w_b[i] * wf))
             }
-            Form::RateAbs => 1e-6 * w[i].abs(),
-            Form::RateSquare => 1e-6 * w[i] * w[i],
-            Form::RateCube => 1e-6 * w[i].powi(3),
+            Form::RateAbs => {
+                let w = s.w_ib_dps();
+                each(&|i| 1e-6 * w[i].abs())
+            }
+            Form::RateSquare => {
+                let w = s.w_ib_dps();
+                each(&|i| 1e-6 * w[i] * w[i])
+            }
+            Form::RateCube => {
+                let w = s.w_ib_dps();
+                each(&|i| 1e-6 * w[i].powi(3))
+            }
             Form::Drift { t0 } => bias(hours(t0)),
             Form::Drift2 { t0 } => bias(hours(t0).powi(2)),
             Form::Decay { t0, tau } => bias((-(s.t_s - t0) / tau).exp()),
             Form::Step { at } => bias(if s.t_s > at { 1.0 } else { 0.0 }),
-            Form::ScaleDrift { t0 } => 1e-6 * input * hours(t0),
-            Form::ThermalScale => 1e-6 * input * s.dtemp_c,
+            Form::ScaleDrift { t0 } => {
+                let (x, h) = (input(), hours(t0));
+                each(&|i| 1e-6 * x[i] * h)
+            }
+            Form::ThermalScale => {
+                let x = input();
+                each(&|i| 1e-6 * x[i] * s.dtemp_c)
+            }
         }
+    }
+
+    /// Whether the form reads the time or the temperature (it changes at rest).
+    pub(crate) fn varies_at_rest(self) -> bool {
+        matches!(
+            self,
+            Form::Drift { .. }
+                | Form::Drift2 { .. }
+                | Form::Decay { .. }
+                | Form::Step { .. }
+                | Form::ScaleDrift { .. }
+                | Form::ThermalScale
+        )
     }
 
     /// The coefficient's unit.

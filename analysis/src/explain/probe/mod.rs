@@ -89,9 +89,14 @@ impl Effect for Probe {
     }
 
     fn regressors(&self, s: &Signals, out: &mut [Partials]) {
+        let v = self.form.values(self.sensor, s);
         for (i, p) in out.iter_mut().enumerate() {
-            *p = Partials::axis(self.sensor, i, self.form.value(self.sensor, s, i));
+            *p = Partials::axis(self.sensor, i, v[i]);
         }
+    }
+
+    fn varies_at_rest(&self) -> bool {
+        self.form.varies_at_rest()
     }
 }
 

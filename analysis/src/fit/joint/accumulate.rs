@@ -63,6 +63,10 @@ pub(crate) struct Accumulator<'l> {
     blocks: Vec<Block>,
     cur: Block,
     block_end: f64,
+    /// The signals `parts` were last filled from, time and temperature left out.
+    filled: Option<Signals>,
+    /// Layout indices of the effects whose regressors change at rest.
+    varying: Vec<usize>,
 }
 
 impl<'l> Accumulator<'l> {
@@ -80,6 +84,10 @@ impl<'l> Accumulator<'l> {
             blocks: Vec::new(),
             cur: Self::new_block(layout),
             block_end: t_start + BLOCK_S,
+            filled: None,
+            varying: (0..layout.effects.len())
+                .filter(|&e| layout.effects[e].varies_at_rest())
+                .collect(),
         }
     }
 
@@ -115,8 +123,18 @@ impl<'l> Accumulator<'l> {
             self.blocks.push(full);
             self.block_end += BLOCK_S * ((t - self.block_end) / BLOCK_S).ceil().max(1.0);
         }
-        for (e, fx) in layout.effects.iter().enumerate() {
-            fx.regressors(sig, &mut self.parts[layout.columns_of(e)]);
+        // At rest only the terms that read the time or the temperature change.
+        let mut motion = *sig;
+        (motion.t_s, motion.dtemp_c) = (0.0, 0.0);
+        if self.filled == Some(motion) {
+            for &e in &self.varying {
+                layout.effects[e].regressors(sig, &mut self.parts[layout.columns_of(e)]);
+            }
+        } else {
+            for (e, fx) in layout.effects.iter().enumerate() {
+                fx.regressors(sig, &mut self.parts[layout.columns_of(e)]);
+            }
+            self.filled = Some(motion);
         }
         for c in 0..6 {
             let (sensor, ax) = channel(c);

@@ -1,6 +1,13 @@
 //! Least squares kept as a triangle: rows are folded into an upper-triangular factor by
 //! Householder reflections, a block at a time, so a design matrix of any length is never
 //! held whole and the normal equations are never formed.
+//!
+//! A column that has kept its first value in every row so far (at rest, every regressor
+//! that follows only the attitude) is not folded: it is that value times a column of
+//! ones, which is folded once for all of them. The column joins the fold, with the history
+//! the ones column holds for it, at the first row where it changes. A static hour's rows
+//! then cost the square of the columns that follow time or temperature, not of all of
+//! them.
 
 use nalgebra::DMatrix;
 
@@ -14,8 +21,18 @@ const BLOCK: usize = 256;
 #[derive(Debug, Clone)]
 pub(crate) struct Tri {
     cols: usize,
-    /// `R` in the first `cols` rows, then the pending rows.
+    /// The stack's first column is the ones column, then the caller's columns that have
+    /// changed, in the order they changed: `R` in the first `cols + 1` rows, then the
+    /// pending rows.
     stack: DMatrix<f64>,
+    /// Stack columns in use (the ones column included).
+    active: usize,
+    /// Per caller column, its stack column once it has changed.
+    pos: Vec<Option<usize>>,
+    /// `(caller column, stack column)` of the columns that have changed.
+    moving: Vec<(usize, usize)>,
+    /// The first row.
+    first: Vec<f64>,
     rows: usize,
     /// Rows folded in so far.
     pub n: usize,
@@ -24,9 +41,14 @@ pub(crate) struct Tri {
 impl Tri {
     /// An empty factor of `cols` columns (regressors and the observation).
     pub(crate) fn new(cols: usize) -> Self {
+        let k = cols + 1;
         Tri {
             cols,
-            stack: DMatrix::zeros(cols + BLOCK, cols),
+            stack: DMatrix::zeros(k + BLOCK, k),
+            active: 1,
+            pos: vec![None; cols],
+            moving: Vec::with_capacity(cols),
+            first: Vec::new(),
             rows: 0,
             n: 0,
         }
@@ -35,9 +57,21 @@ impl Tri {
     /// Adds one row (regressors then the observation).
     pub(crate) fn push(&mut self, row: &[f64]) {
         debug_assert_eq!(row.len(), self.cols);
-        let i = self.cols + self.rows;
-        for (j, v) in row.iter().enumerate() {
-            self.stack[(i, j)] = *v;
+        if self.n == 0 {
+            self.first = row.to_vec();
+        } else if self.active <= self.cols {
+            for (l, v) in row.iter().enumerate() {
+                // Bits, not values: a NaN that stays is constant, and -0 is not 0.
+                if self.pos[l].is_none() && v.to_bits() != self.first[l].to_bits() {
+                    self.start_moving(l);
+                }
+            }
+        }
+        let k = self.cols + 1;
+        let i = k + self.rows;
+        self.stack[(i, 0)] = 1.0;
+        for &(l, p) in &self.moving {
+            self.stack[(i, p)] = row[l];
         }
         self.rows += 1;
         self.n += 1;
@@ -46,11 +80,25 @@ impl Tri {
         }
     }
 
+    /// Caller column `l` changes: it joins the fold as its first value times the ones
+    /// column, in the factor and in the pending rows.
+    fn start_moving(&mut self, l: usize) {
+        let (k, p, c) = (self.cols + 1, self.active, self.first[l]);
+        self.active += 1;
+        self.pos[l] = Some(p);
+        self.moving.push((l, p));
+        // The ones column of an upper-triangular factor is its corner alone.
+        self.stack[(0, p)] = c * self.stack[(0, 0)];
+        for i in 0..self.rows {
+            self.stack[(k + i, p)] = c;
+        }
+    }
+
     fn flush(&mut self) {
         if self.rows == 0 {
             return;
         }
-        fold(&mut self.stack, self.cols, self.rows);
+        fold(&mut self.stack, self.active, self.cols + 1, self.rows);
         self.rows = 0;
     }
 
@@ -58,26 +106,36 @@ impl Tri {
     pub(crate) fn finish(mut self) -> DMatrix<f64> {
         self.flush();
         let c = self.cols;
-        self.stack.rows(0, c).into_owned()
+        if self.n == 0 {
+            return DMatrix::zeros(c, c);
+        }
+        // The caller's columns from the fold's: a constant one is its value times the
+        // ones column. One QR of a square matrix puts them back in the caller's order.
+        let a = self.active;
+        let full = DMatrix::from_fn(a, c, |i, l| match self.pos[l] {
+            Some(p) => self.stack[(i, p)],
+            None => self.first[l] * self.stack[(i, 0)],
+        });
+        triangle(full, c)
     }
 }
 
-/// Folds the `rows` rows below the upper-triangular `R` (the first `cols` rows of
-/// `stack`) into it by Householder reflections, in place. A reflection of column `j`
-/// involves `R`'s row `j` and the new rows only (the rest of the column is zero), so a fold
-/// costs `2 rows cols^2` flops, and the stack is never copied. The rows below `R` are left
-/// as scratch.
+/// Folds the `rows` rows that start at row `k` of `stack` into the upper-triangular `R`
+/// of its first `cols` columns (its first `cols` rows; zero down to row `k`) by
+/// Householder reflections, in place. A reflection of column `j` involves `R`'s row `j`
+/// and the new rows only (the rest of the column is zero), so a fold costs `2 rows cols^2`
+/// flops, and the stack is never copied. The rows below `R` are left as scratch.
 ///
 /// Each reflection is LAPACK's (`dlarfg`/`dlarf`): `H = I - tau u u^T` with `u = [1; x /
 /// v0]` and `tau` in `[1, 2]`, so no step divides by a square of the column's size. A
 /// column of tiny values (a decay long gone, 1e-150) would otherwise underflow `|v|^2` to a
 /// subnormal or zero and make its `2 / |v|^2` infinite: every later column of the factor,
 /// and every fit that uses it, would be NaN.
-fn fold(stack: &mut DMatrix<f64>, cols: usize, rows: usize) {
-    let (k, r) = (cols, rows);
+fn fold(stack: &mut DMatrix<f64>, cols: usize, k: usize, rows: usize) {
+    let r = rows;
     let ld = stack.nrows();
     let a = stack.as_mut_slice();
-    for j in 0..k {
+    for j in 0..cols {
         let (head, tail) = a.split_at_mut((j + 1) * ld);
         let cj = &mut head[j * ld..];
         let x0 = cj[j];
@@ -95,7 +153,7 @@ fn fold(stack: &mut DMatrix<f64>, cols: usize, rows: usize) {
         }
         cj[j] = alpha;
         let u = &cj[k..k + r];
-        for cl in tail.chunks_exact_mut(ld).take(k - j - 1) {
+        for cl in tail.chunks_exact_mut(ld).take(cols - j - 1) {
             let f = tau * (cl[j] + dot(u, &cl[k..k + r]));
             cl[j] -= f;
             for (ui, ai) in u.iter().zip(&mut cl[k..k + r]) {
@@ -147,13 +205,15 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
-/// The `cols x cols` upper-triangular factor of a stack of rows.
+/// The `cols x cols` upper-triangular factor of a stack of rows: the rows folded into a
+/// zero factor, by the same reflections as every other fold.
 pub(crate) fn triangle(m: DMatrix<f64>, cols: usize) -> DMatrix<f64> {
-    let r = m.qr().r();
-    let mut out = DMatrix::zeros(cols, cols);
-    let k = r.nrows().min(cols);
-    out.view_mut((0, 0), (k, cols)).copy_from(&r.rows(0, k));
-    out
+    debug_assert_eq!(m.ncols(), cols);
+    let rows = m.nrows();
+    let mut stack = DMatrix::zeros(cols + rows, cols);
+    stack.view_mut((cols, 0), (rows, cols)).copy_from(&m);
+    fold(&mut stack, cols, cols, rows);
+    stack.rows(0, cols).into_owned()
 }
 
 #[cfg(test)]
@@ -188,7 +248,7 @@ mod tests {
             rows.extend_from_slice(&row);
         }
         let a = DMatrix::from_row_slice(700, 5, &rows);
-        let (r, q) = (t.finish(), triangle(a, 5));
+        let (r, q) = (t.finish(), a.qr().r());
         for i in 0..5 {
             let s = (r[(i, i)] * q[(i, i)]).signum();
             for j in 0..5 {
@@ -245,6 +305,41 @@ mod tests {
         let r = t.finish();
         assert!(r.iter().all(|v| v.is_finite()));
         assert_eq!(r.column(1).norm(), 0.0);
-        assert_eq!(r.row(1).norm(), 0.0);
+    }
+
+    #[test]
+    fn columns_that_start_moving_late_are_folded_with_their_history() {
+        // Constant throughout, constant until row 300 (past a fold), until row 3, always
+        // moving, and the observation.
+        let mut t = Tri::new(5);
+        let mut rows = Vec::new();
+        for i in 0..700 {
+            let x = i as f64 * 0.01;
+            let late = if i < 300 { 2.5 } else { 2.5 + (x * 3.0).sin() };
+            let early = if i < 3 { -1.0 } else { x * x };
+            let row = [
+                0.7,
+                late,
+                early,
+                x.cos(),
+                1.0 + 0.3 * x + 0.01 * (x * 13.0).sin(),
+            ];
+            t.push(&row);
+            rows.extend_from_slice(&row);
+        }
+        let a = DMatrix::from_row_slice(700, 5, &rows);
+        let r = t.finish();
+        let (g, h) = (a.transpose() * &a, r.transpose() * &r);
+        assert!((&g - &h).norm() < 1e-12 * g.norm(), "{g} {h}");
+        for i in 0..5 {
+            for j in 0..i {
+                assert_eq!(r[(i, j)], 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn no_rows_give_a_zero_factor() {
+        assert_eq!(Tri::new(4).finish(), DMatrix::zeros(4, 4));
     }
 }
