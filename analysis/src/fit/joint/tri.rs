@@ -182,8 +182,9 @@ fn column_norm(x0: f64, x: &[f64]) -> Option<f64> {
         let s = (x0 / amax).powi(2) + x.iter().map(|v| (v / amax).powi(2)).sum::<f64>();
         amax * s.sqrt()
     };
-    // A column below the smallest normal double folds nothing a fit could see.
-    (!(norm < f64::MIN_POSITIVE)).then_some(norm)
+    // A column below the smallest normal double folds nothing a fit could see (a NaN
+    // goes on, so that it shows in the fit).
+    (norm >= f64::MIN_POSITIVE || norm.is_nan()).then_some(norm)
 }
 
 /// `a . b` in four running sums, which the compiler keeps in vector registers (one
