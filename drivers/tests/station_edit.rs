@@ -96,3 +96,29 @@ fn values_are_located_for_errors() {
     assert!(DEFAULT_STATION_YAML[at..].starts_with("[0, -1, 0]"));
     assert_eq!(locate(DEFAULT_STATION_YAML, "site", "nothing"), None);
 }
+
+#[test]
+fn effects_and_user_effects_added_at_the_end_of_the_imu_stay_in_their_blocks() {
+    // `imu.effects` is the last key of `imu` here: its end is where `imu.user_effects`
+    // goes too.
+    let text = include_str!("../stations/with-lever-arm.yaml");
+    let mut user = set("discovered_ax_drift", "k_ax", 3.0, 0.1);
+    user.file = Some("discovered_ax_drift.effect".into());
+    let sets = [
+        set("clock_rate", "ppm", 50.0, 0.1),
+        user,
+        set("time_offset", "tau_ms", 5.0, 0.01),
+    ];
+    let out = edit(text, &sets).unwrap();
+    let st = Station::from_yaml(&out, "out.yaml").unwrap_or_else(|e| panic!("{e:?}\n{out}"));
+    assert_eq!(st.imu.effects.value("clock_rate", "ppm"), 50.0, "{out}");
+    assert_eq!(st.imu.effects.value("time_offset", "tau_ms"), 5.0, "{out}");
+    assert_eq!(st.imu.effects.value("lever_arm", "rzz_mm"), 25.0, "{out}");
+    assert_eq!(text.lines().count() + 4, out.lines().count(), "{out}");
+    let u = &st.imu.user_effects["discovered_ax_drift"];
+    assert_eq!(u.file, "discovered_ax_drift.effect");
+    // In the order asked for, each in its block.
+    let at = |s: &str| out.find(s).unwrap_or_else(|| panic!("{s}\n{out}"));
+    assert!(at("lever_arm") < at("clock_rate") && at("clock_rate") < at("time_offset"));
+    assert!(at("time_offset") < at("user_effects"), "{out}");
+}

@@ -203,12 +203,32 @@ pub fn edit(text: &str, sets: &[SetValue]) -> Result<String, String> {
             },
         }
     }
-    edits.sort_by(|a, b| b.0.cmp(&a.0).then(b.1.cmp(&a.1)));
+    Ok(apply(text, edits))
+}
+
+/// `text` with the edits made, from the end backwards. Insertions at one place (the end
+/// of `imu.effects` is often the end of `imu` too) end up in the order they were asked
+/// for, the deeper block's entries first: an effect added to `imu.effects` stays inside it
+/// when `imu.user_effects` is added after it.
+fn apply(text: &str, edits: Edits) -> String {
+    let depth = |s: &str| {
+        s.strip_prefix('\n')
+            .map_or(usize::MAX, |r| r.len() - r.trim_start_matches(' ').len())
+    };
+    let mut order: Vec<(usize, (usize, usize, String))> = edits.into_iter().enumerate().collect();
+    // Made from the end, a later insertion at the same place lands before an earlier one:
+    // shallower ones and later ones are made first.
+    order.sort_by(|(i, x), (j, y)| {
+        y.0.cmp(&x.0)
+            .then(y.1.cmp(&x.1))
+            .then(depth(&x.2).cmp(&depth(&y.2)))
+            .then(j.cmp(i))
+    });
     let mut out = text.to_string();
-    for (a, b, s) in edits {
+    for (_, (a, b, s)) in order {
         out.replace_range(a..b, &s);
     }
-    Ok(out)
+    out
 }
 
 /// A user effect's values under `imu.user_effects` (the entry, or its `values`, added
