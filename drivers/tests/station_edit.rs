@@ -122,3 +122,17 @@ fn effects_and_user_effects_added_at_the_end_of_the_imu_stay_in_their_blocks() {
     assert!(at("lever_arm") < at("clock_rate") && at("clock_rate") < at("time_offset"));
     assert!(at("time_offset") < at("user_effects"), "{out}");
 }
+
+#[test]
+fn two_effects_added_to_an_empty_flow_map_are_both_in_it() {
+    assert!(DEFAULT_STATION_YAML.contains("effects: {}"));
+    let sets = [
+        set("time_offset", "tau_ms", 4.0, 0.01),
+        set("clock_rate", "ppm", 60.0, 0.001),
+    ];
+    let out = edit(DEFAULT_STATION_YAML, &sets).unwrap();
+    let st = Station::from_yaml(&out, "out.yaml").unwrap_or_else(|e| panic!("{e:?}\n{out}"));
+    assert_eq!(st.imu.effects.value("time_offset", "tau_ms"), 4.0, "{out}");
+    assert_eq!(st.imu.effects.value("clock_rate", "ppm"), 60.0, "{out}");
+    assert_eq!(DEFAULT_STATION_YAML.lines().count(), out.lines().count());
+}

@@ -3,8 +3,8 @@
 
 use super::earth::EARTH_HELD;
 use super::probe::{self, Probe};
-use crate::fit::Source;
 use crate::fit::joint::{Layout, SegAcc, excitation};
+use crate::fit::{Retime, Source};
 use crate::recording::SegmentKind;
 use ratecal_physics::Effect;
 
@@ -28,6 +28,9 @@ pub(crate) struct Data {
     /// The channels' factors merged over the segment sets fitted so far: explain fits
     /// hundreds of models over a handful of sets.
     pub merged: Merged,
+    /// The timing error the signals were evaluated with: the timing columns
+    /// (`time_offset`, `clock_rate`) measure what is left about it.
+    pub retime: Retime,
 }
 
 /// Merged factors by (accelerometer segments, gyro segments).
@@ -48,6 +51,7 @@ impl Data {
     pub(crate) fn with_effects<S: Source>(
         src: &S,
         mut effects: Vec<&'static dyn Effect>,
+        retime: Retime,
     ) -> Result<Data, S::Error> {
         let segs = &src.manifest().segments;
         let t0 = segs.iter().map(|s| s.t_start).fold(f64::INFINITY, f64::min);
@@ -66,7 +70,7 @@ impl Data {
             effects.push(p);
         }
         let mut layout = Layout::new(effects);
-        let mut accs = crate::fit::accumulate_all(src, &layout)?;
+        let mut accs = crate::fit::accumulate_all(src, &layout, retime)?;
         let spans: Vec<(f64, f64)> = accs
             .iter()
             .map(|a| (segs[a.seg].t_start, segs[a.seg].t_end))
@@ -103,6 +107,7 @@ impl Data {
             probes,
             earth,
             merged: Default::default(),
+            retime,
         })
     }
 

@@ -81,7 +81,7 @@ pub fn explain_source<S: Source>(
     nominal: &NominalModel,
     opts: &Options,
 ) -> Result<Explanation, S::Error> {
-    let (data, nonfinite) = accumulate(src, opts)?;
+    let (data, nonfinite) = accumulate(src, opts, crate::fit::Retime::default())?;
     Ok(explain_data(
         src.manifest(),
         &data,
@@ -97,12 +97,13 @@ pub fn explain_source<S: Source>(
 pub(crate) fn accumulate<S: Source>(
     src: &S,
     opts: &Options,
+    retime: crate::fit::Retime,
 ) -> Result<(Data, Vec<usize>), S::Error> {
     let mut effects: Vec<&'static dyn Effect> = REGISTRY.to_vec();
     effects.extend(opts.user.iter().map(|u| *u as &'static dyn Effect));
     let nonfinite: Vec<usize> = opts.user.iter().map(|u| u.nonfinite()).collect();
     let clock = std::time::Instant::now();
-    let data = Data::with_effects(src, effects)?;
+    let data = Data::with_effects(src, effects, retime)?;
     if std::env::var_os("RATECAL_EXPLAIN_DEBUG").is_some() {
         eprintln!("accumulated in {:?}", clock.elapsed());
     }

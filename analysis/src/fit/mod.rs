@@ -25,7 +25,7 @@ mod stats;
 
 pub use allan::overlapping_adev;
 pub use repeat::analyze_runs;
-pub use segment::WINDOW_ROWS;
+pub use segment::{Retime, WINDOW_ROWS};
 pub use source::{ImuView, Source, Streamed};
 
 use crate::plan::{Outliers, Plan};
@@ -246,7 +246,11 @@ pub fn analyze_source<S: Source>(
 /// A long segment (the standard's hour at rest is four fifths of its samples) is passed in
 /// pieces of about [`PIECE_ROWS`] rows side by side, their factors merged: the factor of
 /// stacked rows is the factor of the stacked factors.
-pub(crate) fn accumulate_all<S: Source>(src: &S, layout: &Layout) -> Result<Vec<SegAcc>, S::Error> {
+pub(crate) fn accumulate_all<S: Source>(
+    src: &S,
+    layout: &Layout,
+    retime: Retime,
+) -> Result<Vec<SegAcc>, S::Error> {
     use rayon::prelude::*;
     let m = src.manifest();
     let Context {
@@ -281,6 +285,7 @@ pub(crate) fn accumulate_all<S: Source>(src: &S, layout: &Layout) -> Result<Vec<
                 rate_hz,
                 window_rows: segment::WINDOW_ROWS,
                 span,
+                retime,
             });
         }
     }
@@ -371,6 +376,7 @@ fn pass_segments<S: Source>(
                 rate_hz,
                 window_rows,
                 span: None,
+                retime: Retime::default(),
             };
             segment::pass(src, &job)
         })

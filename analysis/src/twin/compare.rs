@@ -101,6 +101,9 @@ pub(super) fn report(
                     .map_or(0.0, |g| f.theta[g]);
                 v / (1.0 + s * 1e-6)
             }
+            // The timing the signals were evaluated at, plus what the fit leaves.
+            None if id == "time_offset" => v + data.retime.tau_s * 1e3,
+            None if id == "clock_rate" => v + data.retime.eps * 1e6,
             None => v,
         }
     };
@@ -138,7 +141,8 @@ pub(super) fn report(
             u: f.u(g),
             unit: fx.params()[k].unit.into(),
             standard_errors: z.abs(),
-            added: false,
+            // A timing the twin lacked is compared as held, at 0 (`compare_source`).
+            added: from.is_none() && super::TIMING.contains(&fx.id()),
             defined_in: None,
         });
     }

@@ -46,6 +46,11 @@ pub(super) fn theta(m: &Manifest, data: &Data, twin: &Twin, t_ref_data: f64) -> 
             set(nominal, &shift);
         }
     }
+    // The signals hold the timing they were evaluated at: its columns measure what is left.
+    let base = [data.retime.tau_s * 1e3, data.retime.eps * 1e6];
+    for (id, b) in super::TIMING.iter().zip(base) {
+        set(id, &[-b]);
+    }
     let lat = m.station.site.latitude_deg;
     set(
         "earth_rate",

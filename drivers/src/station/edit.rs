@@ -407,7 +407,14 @@ fn insert_entry(text: &str, map: usize, entry: &str, edits: &mut Edits) {
         };
         let inner = &text[map + 1..close];
         if inner.trim().is_empty() {
-            edits.push((map, close + 1, format!("{{ {entry} }}")));
+            // A second entry into the same empty map joins the first one's.
+            match edits.iter_mut().find(|e| (e.0, e.1) == (map, close + 1)) {
+                Some(e) => {
+                    let first = e.2.strip_suffix(" }").unwrap_or(&e.2).to_string();
+                    e.2 = format!("{first}, {entry} }}");
+                }
+                None => edits.push((map, close + 1, format!("{{ {entry} }}"))),
+            }
         } else {
             let at = map + 1 + inner.trim_end().len();
             edits.push((at, at, format!(", {entry}")));

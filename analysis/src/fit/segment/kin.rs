@@ -17,11 +17,42 @@ pub(super) struct Kin<'a> {
     pub still: bool,
     /// A rate segment's steady rates, rad/s.
     steady: Option<(f64, f64)>,
+    /// The table time of an IMU stamp.
+    retime: Retime,
     j: usize,
 }
 
+/// A known timing error of the samples against the table's feedback: the sample stamped
+/// `t` saw the motion of table time `t / (1 + eps) - tau_s` (the simulator's `time_offset`
+/// and `clock_rate`, docs/effects.md). The fit's timing columns then measure what is left
+/// about it, so that a long recording's growing lag is taken exactly, not to first order.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Retime {
+    /// Time offset, s.
+    pub tau_s: f64,
+    /// Clock rate, `ppm * 1e-6`.
+    pub eps: f64,
+}
+
+impl Retime {
+    /// The table time of the sample stamped `t`.
+    pub fn table_time(&self, t: f64) -> f64 {
+        if *self == Retime::default() {
+            t
+        } else {
+            t / (1.0 + self.eps) - self.tau_s
+        }
+    }
+}
+
 impl<'a> Kin<'a> {
-    pub(super) fn new(tab: &'a TableStream, seg: &Segment, geo: &'a Geometry, site: Site) -> Self {
+    pub(super) fn new(
+        tab: &'a TableStream,
+        seg: &Segment,
+        geo: &'a Geometry,
+        site: Site,
+        retime: Retime,
+    ) -> Self {
         let still = seg.kind == SegmentKind::Static;
         let rest = still
             .then(|| prep::rest_angles(tab, seg.t_start, seg.t_end))
@@ -49,6 +80,7 @@ impl<'a> Kin<'a> {
             rest,
             still,
             steady,
+            retime,
             j: 0,
         };
         kin.seek(seg.t_start);
@@ -58,12 +90,14 @@ impl<'a> Kin<'a> {
     /// Puts the cursor at the feedback step holding `t` (a window's first stamp: a window
     /// read with a margin starts before where the last one ended).
     pub(super) fn seek(&mut self, t: f64) {
+        let t = self.retime.table_time(t);
         self.j = self.tab.t.partition_point(|&x| x <= t).saturating_sub(1);
     }
 
-    /// Moves the cursor to the feedback step holding `t`; the step `j..j + 1` and the
-    /// fraction of it.
+    /// Moves the cursor to the feedback step holding the table time of stamp `t`; the
+    /// step `j..j + 1` and the fraction of it.
     pub(super) fn advance(&mut self, t: f64) -> (usize, f64) {
+        let t = self.retime.table_time(t);
         let tab = &self.tab.t;
         let last = tab.len().saturating_sub(2);
         while self.j < last && tab[self.j + 1] <= t {

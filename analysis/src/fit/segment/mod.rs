@@ -22,6 +22,7 @@ use super::stats::median_step;
 use crate::recording::{Segment, TableStream};
 use crate::results::SyncReport;
 use kin::Kin;
+pub use kin::Retime;
 use ratecal_physics::Geometry;
 use ratecal_physics::effects::Signals;
 use std::borrow::Cow;
@@ -56,6 +57,8 @@ pub(crate) struct Job<'a> {
     pub window_rows: usize,
     /// Only this part of the segment (s), when one segment is passed in pieces.
     pub span: Option<(f64, f64)>,
+    /// The samples' known timing error against the feedback.
+    pub retime: Retime,
 }
 
 /// What is left of a segment once its rows have passed.
@@ -91,7 +94,7 @@ pub(crate) struct Summary {
 pub(crate) fn pass<S: Source>(src: &S, job: &Job) -> Result<(Summary, SegAcc), S::Error> {
     let m = src.manifest();
     let seg = &m.segments[job.seg];
-    let mut kin = Kin::new(src.table(), seg, job.geo, m.station.site);
+    let mut kin = Kin::new(src.table(), seg, job.geo, m.station.site, job.retime);
     let moving = kin.rest.is_none() && !kin.still;
     let per = if moving {
         job.window_rows / MOVING_DIVISOR
