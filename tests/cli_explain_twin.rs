@@ -10,7 +10,7 @@
 mod support;
 
 use std::path::Path;
-use support::{code, ratecal, shared_example, text};
+use support::{code, ratecal, shared_example, text, twin_changes};
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
@@ -59,31 +59,11 @@ fn twin_json(dir: &Path, rec: &Path, twin: &str, extra: &[&str]) -> (i32, serde_
 }
 
 /// `(effect.parameter, from, to, u)` of every change.
-fn changes(v: &serde_json::Value) -> Vec<(String, f64, f64, f64)> {
-    v["twin"]["changes"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|c| {
-            (
-                format!(
-                    "{}.{}",
-                    c["effect"].as_str().unwrap(),
-                    c["parameter"].as_str().unwrap()
-                ),
-                c["from"].as_f64().unwrap(),
-                c["to"].as_f64().unwrap(),
-                c["u"].as_f64().unwrap(),
-            )
-        })
-        .collect()
-}
-
 /// `name` changed to within 3u of the truth, plus 0.05 % of it for a lever arm: what the
 /// registry's first-order columns on the 50 Hz feedback leave (micrometres at 25 mm; the
 /// scale factor the accelerometers sense it through is taken out).
-fn assert_within(c: &[(String, f64, f64, f64)], name: &str, truth: f64) {
-    let (_, _, to, u) = c
+fn assert_within(c: &[(String, f64, f64, f64, bool)], name: &str, truth: f64) {
+    let (_, _, to, u, _) = c
         .iter()
         .find(|c| c.0 == name)
         .unwrap_or_else(|| panic!("{name} in {c:?}"));
@@ -108,7 +88,7 @@ fn twins_of_the_independent_example_right_missing_wrong_and_a_pair() {
     // Right: nothing to change, exit 0, the residual at the stated noise.
     let (c, v) = twin_json(dir, &ex, &example_twin(TRUE_LEVER, TRUE_GYRO_SCALE), &[]);
     assert_eq!(c, 0, "{}", v["twin"]);
-    assert!(changes(&v).is_empty(), "{:?}", changes(&v));
+    assert!(twin_changes(&v).is_empty(), "{:?}", twin_changes(&v));
     let before = &v["twin"]["before"];
     let rms = before["rms"]["accel_mps2"].as_f64().unwrap();
     assert!((rms / 0.0025 - 1.0).abs() < 0.05, "{rms}");
@@ -119,7 +99,7 @@ fn twins_of_the_independent_example_right_missing_wrong_and_a_pair() {
     // Missing the lever arm: added from 0, the observable coordinates at the truth.
     let (c, v) = twin_json(dir, &ex, &example_twin("effects: {}", TRUE_GYRO_SCALE), &[]);
     assert_eq!(c, 1);
-    let ch = changes(&v);
+    let ch = twin_changes(&v);
     let names: Vec<&str> = ch.iter().map(|c| c.0.as_str()).collect();
     assert_eq!(
         names,
@@ -156,7 +136,7 @@ fn twins_of_the_independent_example_right_missing_wrong_and_a_pair() {
     let wrong = TRUE_LEVER.replace("rzz_mm: 25", "rzz_mm: 31");
     let (c, v) = twin_json(dir, &ex, &example_twin(&wrong, TRUE_GYRO_SCALE), &[]);
     assert_eq!(c, 1);
-    let ch = changes(&v);
+    let ch = twin_changes(&v);
     assert_eq!(ch.len(), 1, "{ch:?}");
     assert_eq!((ch[0].0.as_str(), ch[0].1), ("lever_arm.rzz_mm", 31.0));
     assert_within(&ch, "lever_arm.rzz_mm", 25.0);
@@ -169,7 +149,7 @@ fn twins_of_the_independent_example_right_missing_wrong_and_a_pair() {
         &["--write-twin", "fixed.yaml"],
     );
     assert_eq!(c, 1);
-    let ch = changes(&v);
+    let ch = twin_changes(&v);
     let names: Vec<&str> = ch.iter().map(|c| c.0.as_str()).collect();
     assert_eq!(
         names,
@@ -262,7 +242,7 @@ fn a_simulated_station_against_the_twin_of_another_station_file() {
     }
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     twin_series_follow_the_recording(dir, &v);
-    let ch = changes(&v);
+    let ch = twin_changes(&v);
     let names: Vec<&str> = ch.iter().map(|c| c.0.as_str()).collect();
     assert_eq!(
         names,
@@ -423,7 +403,7 @@ fn a_right_twin_is_changed_in_under_five_percent_of_recordings() {
         if code(&o) == 1 {
             changed.push((
                 seed,
-                changes(&v),
+                twin_changes(&v),
                 v["findings"].clone(),
                 v["unexplained"].clone(),
             ));
@@ -487,7 +467,7 @@ fn a_user_effect_is_simulated_found_and_written_by_reference() {
     );
     assert_eq!(code(&o), 1, "{}", text(&o));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    let ch = changes(&v);
+    let ch = twin_changes(&v);
     let names: Vec<&str> = ch.iter().map(|c| c.0.as_str()).collect();
     assert_eq!(names, ["accel_cross_xz.xz", "accel_cross_xz.zx"], "{ch:?}");
     assert_within(&ch, "accel_cross_xz.xz", 800.0);

@@ -13,7 +13,7 @@ mod support;
 use ratecal_witness::{Hidden, Scenario};
 use serde_json::Value;
 use std::path::Path;
-use support::{code, ratecal, text};
+use support::{code, ratecal, text, twin_changes};
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
@@ -27,37 +27,16 @@ fn explain(dir: &Path, rec: &str, twin: &str, extra: &[&str]) -> (i32, Value) {
     (code(&o), v)
 }
 
-/// The changes as (`effect.parameter`, to, u, added).
-fn changes(v: &Value) -> Vec<(String, f64, f64, bool)> {
-    v["twin"]["changes"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|c| {
-            (
-                format!(
-                    "{}.{}",
-                    c["effect"].as_str().unwrap(),
-                    c["parameter"].as_str().unwrap()
-                ),
-                c["to"].as_f64().unwrap(),
-                c["u"].as_f64().unwrap(),
-                c["added"].as_bool().unwrap(),
-            )
-        })
-        .collect()
-}
-
 /// The added timing within 3u of the truth, and nothing else added or discovered.
 fn timing_found(v: &Value, tau_ms: f64, ppm: f64) {
-    let c = changes(v);
+    let c = twin_changes(v);
     let get = |name: &str| {
         c.iter()
             .find(|x| x.0 == name)
             .unwrap_or_else(|| panic!("{name} in {c:?}"))
     };
     for (name, truth) in [("time_offset.tau_ms", tau_ms), ("clock_rate.ppm", ppm)] {
-        let (_, to, u, added) = get(name);
+        let (_, _, to, u, added) = get(name);
         assert!(*added, "{name}");
         assert!(
             (to - truth).abs() < 3.0 * u,
@@ -66,7 +45,7 @@ fn timing_found(v: &Value, tau_ms: f64, ppm: f64) {
     }
     let others: Vec<_> = c
         .iter()
-        .filter(|x| x.3 && !x.0.starts_with("time_offset") && !x.0.starts_with("clock_rate"))
+        .filter(|x| x.4 && !x.0.starts_with("time_offset") && !x.0.starts_with("clock_rate"))
         .collect();
     assert!(others.is_empty(), "added besides the timing: {others:?}");
     let discovered: Vec<&Value> = v["findings"]

@@ -119,3 +119,26 @@ pub fn shared_path(rel: &str) -> Option<PathBuf> {
 pub fn example() -> Option<PathBuf> {
     shared::shared_example("standard-with-lever-arm")
 }
+
+/// The changes of `explain --twin --format json` (`twin.changes`), each as
+/// (`effect.parameter`, from, to, u, added).
+pub fn twin_changes(v: &serde_json::Value) -> Vec<(String, f64, f64, f64, bool)> {
+    v["twin"]["changes"]
+        .as_array()
+        .expect("twin.changes")
+        .iter()
+        .map(|c| {
+            (
+                format!(
+                    "{}.{}",
+                    c["effect"].as_str().unwrap(),
+                    c["parameter"].as_str().unwrap()
+                ),
+                c["from"].as_f64().unwrap(),
+                c["to"].as_f64().unwrap(),
+                c["u"].as_f64().unwrap(),
+                c["added"].as_bool().unwrap(),
+            )
+        })
+        .collect()
+}
