@@ -4,6 +4,8 @@
 //! evaluates the signals at the twin's timing and, when the recording's differs, again at
 //! the corrected one.
 //!
+//! Plain `explain` does the same with the timing it finds.
+//!
 //! Two recordings the twin's code path did not make: one written by `ratecal-witness` (a
 //! second, closed-form implementation of the spec), and a dry run on a station file with
 //! the timing that the twin lacks.
@@ -116,6 +118,46 @@ fn a_witness_recording_with_a_clock_rate_and_a_time_offset_against_a_twin_withou
     // The corrected twin is right: nothing to change.
     let (c, v) = explain(dir, "real", "updated.yaml", &[]);
     assert_eq!(c, 0, "{}", v["twin"]["changes"]);
+    // Plain explain (no twin) takes the timing it finds exactly too: both terms within 3u,
+    // nothing discovered, nothing left unexplained.
+    let o = ratecal(&["explain", "real", "--format", "json"], dir);
+    assert_eq!(code(&o), 1, "{}", text(&o));
+    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    for (id, p, truth) in [
+        ("time_offset", "tau_ms", tau_ms),
+        ("clock_rate", "ppm", ppm),
+    ] {
+        let f = v["findings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|f| f["effect"] == id)
+            .unwrap_or_else(|| panic!("{id} in {}", v["findings"]));
+        let (x, u) = (
+            f["parameters"][p]["value"].as_f64().unwrap(),
+            f["parameters"][p]["u"].as_f64().unwrap(),
+        );
+        assert!(
+            (x - truth).abs() < 3.0 * u,
+            "{id}.{p} = {x} ± {u}, truth {truth}"
+        );
+    }
+    let found: Vec<&str> = v["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["effect"].as_str().unwrap())
+        .collect();
+    assert!(
+        found.iter().all(|e| !e.starts_with("discovered")),
+        "{found:?}"
+    );
+    assert_eq!(
+        v["unexplained"].as_array().unwrap().len(),
+        0,
+        "{}",
+        v["unexplained"]
+    );
 }
 
 #[test]

@@ -24,7 +24,10 @@ mod plausible;
 mod probe;
 mod select;
 mod text;
+mod timing;
 mod unexplained;
+
+pub(crate) use timing::TIMING;
 pub mod user;
 
 pub use adopt::{AdoptTarget, Adoption, adoption, next_version};
@@ -82,13 +85,8 @@ pub fn explain_source<S: Source>(
     opts: &Options,
 ) -> Result<Explanation, S::Error> {
     let (data, nonfinite) = accumulate(src, opts, crate::fit::Retime::default())?;
-    Ok(explain_data(
-        src.manifest(),
-        &data,
-        &nonfinite,
-        nominal,
-        opts,
-    ))
+    let x = explain_data(src.manifest(), &data, &nonfinite, nominal, opts);
+    timing::exact(src, nominal, opts, x)
 }
 
 /// The recording accumulated once for explain (the registry's effects and `opts.user`),
@@ -118,6 +116,18 @@ pub(crate) fn explain_data(
     nominal: &NominalModel,
     opts: &Options,
 ) -> Explanation {
+    explain_fitted(m, data, nonfinite, nominal, opts).0
+}
+
+/// [`explain_data`], with the final model's value and u of the first column of each
+/// nominal timing term ([`TIMING`]): what is left about the timing the data hold.
+pub(crate) fn explain_fitted(
+    m: &Manifest,
+    data: &Data,
+    nonfinite: &[usize],
+    nominal: &NominalModel,
+    opts: &Options,
+) -> (Explanation, Vec<(&'static str, f64, f64)>) {
     let clock = std::time::Instant::now();
     let debug = std::env::var_os("RATECAL_EXPLAIN_DEBUG").is_some();
     let lay = &data.layout;
@@ -217,6 +227,18 @@ pub(crate) fn explain_data(
         eprintln!("discovered in {:?}", clock.elapsed());
     }
     let whole = fit(data, &terms, &all, &all);
+    let timing_left: Vec<(&'static str, f64, f64)> = TIMING
+        .iter()
+        .filter(|id| nominal.effects.contains(id))
+        .filter_map(|id| {
+            let g = lay.columns_of(lay.index(id)?).start;
+            whole
+                .0
+                .estimated
+                .contains(&g)
+                .then(|| (*id, whole.0.theta[g], whole.0.u(g)))
+        })
+        .collect();
     let mut findings: Vec<Finding> = steps
         .iter()
         .map(|step| {
@@ -266,7 +288,7 @@ pub(crate) fn explain_data(
         .map(|f| f.effect.as_str())
         .collect();
     let adopt = (!ids.is_empty()).then(|| format!("with {}", ids.join(", ")));
-    Explanation {
+    let x = Explanation {
         format: FORMAT.into(),
         recording: opts.path.clone(),
         nominal: nominal_out,
@@ -298,7 +320,8 @@ pub(crate) fn explain_data(
             })
             .collect(),
         warnings,
-    }
+    };
+    (x, timing_left)
 }
 
 /// One accepted step as a finding, its parameters from the final model fitted on every

@@ -52,7 +52,7 @@ const NOMINAL: [&str; 4] = ["accel_bias", "accel_scale", "gyro_bias", "gyro_scal
 
 /// The registry's timing terms: the simulator re-times the motion by them (exactly), so
 /// the comparison evaluates the signals at the twin's timing and fits what is left.
-pub(crate) const TIMING: [&str; 2] = ["time_offset", "clock_rate"];
+pub(crate) use crate::explain::TIMING;
 
 /// The timing a twin declares.
 fn retime_of(twin: &Twin) -> Retime {
