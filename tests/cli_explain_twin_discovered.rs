@@ -197,3 +197,53 @@ fn a_discovered_g_squared_sensitivity_is_simulated_on_the_updated_twin() {
     let (c, v) = explain(dir, &dir.join("dry"), "upd/without.yaml", &[]);
     assert_eq!(c, 1, "{}", v["twin"]);
 }
+
+/// A warm-up (300 s) in a witness recording (a closed-form implementation of the spec)
+/// joins the twin as its discovered decay: the draft written and referenced, the
+/// amplitudes within 3u (plus 15 % for the grid's time constant) of the truth, and the
+/// updated twin right (`update`).
+#[test]
+fn a_discovered_warm_up_joins_the_twin() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let (a, tau) = ([0.03, -0.02, 0.025], 300.0);
+    let mut s = ratecal_witness::Scenario::standard("warm-up", 1).with(
+        ratecal_witness::Hidden::GyroWarmUp {
+            amplitude_dps: a,
+            tau_s: tau,
+        },
+    );
+    // A constant temperature: nothing thermal to mistake it for.
+    s.thermal.rise_c = 0.0;
+    let rec = dir.join("warm");
+    ratecal_witness::write(&rec, &s).unwrap();
+    let found = update(dir, &rec);
+    let id = &found[0].0;
+    let found_tau: f64 = id
+        .rsplit("decay_")
+        .next()
+        .and_then(|r| r.strip_suffix('s'))
+        .and_then(|r| r.parse().ok())
+        .unwrap_or_else(|| panic!("a decay: {id}"));
+    assert!((found_tau - tau).abs() < 0.15 * tau, "{found_tau} s");
+    // Amplitudes at the expression's t0, deg/h.
+    let draft = std::fs::read_to_string(dir.join("upd").join(format!("{id}.effect"))).unwrap();
+    let t0: f64 = draft
+        .split("(t_s - ")
+        .nth(1)
+        .and_then(|r| r.split(')').next())
+        .and_then(|r| r.parse().ok())
+        .unwrap_or_else(|| panic!("{draft}"));
+    for (_, p, to, u, unit) in &found {
+        assert_eq!(unit, "deg/h");
+        let i = ["k_gx", "k_gy", "k_gz"]
+            .iter()
+            .position(|c| c == p)
+            .unwrap();
+        let truth = a[i] * 3600.0 * (-t0 / tau).exp();
+        assert!(
+            (to - truth).abs() <= 3.0 * u + 0.15 * truth.abs(),
+            "{p}: {to} ± {u}, truth {truth}"
+        );
+    }
+}

@@ -136,3 +136,23 @@ fn two_effects_added_to_an_empty_flow_map_are_both_in_it() {
     assert_eq!(st.imu.effects.value("clock_rate", "ppm"), 60.0, "{out}");
     assert_eq!(DEFAULT_STATION_YAML.lines().count(), out.lines().count());
 }
+
+#[test]
+fn two_user_effects_added_to_a_file_without_any_share_one_block() {
+    let file = |id: &str| {
+        let mut v = set(id, "k_gx", 1.5, 0.1);
+        v.file = Some(format!("{id}.effect"));
+        v
+    };
+    let sets = [file("discovered_a"), file("discovered_b")];
+    let out = edit(DEFAULT_STATION_YAML, &sets).unwrap();
+    let st = Station::from_yaml(&out, "out.yaml").unwrap_or_else(|e| panic!("{e:?}\n{out}"));
+    for id in ["discovered_a", "discovered_b"] {
+        assert_eq!(
+            st.imu.user_effects[id].file,
+            format!("{id}.effect"),
+            "{out}"
+        );
+    }
+    assert_eq!(out.matches("user_effects:").count(), 1, "{out}");
+}

@@ -252,13 +252,24 @@ fn user(
     let entry = || format!("{id}: {{ file: {file:?}, values: {} }}", flow());
     match &imu.user_effects {
         None => {
-            let e = if text[imu_at..].starts_with('{') {
-                format!("user_effects: {{ {} }}", entry())
+            let flow = text[imu_at..].starts_with('{');
+            let col = column(text, imu_at) + 2;
+            // A second user effect joins the block the first one added.
+            if let Some(e) = edits.iter_mut().find(|e| e.2.contains("user_effects: {"))
+                && flow
+            {
+                let open = e.2.strip_suffix(" }").unwrap_or(&e.2).to_string();
+                e.2 = format!("{open}, {} }}", entry());
+            } else if let Some(e) = edits.iter_mut().find(|e| e.2.contains("user_effects:\n")) {
+                e.2 = format!("{}\n{}{}", e.2, " ".repeat(col), entry());
             } else {
-                let col = column(text, imu_at) + 2;
-                format!("user_effects:\n{}{}", " ".repeat(col), entry())
-            };
-            insert_entry(text, imu_at, &e, edits);
+                let e = if flow {
+                    format!("user_effects: {{ {} }}", entry())
+                } else {
+                    format!("user_effects:\n{}{}", " ".repeat(col), entry())
+                };
+                insert_entry(text, imu_at, &e, edits);
+            }
         }
         Some(block) => match block.value.get(id) {
             None => insert_entry(text, start(block)?, &entry(), edits),
