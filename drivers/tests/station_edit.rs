@@ -156,3 +156,30 @@ fn two_user_effects_added_to_a_file_without_any_share_one_block() {
     }
     assert_eq!(out.matches("user_effects:").count(), 1, "{out}");
 }
+
+#[test]
+fn two_effects_added_to_a_file_without_an_effects_key_share_one_block() {
+    let text = DEFAULT_STATION_YAML.replace("  effects: {}\n", "");
+    assert!(!text.contains("effects"));
+    let sets = [
+        set("time_offset", "tau_ms", 4.0, 0.01),
+        set("lever_arm", "rzz_mm", 25.0, 0.1),
+        set("table_encoder_eccentricity", "outer_sin_arcsec", 3.0, 0.5),
+        set("table_encoder_eccentricity", "inner_cos_arcsec", -2.0, 0.5),
+    ];
+    let out = edit(&text, &sets).unwrap();
+    let st = Station::from_yaml(&out, "out.yaml").unwrap_or_else(|e| panic!("{e:?}\n{out}"));
+    assert_eq!(st.imu.effects.value("time_offset", "tau_ms"), 4.0, "{out}");
+    assert_eq!(st.imu.effects.value("lever_arm", "rzz_mm"), 25.0, "{out}");
+    let table = &st.table.effects.0;
+    assert_eq!(
+        table.value("table_encoder_eccentricity", "outer_sin_arcsec"),
+        3.0
+    );
+    assert_eq!(
+        table.value("table_encoder_eccentricity", "inner_cos_arcsec"),
+        -2.0
+    );
+    // One `effects:` under the imu, one under the table.
+    assert_eq!(out.matches("effects:").count(), 2, "{out}");
+}

@@ -90,6 +90,7 @@ type Edits = Vec<(usize, usize, String)>;
 pub fn edit(text: &str, sets: &[SetValue]) -> Result<String, String> {
     let skel: Skel = serde_saphyr::from_str(text).map_err(|e| e.to_string())?;
     let mut edits: Edits = Vec::new();
+    let mut new_blocks = NewBlocks::default();
     let mut by_effect: BTreeMap<&str, Vec<&SetValue>> = BTreeMap::new();
     for s in sets {
         by_effect.entry(s.effect.as_str()).or_default().push(s);
@@ -100,7 +101,9 @@ pub fn edit(text: &str, sets: &[SetValue]) -> Result<String, String> {
             let file = values.iter().find_map(|v| v.file.clone()).ok_or_else(|| {
                 format!("`{id}` is neither a registry effect nor a user effect's")
             })?;
-            user(text, start(&skel.imu)?, imu, id, &file, &values, &mut edits)?;
+            if let Some(entry) = user(text, imu, id, &file, &values, &mut edits)? {
+                new_blocks.add(start(&skel.imu)?, "user_effects", entry);
+            }
             continue;
         };
         let named = |name: &str| {
@@ -168,15 +171,7 @@ pub fn edit(text: &str, sets: &[SetValue]) -> Result<String, String> {
             format!("{{ {} }}", inner.join(", "))
         };
         match block {
-            None => {
-                let col = column(text, owner) + 2;
-                let entry = if text[owner..].starts_with('{') {
-                    format!("effects: {{ {id}: {} }}", flow(&params))
-                } else {
-                    format!("effects:\n{}{id}: {}", " ".repeat(col), flow(&params))
-                };
-                insert_entry(text, owner, &entry, &mut edits);
-            }
+            None => new_blocks.add(owner, "effects", format!("{id}: {}", flow(&params))),
             Some(block) => match block.value.get(id) {
                 None => insert_entry(
                     text,
@@ -203,7 +198,37 @@ pub fn edit(text: &str, sets: &[SetValue]) -> Result<String, String> {
             },
         }
     }
+    new_blocks.write(text, &mut edits);
     Ok(apply(text, edits))
+}
+
+/// The blocks the edit adds (`imu.effects`, `table.effects`, `imu.user_effects` where the
+/// file has none): their entries gathered, so that one key holds every entry.
+#[derive(Default)]
+struct NewBlocks(Vec<(usize, &'static str, Vec<String>)>);
+
+impl NewBlocks {
+    /// Entry `entry` under `key`, a block the map starting at `owner` lacks.
+    fn add(&mut self, owner: usize, key: &'static str, entry: String) {
+        match self.0.iter_mut().find(|b| (b.0, b.1) == (owner, key)) {
+            Some(b) => b.2.push(entry),
+            None => self.0.push((owner, key, vec![entry])),
+        }
+    }
+
+    /// The blocks' insertions, in the owner's style (flow or block).
+    fn write(self, text: &str, edits: &mut Edits) {
+        for (owner, key, entries) in self.0 {
+            let block = if text[owner..].starts_with('{') {
+                format!("{key}: {{ {} }}", entries.join(", "))
+            } else {
+                let pad = " ".repeat(column(text, owner) + 2);
+                let lines: Vec<String> = entries.iter().map(|e| format!("\n{pad}{e}")).collect();
+                format!("{key}:{}", lines.concat())
+            };
+            insert_entry(text, owner, &block, edits);
+        }
+    }
 }
 
 /// `text` with the edits made, from the end backwards. Insertions at one place (the end
@@ -232,16 +257,15 @@ fn apply(text: &str, edits: Edits) -> String {
 }
 
 /// A user effect's values under `imu.user_effects` (the entry, or its `values`, added
-/// when missing).
+/// when missing); the entry, when the file has no `imu.user_effects` to add it to.
 fn user(
     text: &str,
-    imu_at: usize,
     imu: &ImuSkel,
     id: &str,
     file: &str,
     values: &[&SetValue],
     edits: &mut Edits,
-) -> Result<(), String> {
+) -> Result<Option<String>, String> {
     let flow = || {
         let inner: Vec<String> = values
             .iter()
@@ -251,26 +275,7 @@ fn user(
     };
     let entry = || format!("{id}: {{ file: {file:?}, values: {} }}", flow());
     match &imu.user_effects {
-        None => {
-            let flow = text[imu_at..].starts_with('{');
-            let col = column(text, imu_at) + 2;
-            // A second user effect joins the block the first one added.
-            if let Some(e) = edits.iter_mut().find(|e| e.2.contains("user_effects: {"))
-                && flow
-            {
-                let open = e.2.strip_suffix(" }").unwrap_or(&e.2).to_string();
-                e.2 = format!("{open}, {} }}", entry());
-            } else if let Some(e) = edits.iter_mut().find(|e| e.2.contains("user_effects:\n")) {
-                e.2 = format!("{}\n{}{}", e.2, " ".repeat(col), entry());
-            } else {
-                let e = if flow {
-                    format!("user_effects: {{ {} }}", entry())
-                } else {
-                    format!("user_effects:\n{}{}", " ".repeat(col), entry())
-                };
-                insert_entry(text, imu_at, &e, edits);
-            }
-        }
+        None => return Ok(Some(entry())),
         Some(block) => match block.value.get(id) {
             None => insert_entry(text, start(block)?, &entry(), edits),
             Some(u) => match &u.value.values {
@@ -294,7 +299,7 @@ fn user(
             },
         },
     }
-    Ok(())
+    Ok(None)
 }
 
 /// Where a node starts (a block map: its first key; a flow collection: its bracket).
