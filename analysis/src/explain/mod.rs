@@ -281,13 +281,7 @@ pub(crate) fn explain_fitted(
             gyro_dps: floor(3..6),
         },
     };
-    // Only the registry's effects can be declared in a procedure.
-    let ids: Vec<&str> = findings
-        .iter()
-        .filter(|f| f.defined_in.is_none() && !f.discovered)
-        .map(|f| f.effect.as_str())
-        .collect();
-    let adopt = (!ids.is_empty()).then(|| format!("with {}", ids.join(", ")));
+    let adopt = adopt_of(&findings);
     let x = Explanation {
         format: FORMAT.into(),
         recording: opts.path.clone(),
@@ -322,6 +316,17 @@ pub(crate) fn explain_fitted(
         warnings,
     };
     (x, timing_left)
+}
+
+/// How to adopt the findings (`with lever_arm, time_offset`): only the registry's effects
+/// can be declared in a procedure.
+fn adopt_of(findings: &[Finding]) -> Option<String> {
+    let ids: Vec<&str> = findings
+        .iter()
+        .filter(|f| f.defined_in.is_none() && !f.discovered)
+        .map(|f| f.effect.as_str())
+        .collect();
+    (!ids.is_empty()).then(|| format!("with {}", ids.join(", ")))
 }
 
 /// One accepted step as a finding, its parameters from the final model fitted on every

@@ -13,8 +13,8 @@
 use super::{Explanation, Finding, NominalModel, Options, ParamOut, accumulate, explain_fitted};
 use crate::fit::{Retime, Source};
 
-/// The registry's timing terms, with the one parameter each and what it is per unit of
-/// [`Retime`]: `time_offset.tau_ms` (ms, 1e-3 s) and `clock_rate.ppm` (1e-6).
+/// The registry's timing terms, in the order of [`Retime::registry`]: `time_offset.tau_ms`
+/// and `clock_rate.ppm`.
 pub(crate) const TIMING: [&str; 2] = ["time_offset", "clock_rate"];
 
 /// Passes at a corrected timing at most.
@@ -64,10 +64,7 @@ pub(super) fn exact<S: Source>(
     let first = x;
     let mut last = None;
     for _ in 0..PASSES {
-        let retime = Retime {
-            tau_s: held[0].unwrap_or(0.0) * 1e-3,
-            eps: held[1].unwrap_or(0.0) * 1e-6,
-        };
+        let retime = Retime::from_registry(held.map(|h| h.unwrap_or(0.0)));
         let mut model = nominal.clone();
         for (k, id) in TIMING.iter().enumerate() {
             if held[k].is_some() && !model.effects.contains(id) {
@@ -105,13 +102,7 @@ pub(super) fn exact<S: Source>(
     let n = found.len();
     x.findings.splice(0..0, found);
     x.nominal = first.nominal;
-    let ids: Vec<&str> = x
-        .findings
-        .iter()
-        .filter(|f| f.defined_in.is_none() && !f.discovered)
-        .map(|f| f.effect.as_str())
-        .collect();
-    x.adopt = (!ids.is_empty()).then(|| format!("with {}", ids.join(", ")));
+    x.adopt = super::adopt_of(&x.findings);
     x.warnings.push(format!(
         "{n} timing term(s) found: the recording was read again with the table's feedback at the found timing, so that the lag is taken exactly, not to first order"
     ));

@@ -102,9 +102,10 @@ pub(super) fn report(
                 v / (1.0 + s * 1e-6)
             }
             // The timing the signals were evaluated at, plus what the fit leaves.
-            None if id == "time_offset" => v + data.retime.tau_s * 1e3,
-            None if id == "clock_rate" => v + data.retime.eps * 1e6,
-            None => v,
+            None => match super::TIMING.iter().position(|t| *t == id) {
+                Some(k) => v + data.retime.registry()[k],
+                None => v,
+            },
         }
     };
     let normal = Normal::standard();

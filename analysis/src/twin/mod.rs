@@ -56,11 +56,12 @@ pub(crate) use crate::explain::TIMING;
 
 /// The timing a twin declares.
 fn retime_of(twin: &Twin) -> Retime {
-    let at = |id: &str| twin.values(id).and_then(|v| v.first()).copied();
-    Retime {
-        tau_s: at("time_offset").unwrap_or(0.0) * 1e-3,
-        eps: at("clock_rate").unwrap_or(0.0) * 1e-6,
-    }
+    Retime::from_registry(TIMING.map(|id| {
+        twin.values(id)
+            .and_then(|v| v.first())
+            .copied()
+            .unwrap_or(0.0)
+    }))
 }
 
 /// Compares a recording with its twin: explain's findings with the twin's model as the
@@ -153,8 +154,7 @@ fn compare_at<S: Source>(
         }
     }
     // A timing the signals hold is part of the model the recording is compared with.
-    let held = [retime.tau_s, retime.eps];
-    for (id, v) in TIMING.iter().zip(held) {
+    for (id, v) in TIMING.iter().zip(retime.registry()) {
         if v != 0.0 && !effects.contains(id) {
             effects.push(id);
         }

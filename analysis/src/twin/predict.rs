@@ -47,8 +47,7 @@ pub(super) fn theta(m: &Manifest, data: &Data, twin: &Twin, t_ref_data: f64) -> 
         }
     }
     // The signals hold the timing they were evaluated at: its columns measure what is left.
-    let base = [data.retime.tau_s * 1e3, data.retime.eps * 1e6];
-    for (id, b) in super::TIMING.iter().zip(base) {
+    for (id, b) in super::TIMING.iter().zip(data.retime.registry()) {
         set(id, &[-b]);
     }
     let lat = m.station.site.latitude_deg;

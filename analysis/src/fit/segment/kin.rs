@@ -35,6 +35,19 @@ pub struct Retime {
 }
 
 impl Retime {
+    /// From the registry's parameters, `[time_offset.tau_ms, clock_rate.ppm]`.
+    pub fn from_registry([tau_ms, ppm]: [f64; 2]) -> Retime {
+        Retime {
+            tau_s: tau_ms * 1e-3,
+            eps: ppm * 1e-6,
+        }
+    }
+
+    /// The registry's parameters, `[time_offset.tau_ms, clock_rate.ppm]`.
+    pub fn registry(&self) -> [f64; 2] {
+        [self.tau_s * 1e3, self.eps * 1e6]
+    }
+
     /// The table time of the sample stamped `t`.
     pub fn table_time(&self, t: f64) -> f64 {
         if *self == Retime::default() {
