@@ -7,7 +7,7 @@
 //! script `benches/analyze_pandas.py` is timed the same way (whole process) and the ratio
 //! printed.
 
-#[path = "../engine/tests/fit_support/mod.rs"]
+#[path = "../analysis/tests/fit_support/mod.rs"]
 mod fit_support;
 
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -62,24 +62,24 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("analyze");
     g.sample_size(20);
     g.bench_function("read", |b| {
-        b.iter(|| ratecal_engine::recording::read(&dir).unwrap())
+        b.iter(|| ratecal_recording::read(&dir).unwrap())
     });
-    let rec = ratecal_engine::recording::read(&dir).unwrap();
+    let rec = ratecal_recording::read(&dir).unwrap();
     g.bench_function("fit", |b| {
-        b.iter(|| ratecal_engine::fit::analyze(&rec, None))
+        b.iter(|| ratecal_analysis::fit::analyze(&rec, None))
     });
     g.bench_function("read+fit+json", |b| {
         b.iter(|| {
-            let rec = ratecal_engine::recording::read(&dir).unwrap();
-            ratecal_engine::fit::analyze(&rec, None).to_json()
+            let rec = ratecal_recording::read(&dir).unwrap();
+            ratecal_analysis::fit::analyze(&rec, None).to_json()
         })
     });
     // What `ratecal analyze` does: the IMU stream read a window at a time.
     g.bench_function("open+stream+json", |b| {
         b.iter(|| {
-            let src = ratecal_engine::fit::Streamed::open(&dir).unwrap();
-            let opts = ratecal_engine::fit::Options::default();
-            let res = ratecal_engine::fit::analyze_source(&src, None, &opts).unwrap();
+            let src = ratecal_analysis::fit::Streamed::open(&dir).unwrap();
+            let opts = ratecal_analysis::fit::Options::default();
+            let res = ratecal_analysis::fit::analyze_source(&src, None, &opts).unwrap();
             res.to_json()
         })
     });

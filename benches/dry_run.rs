@@ -4,9 +4,9 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use ratecal_drivers::{DEFAULT_STATION_YAML, Station};
-use ratecal_engine::plan::Plan;
-use ratecal_engine::recording::{Columns, Manifest, ManifestStation, RecordingWriter, TableAxes};
-use ratecal_engine::run::{NoProgress, RunOptions, RunStatus, execute};
+use ratecal_plan::Plan;
+use ratecal_recording::{Columns, Manifest, ManifestStation, RecordingWriter, TableAxes};
+use ratecal_run::{NoProgress, RunOptions, RunStatus, execute};
 use std::time::Instant;
 
 /// The default station with the IMU sampled at 1 kHz, noise densities unchanged (the
@@ -24,8 +24,8 @@ fn standard_plan() -> Plan {
         "/procedures/imu-2d-standard/1.0.0.rcal"
     );
     let text = std::fs::read_to_string(path).expect("standard procedure");
-    let opts = ratecal_engine::check::CheckOptions::default();
-    match ratecal_engine::check::check_text(path, &text, &ratecal_engine::check::NoImports, &opts) {
+    let opts = ratecal_check::CheckOptions::default();
+    match ratecal_check::check_text(path, &text, &ratecal_check::NoImports, &opts) {
         Ok(c) => c.plan,
         Err(d) => panic!("{d:?}"),
     }

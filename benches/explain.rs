@@ -3,7 +3,7 @@
 //! process from the command line (the figure: under 1 s on this machine).
 //! The recording is the analyze bench's (`target/analyze-bench-recording/`).
 
-#[path = "../engine/tests/fit_support/mod.rs"]
+#[path = "../analysis/tests/fit_support/mod.rs"]
 mod fit_support;
 
 use criterion::{Criterion, criterion_group, criterion_main};

@@ -14,7 +14,7 @@
 
 use criterion::{Criterion, Throughput, criterion_group};
 use ratecal_drivers::Station;
-use ratecal_engine::recording::{Columns, Manifest, ManifestStation, RecordingWriter, TableAxes};
+use ratecal_recording::{Columns, Manifest, ManifestStation, RecordingWriter, TableAxes};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};

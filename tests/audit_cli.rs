@@ -4,7 +4,7 @@ use std::path::Path;
 use std::process::Command;
 
 fn sha(bytes: &[u8]) -> String {
-    ratecal_engine::audit::verify::sha256_hex(bytes)
+    ratecal_folder::hashes::sha256_hex(bytes)
 }
 
 const IMU: &str = "t,ax,ay,az,gx,gy,gz\n0,0,0,9.8,0,0,0\n0.01,0,0,9.8,0,0,0\n";
@@ -56,7 +56,7 @@ run:
         .iter()
         .map(|n| (*n, std::fs::read(dir.join(n)).unwrap()))
         .collect();
-    let seal = ratecal_engine::audit::seal::Seal::new(
+    let seal = ratecal_folder::seal::Seal::new(
         "2026-01-01T01:00:00Z",
         bytes.iter().map(|(n, b)| (*n, b.as_slice())),
     );
@@ -64,7 +64,7 @@ run:
     std::fs::write(dir.join("seal.json"), &json).unwrap();
     std::fs::write(
         dir.join("seal.sha256"),
-        ratecal_engine::audit::seal::Seal::hash_line(&json),
+        ratecal_folder::seal::Seal::hash_line(&json),
     )
     .unwrap();
 }

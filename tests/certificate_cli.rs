@@ -181,7 +181,7 @@ fn full_flow(procedure: &str, text_of: Option<&str>, label: &str, step: &str, gy
     let pages = pdf_pages(&std::fs::read(dir.join("cert.pdf")).unwrap());
     let n = pages.len();
     assert!(n >= 2, "{n} pages");
-    let year = &ratecal_engine::recording::rfc3339(std::time::SystemTime::now())[..4];
+    let year = &ratecal_recording::rfc3339(std::time::SystemTime::now())[..4];
     let number = format!("EICL-{year}-000001");
     for (i, p) in pages.iter().enumerate() {
         let p = flat(p);
@@ -600,7 +600,7 @@ fn concurrent_numbering(dir: &Path, archive: &str) {
     }
     let all: std::collections::BTreeSet<&String> = by_run.iter().flatten().collect();
     assert_eq!(all.len(), 4, "no two runs share a number: {by_run:?}");
-    let year = &ratecal_engine::recording::rfc3339(std::time::SystemTime::now())[..4];
+    let year = &ratecal_recording::rfc3339(std::time::SystemTime::now())[..4];
     let expected: std::collections::BTreeSet<String> =
         (1..=4).map(|n| format!("EICL-{year}-{n:06}")).collect();
     assert_eq!(

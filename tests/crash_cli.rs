@@ -68,7 +68,7 @@ fn finish_and_check(dir: &Path, cwd: &Path, what: &str) {
     }
     let o = ratecal(&["verify", &d], cwd);
     assert_eq!(code(&o), 0, "{what}: {}", text(&o));
-    let rec = ratecal_engine::recording::read(dir)
+    let rec = ratecal_recording::read(dir)
         .unwrap_or_else(|e| panic!("{what}: sealed but unreadable: {e}"));
     let run = rec.manifest.run.as_ref().unwrap();
     assert_eq!(run.status, "completed", "{what}");
@@ -164,7 +164,7 @@ fn a_tail_written_after_the_last_record_is_cut_by_resume_and_said() {
     assert_eq!(code(&o), 4, "{}", text(&o));
     let o = ratecal(&["run", "--resume", "r"], tmp.path());
     assert_eq!(code(&o), 0, "{}", text(&o));
-    let m = ratecal_engine::recording::read(&tmp.path().join("r"))
+    let m = ratecal_recording::read(&tmp.path().join("r"))
         .unwrap()
         .manifest;
     let resumes = m.run.unwrap().resumes;
@@ -251,7 +251,7 @@ fn a_resume_stopped_at_any_named_point_leaves_the_sealed_run_or_the_new_one() {
         }
         finish_and_check(&dir, tmp.path(), point);
         // The resume is on record, and the resumed part's streams continue the old ones.
-        let m = ratecal_engine::recording::read(&dir).unwrap().manifest;
+        let m = ratecal_recording::read(&dir).unwrap().manifest;
         assert!(!m.run.unwrap().resumes.is_empty(), "{point}");
     }
 }

@@ -7,8 +7,8 @@ use std::path::Path;
 use std::process::Command;
 use support::{MINI, code, ratecal, station_with, text};
 
-fn manifest(dir: &Path) -> ratecal_engine::recording::Manifest {
-    ratecal_engine::recording::parse_manifest(
+fn manifest(dir: &Path) -> ratecal_recording::Manifest {
+    ratecal_recording::parse_manifest(
         "manifest.yaml",
         &std::fs::read_to_string(dir.join("manifest.yaml")).unwrap(),
     )
@@ -96,7 +96,7 @@ fn dry_run_writes_the_run_folder() {
     );
     let canon = ratecal_grammar::canonical(MINI).unwrap();
     assert_eq!(m.procedure.unwrap().sha256, canon.sha256);
-    let rec = ratecal_engine::recording::read(&dir).unwrap();
+    let rec = ratecal_recording::read(&dir).unwrap();
     assert!(rec.imu.t[0] >= 0.0 && rec.imu.t[0] < 0.02);
     assert!(text(&o).contains("run folder"));
     // Same seed, same recording.
@@ -137,7 +137,7 @@ fn station_fault_aborts_with_4_and_resume_completes() {
     assert_eq!(run.status, "aborted");
     let abort = run.abort.as_ref().unwrap();
     assert!(abort.rule.contains("ambient.temperature"), "{}", abort.rule);
-    let rec = ratecal_engine::recording::read(&dir).unwrap();
+    let rec = ratecal_recording::read(&dir).unwrap();
     assert!(*rec.imu.t.last().unwrap() >= abort.t - 0.02);
 
     // The lab recovers; the run resumes with the station file it started with (the
@@ -163,7 +163,7 @@ fn station_fault_aborts_with_4_and_resume_completes() {
     let o = ratecal(&["verify", "r"], tmp.path());
     assert_eq!(code(&o), 0, "{}", text(&o));
     // One recording, time increasing through the resume; it reads back.
-    ratecal_engine::recording::read(&dir).unwrap();
+    ratecal_recording::read(&dir).unwrap();
     // Nothing left to resume.
     assert_eq!(code(&ratecal(&["run", "--resume", "r"], tmp.path())), 1);
 }
@@ -315,7 +315,7 @@ fn ctrl_c_aborts_with_4_and_keeps_the_recording() {
         "{:?}",
         run.abort
     );
-    let rec = ratecal_engine::recording::read(&tmp.path().join("cut")).unwrap();
+    let rec = ratecal_recording::read(&tmp.path().join("cut")).unwrap();
     // Every sample up to the stop is on disk: the IMU stream reaches the abort time.
     let t_abort = run.abort.as_ref().unwrap().t;
     let last = rec.imu.t[rec.imu.t.len() - 1];

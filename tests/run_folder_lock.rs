@@ -100,7 +100,7 @@ fn a_second_writer_is_refused_at_once_and_the_folder_then_verifies() {
     assert!(!text(&o).contains(".ratecal.lock"), "{}", text(&o));
     let seal = json(&dir.join("seal.json"));
     assert!(seal["files"].get(".ratecal.lock").is_none(), "{seal}");
-    ratecal_engine::recording::read(&dir).unwrap();
+    ratecal_recording::read(&dir).unwrap();
 }
 
 #[test]

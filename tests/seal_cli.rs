@@ -5,8 +5,8 @@
 mod support;
 use support::*;
 
-use ratecal_engine::audit::seal::Seal;
-use ratecal_engine::audit::verify::sha256_hex;
+use ratecal_folder::hashes::sha256_hex;
+use ratecal_folder::seal::Seal;
 use std::path::Path;
 
 fn copy_dir(from: &Path, to: &Path) {
@@ -226,7 +226,7 @@ fn resume_refuses_a_folder_whose_inputs_changed() {
     assert_eq!(code(&o), 1, "{}", text(&o));
     let err = text(&o);
     assert!(err.contains("procedure.rcal: recorded sha256"), "{err}");
-    let recorded = ratecal_engine::recording::parse_manifest("manifest.yaml", &m)
+    let recorded = ratecal_recording::parse_manifest("manifest.yaml", &m)
         .unwrap()
         .procedure
         .unwrap()

@@ -33,7 +33,7 @@ fn a_file_size_limit_aborts_the_run_and_what_is_sealed_reads_back() {
     assert!(out.contains("ratecal run --resume r"), "{out}");
 
     let dir = tmp.path().join("r");
-    let m = ratecal_engine::recording::read(&dir)
+    let m = ratecal_recording::read(&dir)
         .unwrap_or_else(|e| panic!("sealed but unreadable: {e}"))
         .manifest;
     let run = m.run.as_ref().unwrap();
@@ -65,7 +65,7 @@ fn a_file_size_limit_aborts_the_run_and_what_is_sealed_reads_back() {
     assert_eq!(code(&o), 0, "{}", text(&o));
     let o = ratecal(&["verify", "r"], tmp.path());
     assert_eq!(code(&o), 0, "{}", text(&o));
-    let m = ratecal_engine::recording::read(&dir).unwrap().manifest;
+    let m = ratecal_recording::read(&dir).unwrap().manifest;
     assert_eq!(m.segments.len(), 3, "{:?}", m.segments);
     assert!(m.run.unwrap().write_failure.is_none());
 }

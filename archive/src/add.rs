@@ -51,7 +51,7 @@ impl Archive {
                 });
             }
         }
-        ratecal_engine::recording::commit::crash_point("archive-after-files");
+        ratecal_recording::commit::crash_point("archive-after-files");
         let new = self.insert_index(folder).await?;
         Ok(Added { id, new, files })
     }

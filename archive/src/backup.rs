@@ -3,7 +3,7 @@
 
 use crate::ingest::{Folder, IndexFacts, LimitRow, ParamRow};
 use crate::{Archive, ArchiveError, Backend, Location, Result};
-use ratecal_engine::audit::verify::sha256_hex;
+use ratecal_folder::hashes::sha256_hex;
 use sqlx::Row;
 use std::collections::HashMap;
 use std::path::Path;

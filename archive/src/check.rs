@@ -2,7 +2,7 @@
 //! stored file.
 
 use crate::{Archive, Result};
-use ratecal_engine::audit::verify::sha256_hex;
+use ratecal_folder::hashes::sha256_hex;
 use serde::Serialize;
 
 /// What `check` found.

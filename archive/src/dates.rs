@@ -31,13 +31,13 @@ pub fn days_from_iso(s: &str) -> Option<f64> {
 
 /// `YYYY-MM-DD` of a day count.
 pub fn iso_date(days: f64) -> String {
-    let (y, m, d) = ratecal_engine::recording::civil_from_days(days.floor() as i64);
+    let (y, m, d) = ratecal_recording::civil_from_days(days.floor() as i64);
     format!("{y:04}-{m:02}-{d:02}")
 }
 
 /// Now, RFC 3339 UTC.
 pub fn now_rfc3339() -> String {
-    ratecal_engine::recording::rfc3339(std::time::SystemTime::now())
+    ratecal_recording::rfc3339(std::time::SystemTime::now())
 }
 
 fn split_offset(t: &str) -> Option<(&str, f64)> {

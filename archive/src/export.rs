@@ -1,7 +1,7 @@
 //! Giving a run folder back, byte for byte, from the store.
 
 use crate::{Archive, ArchiveError, Result};
-use ratecal_engine::audit::verify::sha256_hex;
+use ratecal_folder::hashes::sha256_hex;
 use std::path::{Component, Path};
 
 impl Archive {

@@ -2,9 +2,9 @@
 //! index facts (from manifest.yaml and, when present, results.json).
 
 use crate::{ArchiveError, Result};
-use ratecal_engine::audit::seal::is_scratch;
-use ratecal_engine::audit::verify::sha256_hex;
-use ratecal_engine::recording::{FileState, Manifest, hash_folder, regular};
+use ratecal_folder::hashes::sha256_hex;
+use ratecal_folder::seal::is_scratch;
+use ratecal_recording::{FileState, Manifest, hash_folder, regular};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -155,8 +155,7 @@ fn facts(m: &Manifest, results: Option<&Value>) -> IndexFacts {
             .unwrap_or_else(|| UNKNOWN.to_string())
     };
     let run = m.run.as_ref();
-    let run_str =
-        |f: fn(&ratecal_engine::recording::RunInfo) -> String| run.map(f).unwrap_or_default();
+    let run_str = |f: fn(&ratecal_recording::RunInfo) -> String| run.map(f).unwrap_or_default();
     let proc_ = m.procedure.clone();
     let env = m.environment.clone().unwrap_or_default();
     let table_model = m

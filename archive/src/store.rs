@@ -52,7 +52,7 @@ impl Store {
             Store::Folder(root) => copy_file(root, sha, src),
             Store::Database => {
                 let bytes = std::fs::read(src).map_err(|e| ArchiveError::io(src, e))?;
-                if ratecal_engine::audit::verify::sha256_hex(&bytes) != sha {
+                if ratecal_folder::hashes::sha256_hex(&bytes) != sha {
                     return Ok(false);
                 }
                 self.put(pool, sha, &bytes).await?;
@@ -201,7 +201,7 @@ fn copy_file(root: &Path, sha: &str, src: &Path) -> Result<bool> {
         return Ok(true);
     };
     let io = |p: &Path, e| ArchiveError::io(p, e);
-    ratecal_engine::recording::regular(src).map_err(|e| io(src, e))?;
+    ratecal_recording::regular(src).map_err(|e| io(src, e))?;
     let mut from = std::fs::File::open(src).map_err(|e| io(src, e))?;
     let mut to = std::fs::File::create(&tmp).map_err(|e| io(&tmp, e))?;
     let mut hasher = Sha256::new();
@@ -227,7 +227,7 @@ fn copy_file(root: &Path, sha: &str, src: &Path) -> Result<bool> {
         let _ = std::fs::remove_file(&tmp);
         return Ok(false);
     }
-    ratecal_engine::recording::commit::crash_point("archive-before-rename");
+    ratecal_recording::commit::crash_point("archive-before-rename");
     std::fs::rename(&tmp, &dest).map_err(|e| io(&dest, e))?;
     Ok(true)
 }

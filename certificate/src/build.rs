@@ -7,9 +7,9 @@ use crate::model::{
     ProcedureId, ResultLine, StationId, Traceability,
 };
 use crate::terms::{Stated, budget};
-use ratecal_engine::plan::Plan;
-use ratecal_engine::recording::Manifest;
-use ratecal_engine::results::{Parameter, Results};
+use ratecal_analysis::results::{Parameter, Results};
+use ratecal_plan::Plan;
+use ratecal_recording::Manifest;
 
 /// Everything a certificate is made of.
 pub struct Input<'a> {

@@ -3,7 +3,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use ratecal_engine::check::{CheckOptions, NoImports, check_text};
+use ratecal_check::{CheckOptions, NoImports, check_text};
 
 fuzz_target!(|data: &[u8]| {
     let text = String::from_utf8_lossy(data);

@@ -26,7 +26,7 @@ fuzz_target!(|data: &[u8]| {
                 assert!(s.t_start.is_finite() && s.t_end > s.t_start);
                 assert!(rec.imu.t.iter().any(|&t| t >= s.t_start && t <= s.t_end));
             }
-            let _ = ratecal_engine::fit::analyze(&rec, None);
+            let _ = ratecal_analysis::fit::analyze(&rec, None);
         }
         Err(RecordingError::Io { .. }) => {}
         Err(e) => {

@@ -6,11 +6,11 @@
 //! not overlap...), 2 usage error (clap).
 
 use super::procedure::{self, FsSources};
-use ratecal_engine::check::{CheckOptions, check_text};
-use ratecal_engine::fit::{self, Options};
-use ratecal_engine::measured::format_measured;
-use ratecal_engine::plan::Plan;
-use ratecal_engine::results::{Parameter, Results, RunVerdict};
+use ratecal_analysis::fit::{self, Options};
+use ratecal_analysis::measured::format_measured;
+use ratecal_analysis::results::{Parameter, Results, RunVerdict};
+use ratecal_check::{CheckOptions, check_text};
+use ratecal_plan::Plan;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -44,7 +44,7 @@ pub fn main(args: Args) -> ExitCode {
     let _lock = match args
         .out
         .as_deref()
-        .map(|p| super::lock::for_file(p, &super::seal::command_line()))
+        .map(|p| ratecal_folder::lock::for_file(p, &ratecal_folder::sealing::command_line()))
     {
         Some(Err(e)) => {
             errln!("{e:?}");
@@ -92,7 +92,11 @@ pub fn main(args: Args) -> ExitCode {
             // A file ratecal writes into a sealed run folder joins the seal, with the
             // command, in one committed change.
             let bytes = (json + "\n").into_bytes();
-            if let Err(e) = super::seal::write_file(path, bytes, &super::seal::command_line()) {
+            if let Err(e) = ratecal_folder::sealing::write_file(
+                path,
+                bytes,
+                &ratecal_folder::sealing::command_line(),
+            ) {
                 errln!("error: cannot write {}: {e}", path.display());
                 return ExitCode::from(1);
             }
@@ -186,7 +190,7 @@ fn summary(r: &Results) {
 /// pass, the warnings with their count (the count results.json and the report give), the
 /// verdict and why it is what it is.
 pub(crate) fn verdict_lines(r: &Results) -> Vec<String> {
-    use ratecal_engine::results::SanityStatus;
+    use ratecal_analysis::results::SanityStatus;
     let mut out = Vec::new();
     let passed = r
         .sanity

@@ -1,12 +1,12 @@
 //! `ratecal approve RUN_DIR --signer NAME --role ROLE --key LAB.key`: records in the run
 //! folder's seal who approved its results for a certificate (name, role, time, the key's
 //! fingerprint), signed with the approver's Ed25519 key over the seal as it is
-//! (`ratecal_engine::audit::seal::Approval`). The folder must pass its seal first. Exit 0
+//! (`ratecal_folder::seal::Approval`). The folder must pass its seal first. Exit 0
 //! approved, 1 input error (unreadable key, not a run folder), 4 the seal fails.
 
 use miette::miette;
-use ratecal_engine::audit::seal::{SEAL_FILE, Seal};
-use ratecal_engine::recording::rfc3339;
+use ratecal_folder::{names::SEAL_FILE, seal::Seal};
+use ratecal_recording::rfc3339;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -29,7 +29,7 @@ pub struct Args {
 /// Runs the subcommand.
 pub fn main(args: Args) -> ExitCode {
     let dir = &args.run_dir;
-    let key = match super::seal::signing_key(&args.key) {
+    let key = match ratecal_folder::keys::signing_key(&args.key) {
         Ok(k) => k,
         Err(e) => {
             errln!("{e:?}");
@@ -47,14 +47,14 @@ pub fn main(args: Args) -> ExitCode {
             return ExitCode::from(2);
         }
     }
-    let _lock = match super::lock::acquire(dir, "approve") {
+    let _lock = match ratecal_folder::lock::acquire(dir, "approve") {
         Ok(l) => l,
         Err(e) => {
             errln!("{e:?}");
             return ExitCode::from(1);
         }
     };
-    if let Err(e) = super::verify::require_intact(dir, "approval") {
+    if let Err(e) = ratecal_folder::verify::require_intact(dir, "approval") {
         errln!("{e:?}");
         return ExitCode::from(4);
     }
@@ -74,7 +74,7 @@ pub fn main(args: Args) -> ExitCode {
     };
     let now = rfc3339(std::time::SystemTime::now());
     seal.approve(args.signer.trim(), args.role.trim(), &now, &key);
-    if let Err(e) = super::seal::save(dir, &seal) {
+    if let Err(e) = ratecal_folder::sealing::save(dir, &seal) {
         errln!("cannot write the seal of {}: {e}", dir.display());
         return ExitCode::from(1);
     }

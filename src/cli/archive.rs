@@ -276,7 +276,7 @@ async fn add(archive: &Archive, runs: &[PathBuf]) -> ExitCode {
 }
 
 async fn add_one(archive: &Archive, dir: &Path) -> Result<String, Report> {
-    let report = super::verify::verify_folder(dir, None)?;
+    let report = ratecal_folder::verify::verify_folder(dir, None)?;
     if !report.intact() {
         return Err(miette::miette!(
             code = "archive::altered",
@@ -429,7 +429,7 @@ fn show_text(d: &ratecal_archive::RunDetail) -> String {
         s.push_str(&format!(
             "  {:<28} {}\n",
             p.name,
-            ratecal_engine::measured::format_measured(p.value, p.u, &p.unit)
+            ratecal_analysis::measured::format_measured(p.value, p.u, &p.unit)
         ));
     }
     s.push_str(&format!("files ({}):\n", d.files.len()));

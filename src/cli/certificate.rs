@@ -9,13 +9,13 @@
 //! its seal.
 
 use miette::{Diagnostic, NamedSource, SourceSpan};
+use ratecal_analysis::results::Results;
 use ratecal_archive::{Archive, Location, days_from_iso};
 use ratecal_certificate::terms::{Stated, TemperatureCoefficients};
 use ratecal_certificate::{ApprovalBlock, Certificate, Input, Lab, StationId, render};
 use ratecal_drivers::Station;
-use ratecal_engine::audit::seal::{SEAL_FILE, Seal};
-use ratecal_engine::plan::Plan;
-use ratecal_engine::results::Results;
+use ratecal_folder::{names::SEAL_FILE, seal::Seal};
+use ratecal_plan::Plan;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -122,7 +122,7 @@ fn io(path: &Path, e: impl std::fmt::Display, help: &str) -> miette::Report {
 
 /// Runs the subcommand.
 pub fn main(args: Args) -> ExitCode {
-    if let Err(e) = super::verify::require_intact(&args.run_dir, "certificate") {
+    if let Err(e) = ratecal_folder::verify::require_intact(&args.run_dir, "certificate") {
         errln!("{e:?}");
         return ExitCode::from(4);
     }
@@ -266,8 +266,7 @@ async fn issue(args: &Args) -> miette::Result<Certificate> {
         .map_err(|e| io(&results_path, e, "results.json follows docs/results.md"))?;
     let manifest_path = dir.join("manifest.yaml");
     let text = read_text(&manifest_path, "give the folder `ratecal run` wrote")?;
-    let manifest =
-        ratecal_engine::recording::parse_manifest(&manifest_path.display().to_string(), &text)?;
+    let manifest = ratecal_recording::parse_manifest(&manifest_path.display().to_string(), &text)?;
     let plan: Option<Plan> = std::fs::read_to_string(dir.join("plan.json"))
         .ok()
         .and_then(|t| serde_json::from_str(&t).ok());
@@ -357,7 +356,7 @@ async fn issue(args: &Args) -> miette::Result<Certificate> {
             archive.location()
         ));
     }
-    let now = ratecal_engine::recording::rfc3339(std::time::SystemTime::now());
+    let now = ratecal_recording::rfc3339(std::time::SystemTime::now());
     let year: i32 = now[..4].parse().unwrap_or(1970);
     let issued = archive
         .certificate_number(

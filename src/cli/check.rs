@@ -2,8 +2,8 @@
 //! each procedure given; every diagnostic at once. Exit 0 (warnings allowed), 1 errors.
 
 use super::procedure::{self, FsSources};
+use ratecal_check::{CheckOptions, StationLimits, check_text};
 use ratecal_drivers::Station;
-use ratecal_engine::check::{CheckOptions, StationLimits, check_text};
 use std::process::ExitCode;
 
 /// Arguments of `ratecal check`.

@@ -3,9 +3,9 @@
 //! resolved. Exit codes like diff(1): 0 no semantic change, 1 changes, 2 error.
 
 use super::procedure::{self, FsSources};
-use ratecal_engine::audit::{self, render};
-use ratecal_engine::check::{CheckOptions, check_text};
-use ratecal_engine::plan::Plan;
+use ratecal_audit::{self as audit, render};
+use ratecal_check::{CheckOptions, check_text};
+use ratecal_plan::Plan;
 use std::io::IsTerminal;
 use std::process::ExitCode;
 

@@ -6,10 +6,10 @@
 //! reported, 2 error; 4 the run folder's seal fails (or it was never sealed).
 
 use super::procedure;
-use ratecal_engine::explain::{self, AdoptTarget, NominalModel, Options, UserEffect};
-use ratecal_engine::fit::{Source, Streamed};
-use ratecal_engine::render;
+use ratecal_analysis::explain::{self, AdoptTarget, NominalModel, Options, UserEffect};
+use ratecal_analysis::fit::{Source, Streamed};
 use ratecal_physics::Effect;
+use ratecal_render as render;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -113,7 +113,7 @@ fn adopt_target(arg: &Path) -> Option<AdoptTarget> {
     let file = procedure::read(&arg.display().to_string()).ok()?;
     let dir = file.path.parent()?;
     let name = file.path.file_name()?.to_string_lossy().into_owned();
-    let lock = std::fs::read_to_string(dir.join(ratecal_engine::audit::versions::LOCK_FILE));
+    let lock = std::fs::read_to_string(dir.join(ratecal_audit::versions::LOCK_FILE));
     let next = lock.ok().and_then(|lock| {
         let siblings: Vec<String> = std::fs::read_dir(dir)
             .ok()?
@@ -135,7 +135,7 @@ fn adopt_target(arg: &Path) -> Option<AdoptTarget> {
 pub fn main(args: Args) -> ExitCode {
     // A folder whose seal fails (or a run never sealed) is not explained, and its seal
     // gains nothing (exit 4, as `report`).
-    if let Err(e) = super::verify::require_intact(&args.run, "explanation") {
+    if let Err(e) = ratecal_folder::verify::require_intact(&args.run, "explanation") {
         eprintln!("{e:?}");
         return ExitCode::from(4);
     }
@@ -150,7 +150,7 @@ pub fn main(args: Args) -> ExitCode {
     // A ratecal run folder gains explain.json: its lock first, so a second writer is
     // refused at once (exit 2, an error as spec/cli.md has it for explain).
     let _lock = if rec.manifest().run.is_some() {
-        match super::lock::acquire(&args.run, &super::seal::command_line()) {
+        match ratecal_folder::lock::acquire(&args.run, &ratecal_folder::sealing::command_line()) {
             Ok(l) => Some(l),
             Err(e) => {
                 eprintln!("{e:?}");
@@ -202,7 +202,7 @@ pub fn main(args: Args) -> ExitCode {
         None => explain::explain_source(&rec, &nominal, &opts).map(|x| (x, None)),
         Some(f) => {
             let twin = super::twin::twin_of(&f.station);
-            ratecal_engine::twin::compare_source(&rec, &twin, &opts).map(|(x, r)| (x, Some(r)))
+            ratecal_analysis::twin::compare_source(&rec, &twin, &opts).map(|(x, r)| (x, Some(r)))
         }
     };
     let (mut x, mut twin) = match explained {
@@ -366,7 +366,7 @@ pub fn main(args: Args) -> ExitCode {
             explain::render_text(&x)
                 + &twin
                     .as_ref()
-                    .map(ratecal_engine::twin::render_text)
+                    .map(ratecal_analysis::twin::render_text)
                     .unwrap_or_default()
         }
     };
@@ -399,7 +399,7 @@ fn write(dir: &Path, files: &[(String, String)], seal: bool) -> std::io::Result<
         .iter()
         .map(|(n, t)| (n.clone(), t.clone().into_bytes()))
         .collect();
-    super::seal::write_files(dir, &bytes, &super::seal::command_line())?;
+    ratecal_folder::sealing::write_files(dir, &bytes, &ratecal_folder::sealing::command_line())?;
     Ok(())
 }
 

@@ -51,7 +51,7 @@ pub fn main(args: Args) -> ExitCode {
         Ok(s) => {
             // Sealed as written, like a run folder: `verify` shows it unaltered and
             // `archive add` accepts it.
-            if let Err(e) = super::seal::write_known(&s.out, None, &s.files) {
+            if let Err(e) = ratecal_folder::sealing::write_known(&s.out, None, &s.files) {
                 errln!("error: cannot seal {}: {e}", s.out.display());
                 return ExitCode::from(1);
             }

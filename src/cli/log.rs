@@ -3,8 +3,8 @@
 //! one-line summary of its semantic changes from the version before. Exit 0, or 2 when
 //! the folder or one of its versions cannot be read or checked.
 
-use ratecal_engine::audit::versions::{self, FolderData, LOCK_FILE, Version, VersionFile};
-use ratecal_engine::audit::{diff, render};
+use ratecal_audit::versions::{self, FolderData, LOCK_FILE, Version, VersionFile};
+use ratecal_audit::{diff, render};
 use ratecal_grammar::ast::TopItem;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;

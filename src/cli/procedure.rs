@@ -1,7 +1,7 @@
 //! Procedure arguments shared by `check`, `fmt`, `run` and `diff`: a file, a folder (its
 //! newest version) or `folder@version`; reading it, and imports from the filesystem.
 
-use ratecal_engine::check::Sources;
+use ratecal_check::Sources;
 use ratecal_grammar::Diagnostic;
 use std::path::{Path, PathBuf};
 
@@ -144,7 +144,7 @@ pub fn report(d: &Diagnostic) {
 /// another hash): refused with `check::changed_after_release` unless `allow`, when it is
 /// reported as a warning and described for the manifest (`Ok(Some(..))`).
 pub fn released_unchanged(file: &ProcedureFile, allow: bool) -> Result<Option<String>, ()> {
-    use ratecal_engine::audit::versions::{LOCK_FILE, changed_after_release};
+    use ratecal_audit::versions::{LOCK_FILE, changed_after_release};
     let Some(dir) = file.path.parent() else {
         return Ok(None);
     };

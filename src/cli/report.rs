@@ -8,8 +8,8 @@
 //! sealed).
 
 use miette::{Diagnostic, NamedSource, SourceSpan};
-use ratecal_engine::plan::Plan;
-use ratecal_engine::render::{self, Format, ReportInput, TemperatureSeries, Templates};
+use ratecal_plan::Plan;
+use ratecal_render::{self as render, Format, ReportInput, TemperatureSeries, Templates};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -73,7 +73,7 @@ pub fn main(args: Args) -> ExitCode {
     // A folder whose seal fails (or a run never sealed) gets no report, and its seal no
     // addition (spec/cli.md: exit 4).
     if args.run_dir.is_dir()
-        && let Err(e) = super::verify::require_intact(&args.run_dir, "report")
+        && let Err(e) = ratecal_folder::verify::require_intact(&args.run_dir, "report")
     {
         errln!("{e:?}");
         return ExitCode::from(4);
@@ -90,7 +90,7 @@ pub fn main(args: Args) -> ExitCode {
 fn report(args: &Args) -> miette::Result<()> {
     // Writing into a run folder: its lock first, so a second writer is refused at once.
     let _lock = match &args.out {
-        Some(out) => super::lock::for_file(out, &super::seal::command_line())?,
+        Some(out) => ratecal_folder::lock::for_file(out, &ratecal_folder::sealing::command_line())?,
         None => None,
     };
     let mut input = read_run(&args.run_dir)?;
@@ -112,8 +112,12 @@ fn report(args: &Args) -> miette::Result<()> {
         Some(out) => {
             // A report written into a sealed run folder joins the seal, with the command,
             // in one committed change.
-            super::seal::write_file(out, text.into_bytes(), &super::seal::command_line())
-                .map_err(|e| io(out, e, "check that the folder exists and is writable"))?;
+            ratecal_folder::sealing::write_file(
+                out,
+                text.into_bytes(),
+                &ratecal_folder::sealing::command_line(),
+            )
+            .map_err(|e| io(out, e, "check that the folder exists and is writable"))?;
         }
         None => out!("{text}"),
     }
@@ -178,7 +182,7 @@ pub fn read_run(dir: &Path) -> miette::Result<ReportInput> {
     let manifest = match std::fs::read_to_string(&manifest_path) {
         Ok(text) => {
             let file = manifest_path.display().to_string();
-            ratecal_engine::recording::parse_manifest(&file, &text)?;
+            ratecal_recording::parse_manifest(&file, &text)?;
             Some(
                 serde_saphyr::from_str::<serde_json::Value>(&text).map_err(|e| {
                     io(
@@ -201,7 +205,7 @@ pub fn read_run(dir: &Path) -> miette::Result<ReportInput> {
     };
     // The temperature plot is a nicety: a recording whose streams cannot be read still
     // gets its report, from results.json alone.
-    let temperature = ratecal_engine::fit::Streamed::open(dir)
+    let temperature = ratecal_analysis::fit::Streamed::open(dir)
         .ok()
         .and_then(|rec| TemperatureSeries::from_source(&rec).ok())
         .unwrap_or_default();

@@ -12,11 +12,11 @@ mod progress;
 mod resume;
 mod setup;
 
-use super::lock::FolderLock;
 use ed25519_dalek::SigningKey;
 use miette::Report;
-use ratecal_engine::recording::{Columns, RecordingWriter};
-use ratecal_engine::run::{RunOptions, execute};
+use ratecal_folder::lock::FolderLock;
+use ratecal_recording::{Columns, RecordingWriter};
+use ratecal_run::{RunOptions, execute};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -104,7 +104,7 @@ fn survive_file_size_limit() {
 /// Everything the interpreter needs, prepared.
 pub(crate) struct Prepared {
     dir: PathBuf,
-    plan: ratecal_engine::plan::Plan,
+    plan: ratecal_plan::Plan,
     station: ratecal_drivers::Station,
     writer: RecordingWriter,
     opts: RunOptions,
@@ -118,7 +118,7 @@ fn run(args: Args) -> Result<ExitCode, Report> {
     let key = args
         .sign
         .as_deref()
-        .map(super::seal::signing_key)
+        .map(ratecal_folder::keys::signing_key)
         .transpose()?;
     // The folder's lock is held to the end, the failure record and the seal included.
     let (prep, _lock) = match &args.resume {
@@ -146,9 +146,7 @@ fn run(args: Args) -> Result<ExitCode, Report> {
             super::archive::after_run(args.archive.as_deref(), &dir);
             Ok(code)
         }
-        Err(report)
-            if staged && ratecal_engine::recording::commit::pending_intent(&dir).is_none() =>
-        {
+        Err(report) if staged && ratecal_recording::commit::pending_intent(&dir).is_none() => {
             // The rest of a sealed run failed before it was committed: the sealed run
             // stands as it was.
             resume::drop_staged(&dir);
@@ -291,7 +289,7 @@ fn prepare_new(args: &Args) -> Result<(Prepared, FolderLock), Report> {
     let io =
         |e: std::io::Error| miette::miette!("cannot write the run folder {}: {e}", dir.display());
     std::fs::create_dir_all(&dir).map_err(io)?;
-    let lock = super::lock::acquire(&dir, &super::seal::command_line())?;
+    let lock = ratecal_folder::lock::acquire(&dir, &ratecal_folder::sealing::command_line())?;
     // Asked again under the lock: another `run --out` may have started it meanwhile.
     if dir.join("manifest.yaml").exists() {
         return Err(miette::miette!(

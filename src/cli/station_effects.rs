@@ -3,8 +3,8 @@
 //! so that the simulator applies them as it applies the registry's effects.
 
 use miette::{NamedSource, Report, SourceSpan, miette};
+use ratecal_analysis::explain::{self, UserEffect};
 use ratecal_drivers::station::{self, Station};
-use ratecal_engine::explain::{self, UserEffect};
 use ratecal_physics::Effect;
 use ratecal_physics::effects::Term;
 use std::path::Path;

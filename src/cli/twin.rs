@@ -4,10 +4,10 @@
 //! input's own text with its diff (docs/explain.md, "The twin").
 
 use miette::{Diagnostic, NamedSource, SourceSpan};
+use ratecal_analysis::explain::Rms;
+use ratecal_analysis::twin::{Change, Twin};
 use ratecal_drivers::station::{self, SetValue, Station};
-use ratecal_engine::explain::Rms;
-use ratecal_engine::recording::Manifest;
-use ratecal_engine::twin::{Change, Twin};
+use ratecal_recording::Manifest;
 use std::path::{Path, PathBuf};
 
 /// A station file read as a twin: its path as shown, its text and what it says.
@@ -19,7 +19,7 @@ pub struct TwinFile {
     /// The parsed station.
     pub station: Station,
     /// The user effects it references (`imu.user_effects`).
-    pub user: Vec<&'static ratecal_engine::explain::UserEffect>,
+    pub user: Vec<&'static ratecal_analysis::explain::UserEffect>,
 }
 
 /// A twin whose site or table geometry contradicts the recording's manifest.
@@ -211,12 +211,12 @@ fn relative_to(file: &Path, out: &Path) -> String {
 /// `out` (the corrected twin), and points those changes at it (`defined_in`), so that the
 /// corrected file references it under `imu.user_effects`.
 pub fn write_drafts(
-    x: &ratecal_engine::explain::Explanation,
+    x: &ratecal_analysis::explain::Explanation,
     changes: &mut [Change],
     out: &Path,
     run: &Path,
 ) -> std::io::Result<()> {
-    use ratecal_engine::explain::draft;
+    use ratecal_analysis::explain::draft;
     let dir = out.parent().unwrap_or(Path::new(""));
     for f in x.findings.iter().filter(|f| f.discovered) {
         if !changes.iter().any(|c| c.effect == f.effect) {

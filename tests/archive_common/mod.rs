@@ -7,7 +7,7 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 pub fn sha(bytes: &[u8]) -> String {
-    ratecal_engine::audit::verify::sha256_hex(bytes)
+    ratecal_folder::hashes::sha256_hex(bytes)
 }
 
 const TABLE: &str = "t,outer,inner,outer_rate,inner_rate\n0,0,0,0,0\n";
@@ -93,7 +93,7 @@ run:
 
 /// Seals the folder as `ratecal run` does last (every file's SHA-256 in seal.json).
 pub fn seal(dir: &Path) {
-    use ratecal_engine::audit::seal::{SEAL_FILE, SEAL_HASH_FILE, Seal};
+    use ratecal_folder::seal::{SEAL_FILE, SEAL_HASH_FILE, Seal};
     let mut files: Vec<(String, Vec<u8>)> = Vec::new();
     let mut stack = vec![dir.to_path_buf()];
     while let Some(d) = stack.pop() {

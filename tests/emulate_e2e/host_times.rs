@@ -4,7 +4,7 @@
 //! manifest's synchronisation figures (`run.sync`), which the driver keeps per batch from
 //! the same arrivals.
 
-use ratecal_engine::recording::{LinkRecord, parse_manifest};
+use ratecal_recording::{LinkRecord, parse_manifest};
 
 /// Rows that arrived within this of the previous one came in the same read, s.
 const SAME_READ_S: f64 = 0.5e-3;

@@ -3,7 +3,7 @@
 
 use super::{ParamTrend, Trend};
 use crate::dates;
-use ratecal_engine::measured::format_measured;
+use ratecal_analysis::measured::format_measured;
 use std::fmt::Write;
 
 impl Trend {

@@ -3,9 +3,9 @@
 
 use crate::cli::procedure;
 use miette::Report;
+use ratecal_check::{CheckOptions, Sources, check_text};
 use ratecal_drivers::Station;
-use ratecal_engine::check::{CheckOptions, Sources, check_text};
-use ratecal_engine::plan::Plan;
+use ratecal_plan::Plan;
 use std::path::Path;
 
 /// Parses and checks a procedure (its imports read through `sources`); returns the plan and

@@ -4,11 +4,11 @@
 
 use ed25519_dalek::SigningKey;
 use miette::Report;
-use ratecal_engine::measured::{format_measured, format_value};
-use ratecal_engine::plan::Plan;
-use ratecal_engine::recording::{manifest_yaml, parse_manifest, rfc3339};
-use ratecal_engine::results::RunVerdict;
-use ratecal_engine::run::{JournalEntry, JournalEvent, RunOutcome, RunStatus};
+use ratecal_analysis::measured::{format_measured, format_value};
+use ratecal_analysis::results::RunVerdict;
+use ratecal_plan::Plan;
+use ratecal_recording::{manifest_yaml, parse_manifest, rfc3339};
+use ratecal_run::{JournalEntry, JournalEvent, RunOutcome, RunStatus};
 use std::path::Path;
 use std::process::ExitCode;
 
@@ -116,7 +116,7 @@ impl End<'_> {
                 outln!("  warning: {w}");
             }
         }
-        if let Err(e) = crate::cli::seal::write(dir, self.key) {
+        if let Err(e) = ratecal_folder::sealing::write(dir, self.key) {
             errln!("cannot seal {}: {e}", dir.display());
             self.warn_not_at_rest();
             return ExitCode::from(1);
@@ -138,14 +138,14 @@ impl End<'_> {
             .outcome
             .warnings
             .iter()
-            .any(|w| w.ends_with(ratecal_engine::run::NOT_AT_REST))
+            .any(|w| w.ends_with(ratecal_run::NOT_AT_REST))
     }
 
     /// The last lines on the console when the table may still be moving: plain, on both
     /// streams (a script may keep only one).
     fn warn_not_at_rest(&self) {
         if !self.at_rest() {
-            let line = format!("WARNING: {}", ratecal_engine::run::NOT_AT_REST);
+            let line = format!("WARNING: {}", ratecal_run::NOT_AT_REST);
             outln!("{line}");
             errln!("{line}");
         }
@@ -153,7 +153,7 @@ impl End<'_> {
 }
 
 /// The failed write the manifest records, if any.
-fn write_failure(dir: &Path) -> Option<ratecal_engine::recording::WriteFailure> {
+fn write_failure(dir: &Path) -> Option<ratecal_recording::WriteFailure> {
     let text = std::fs::read_to_string(dir.join("manifest.yaml")).ok()?;
     parse_manifest("manifest.yaml", &text)
         .ok()?
@@ -178,7 +178,7 @@ pub fn seal_recorded(
             outln!("  warning: {w}");
         }
     }
-    if let Err(e) = crate::cli::seal::write(dir, key) {
+    if let Err(e) = ratecal_folder::sealing::write(dir, key) {
         errln!("cannot seal {}: {e}", dir.display());
         return ExitCode::from(1);
     }
@@ -191,9 +191,9 @@ pub fn seal_recorded(
     }
     if warnings
         .iter()
-        .any(|w| w.ends_with(ratecal_engine::run::NOT_AT_REST))
+        .any(|w| w.ends_with(ratecal_run::NOT_AT_REST))
     {
-        let line = format!("WARNING: {}", ratecal_engine::run::NOT_AT_REST);
+        let line = format!("WARNING: {}", ratecal_run::NOT_AT_REST);
         outln!("{line}");
         errln!("{line}");
     }
@@ -228,7 +228,7 @@ pub fn journal_warnings(dir: &Path) -> Vec<String> {
 /// Analyses the recording kept (complete or not), writes results.json, plan.json and the
 /// reports; the verdict, or `None` when the recording could not be analysed.
 fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict> {
-    use ratecal_engine::fit::{Options, Source, Streamed, analyze_source};
+    use ratecal_analysis::fit::{Options, Source, Streamed, analyze_source};
     // The recording is read back a window at a time, as `ratecal analyze` reads it.
     let unreadable = |e| {
         errln!("{:?}", Report::new(e));
@@ -238,7 +238,7 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
     let mut results = analyze_source(&rec, Some(plan), &Options::default())
         .map_err(unreadable)
         .ok()?;
-    let temperature = ratecal_engine::render::TemperatureSeries::from_source(&rec)
+    let temperature = ratecal_render::TemperatureSeries::from_source(&rec)
         .map_err(unreadable)
         .ok()?;
     let run_warnings = journal_warnings(dir);
@@ -247,7 +247,7 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
         errln!("cannot write results.json: {e}");
         return None;
     }
-    ratecal_engine::recording::commit::crash_point("after-results");
+    ratecal_recording::commit::crash_point("after-results");
     if !results.acceptance.is_empty() {
         outln!("acceptance (value ± expanded uncertainty U, k = 2):");
     }
@@ -275,7 +275,7 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
     if let Ok(json) = serde_json::to_string_pretty(plan) {
         let _ = std::fs::write(dir.join("plan.json"), json);
     }
-    let mut input = ratecal_engine::render::ReportInput::from_run(
+    let mut input = ratecal_render::ReportInput::from_run(
         &results,
         rec.manifest(),
         Some(plan),
@@ -295,7 +295,7 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
             return None;
         }
     }
-    ratecal_engine::recording::commit::crash_point("after-reports");
+    ratecal_recording::commit::crash_point("after-reports");
     Some(results.verdict)
 }
 
@@ -311,12 +311,8 @@ pub fn mark_failed(dir: &Path, why: &str, key: Option<&SigningKey>) -> std::io::
         run.failure = Some(why.to_string());
         run.ended = Some(rfc3339(std::time::SystemTime::now()));
     }
-    ratecal_engine::recording::commit::write_atomic(
-        dir,
-        "manifest.yaml",
-        manifest_yaml(&m)?.as_bytes(),
-    )?;
+    ratecal_recording::commit::write_atomic(dir, "manifest.yaml", manifest_yaml(&m)?.as_bytes())?;
     outln!("FAILED: {why}");
     outln!("the run folder {} records the failure", dir.display());
-    crate::cli::seal::write(dir, key)
+    ratecal_folder::sealing::write(dir, key)
 }

@@ -7,8 +7,8 @@
 //! `..` written as `^` (`import "../lab/limits.rcal"` becomes `imports/^/lab/limits.rcal`).
 
 use crate::cli::procedure::FsSources;
-use ratecal_engine::check::Sources;
-use ratecal_engine::recording::sha256_hex;
+use ratecal_check::Sources;
+use ratecal_recording::sha256_hex;
 use std::cell::RefCell;
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Component, Path, PathBuf};

@@ -1,7 +1,7 @@
 //! The progress bar of `ratecal run` (indicatif), shown only when stderr is a terminal.
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use ratecal_engine::run::Progress;
+use ratecal_run::Progress;
 use std::io::IsTerminal;
 
 /// Step name, run time (simulated or real) against the estimated total.

@@ -9,17 +9,20 @@
 //! followed.
 
 use super::{Prepared, imports, setup};
-use crate::cli::lock::FolderLock;
-use crate::cli::run_folder::{State, state_of};
 use miette::{Report, miette};
-use ratecal_engine::audit::seal::{SEAL_FILE, SEAL_HASH_FILE, verify_hashes};
-use ratecal_engine::recording::commit::{
+use ratecal_folder::lock::FolderLock;
+use ratecal_folder::state::{State, state_of};
+use ratecal_folder::{
+    names::{SEAL_FILE, SEAL_HASH_FILE},
+    seal::verify_hashes,
+};
+use ratecal_recording::commit::{
     Intent, PENDING_DIR, Recovered, commit, crash_point, pending_dir, recover, sync_dir,
 };
-use ratecal_engine::recording::{
+use ratecal_recording::{
     Manifest, RecordingWriter, ResumeRecord, parse_manifest, rfc3339, sha256_hex,
 };
-use ratecal_engine::run::{JournalEntry, JournalEvent, RunOptions, resume_point};
+use ratecal_run::{JournalEntry, JournalEvent, RunOptions, resume_point};
 use std::path::{Path, PathBuf};
 
 /// The files a resumed sealed run continues on staged copies of.
@@ -32,7 +35,7 @@ pub enum Resume {
     /// A run that ended but was never sealed: analyse, report and seal it.
     Seal {
         /// The plan it ran.
-        plan: Box<ratecal_engine::plan::Plan>,
+        plan: Box<ratecal_plan::Plan>,
         /// Its status (`completed`, `aborted`, `failed`).
         status: String,
     },
@@ -51,7 +54,7 @@ pub fn prepare(dir: &Path) -> Result<(Resume, FolderLock), Report> {
         return Err(io(std::io::ErrorKind::NotFound.into()));
     }
     // Taken before the folder's state is read: a second resume is refused, not interleaved.
-    let lock = crate::cli::lock::acquire(dir, &crate::cli::seal::command_line())?;
+    let lock = ratecal_folder::lock::acquire(dir, &ratecal_folder::sealing::command_line())?;
     match recover(dir).map_err(io)? {
         Recovered::Clean => {}
         Recovered::RolledBack => outln!(
@@ -251,7 +254,7 @@ fn altered_stream(dir: &Path, why: &str) -> Report {
 
 /// A run that ended without a seal is sealed only when its streams are as recorded.
 fn unaltered_streams(dir: &Path) -> Result<(), Report> {
-    match ratecal_engine::recording::chain::check_folder(dir) {
+    match ratecal_recording::chain::check_folder(dir) {
         Ok(Ok(())) => Ok(()),
         Ok(Err(why)) => Err(altered_stream(dir, &why)),
         Err(e) => Err(altered_stream(dir, &e.to_string())),
@@ -264,7 +267,7 @@ fn unaltered(dir: &Path) -> Result<(), Report> {
         return Ok(());
     };
     let hash = std::fs::read_to_string(dir.join(SEAL_HASH_FILE)).ok();
-    let files = crate::cli::seal::folder_files(dir)
+    let files = ratecal_folder::sealing::folder_files(dir)
         .map_err(|e| miette!("cannot read {}: {e}", dir.display()))?;
     let report = verify_hashes(Some(&seal), hash.as_deref(), &files, None);
     if report.intact() {

@@ -3,8 +3,8 @@
 
 use miette::{IntoDiagnostic, Report, WrapErr, miette};
 use ratecal_drivers::{DEFAULT_STATION_YAML, SWAYING_STATION_YAML, Station};
-use ratecal_engine::plan::Plan;
-use ratecal_engine::recording::{
+use ratecal_plan::Plan;
+use ratecal_recording::{
     EnvironmentRecord, FORMAT, Manifest, ManifestStation, Mount, ProcedureRef, RunInfo, TableAxes,
     rfc3339, sha256_hex,
 };

@@ -1,0 +1,146 @@
+//! Checking a run folder against its seal: every file, the seal's own hash, the signature;
+//! the refusal of a command that would publish from a folder that fails it; and what a
+//! folder that was never sealed is (its streams against the journal's running hash).
+
+use crate::hashes::VerifyReport;
+use crate::names::{IMU, JOURNAL, MANIFEST, TABLE};
+use crate::names::{SEAL_FILE, SEAL_HASH_FILE};
+use crate::seal::verify_hashes;
+use crate::state::{State, state_of};
+use ed25519_dalek::VerifyingKey;
+use std::path::Path;
+
+/// Every file of a run folder against its seal (and its signature with `key`): what
+/// `ratecal verify` and `ratecal archive add` check. Errs when `dir` is no run folder.
+pub fn verify_folder(
+    dir: &Path,
+    key: Option<&VerifyingKey>,
+) -> Result<VerifyReport, miette::Report> {
+    // A dangling or looping manifest.yaml is still there: `verify` names it, unreadable.
+    let there = |name: &str| std::fs::symlink_metadata(dir.join(name)).is_ok();
+    let is_run = dir.is_dir() && (there(MANIFEST) || there(SEAL_FILE));
+    let files = match crate::sealing::folder_files(dir) {
+        Ok(f) if is_run => f,
+        Ok(_) | Err(_) => {
+            return Err(miette::miette!(
+                code = "verify::not_a_run",
+                help = "give the folder `ratecal run --out` wrote",
+                "{} is not a run folder (no manifest.yaml, no seal.json)",
+                dir.display()
+            ));
+        }
+    };
+    // Read only when regular: a FIFO in their place would block (it is named unreadable).
+    let read = |name: &str| {
+        let p = dir.join(name);
+        ratecal_recording::regular(&p)
+            .ok()
+            .and_then(|()| std::fs::read_to_string(p).ok())
+    };
+    let seal = read(SEAL_FILE);
+    let seal_hash = read(SEAL_HASH_FILE);
+    Ok(verify_hashes(
+        seal.as_deref(),
+        seal_hash.as_deref(),
+        &files,
+        key,
+    ))
+}
+
+/// Why a command that reads a run folder to publish from it (`report`, `explain`) refuses it:
+/// its seal fails, or a ratecal run folder was never sealed. `Ok` for an intact folder and
+/// for a recording another system wrote (no seal, no `run` section in its manifest).
+pub fn require_intact(dir: &Path, command: &str) -> Result<(), miette::Report> {
+    let sealed = std::fs::symlink_metadata(dir.join(SEAL_FILE)).is_ok();
+    if !sealed {
+        let ratecal_run = std::fs::read_to_string(dir.join(MANIFEST))
+            .ok()
+            .and_then(|t| ratecal_recording::parse_manifest(MANIFEST, &t).ok())
+            .is_some_and(|m| m.run.is_some());
+        if !ratecal_run {
+            return Ok(());
+        }
+        return Err(miette::miette!(
+            code = "verify::never_sealed",
+            help = format!(
+                "a run seals its folder when it ends; finish it with `ratecal run --resume {}`",
+                dir.display()
+            ),
+            "{} was never sealed: no {command} from it (nothing shows it unaltered)",
+            dir.display()
+        ));
+    }
+    let report = verify_folder(dir, None)?;
+    if report.intact() {
+        return Ok(());
+    }
+    let names: Vec<&str> = report.altered().map(|c| c.file.as_str()).collect();
+    Err(miette::miette!(
+        code = "verify::altered",
+        help = format!(
+            "`ratecal verify {}` shows what changed; nothing was added to its seal",
+            dir.display()
+        ),
+        "{} fails its seal ({}): no {command} from it",
+        dir.display(),
+        names.join(", ")
+    ))
+}
+
+/// What a ratecal run folder without a seal is (docs/run-folders.md).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Unsealed {
+    /// A change was committed but not carried out (a crash): its seal is not yet in place.
+    Committing,
+    /// Its streams no longer match the journal: why.
+    Altered(String),
+    /// Never sealed, its streams as the journal recorded them: the state's name and what
+    /// happened, in words.
+    NeverSealed {
+        /// The state's name (`recording`, `recorded-unsealed`).
+        state: &'static str,
+        /// What happened.
+        what: String,
+    },
+}
+
+/// A ratecal run folder without a seal, or with a change a crash left unfinished, checked
+/// against its journal. `None` for every other folder.
+pub fn unsealed(dir: &Path) -> Option<Unsealed> {
+    let state = state_of(dir);
+    let tail_ok = match &state {
+        State::Committing => return Some(Unsealed::Committing),
+        State::Recording => true,
+        State::RecordedUnsealed(_) => false,
+        _ => return None,
+    };
+    let check = if tail_ok {
+        streams_match(dir)
+    } else {
+        ratecal_recording::chain::check_folder(dir).unwrap_or_else(|e| Err(e.to_string()))
+    };
+    if let Err(why) = check {
+        return Some(Unsealed::Altered(why));
+    }
+    let what = match &state {
+        State::Recording => "it stopped while recording (or is recording now)".to_string(),
+        State::RecordedUnsealed(s) => format!("the run ended ({s}) but its seal was never written"),
+        _ => unreachable!("handled above"),
+    };
+    Some(Unsealed::NeverSealed {
+        state: state.name(),
+        what,
+    })
+}
+
+/// A run still recording: every block the journal recorded is as written (a tail after the
+/// last record is allowed: `--resume` cuts it).
+fn streams_match(dir: &Path) -> Result<(), String> {
+    use ratecal_recording::chain::{check_stream, journal_blocks};
+    let blocks = journal_blocks(&dir.join(JOURNAL)).map_err(|e| e.to_string())?;
+    for name in [IMU, TABLE] {
+        let records = blocks.get(name).map(Vec::as_slice).unwrap_or_default();
+        check_stream(&dir.join(name), records).map_err(|e| format!("{name}: {e}"))??;
+    }
+    Ok(())
+}
