@@ -63,6 +63,7 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    ratecal_ops::console::install(Box::new(out::Terminal));
     match cli.command {
         Command::Check(a) => cli::check::main(a),
         Command::Fmt(a) => cli::fmt::main(a),

@@ -31,3 +31,31 @@ fn write(w: &mut dyn Write, gone: &AtomicBool, args: std::fmt::Arguments, newlin
         gone.store(true, Ordering::Relaxed);
     }
 }
+
+/// Writes bytes to standard output as they are; after a failed write, nothing more.
+pub fn stdout_bytes(bytes: &[u8]) {
+    if STDOUT_GONE.load(Ordering::Relaxed) {
+        return;
+    }
+    let mut out = std::io::stdout().lock();
+    if out.write_all(bytes).and_then(|()| out.flush()).is_err() {
+        STDOUT_GONE.store(true, Ordering::Relaxed);
+    }
+}
+
+/// The commands' console: the terminal, quiet once a reader has gone.
+pub struct Terminal;
+
+impl ratecal_ops::console::Console for Terminal {
+    fn out(&self, args: std::fmt::Arguments, newline: bool) {
+        stdout(args, newline);
+    }
+
+    fn err(&self, args: std::fmt::Arguments, newline: bool) {
+        stderr(args, newline);
+    }
+
+    fn bytes(&self, bytes: &[u8]) {
+        stdout_bytes(bytes);
+    }
+}

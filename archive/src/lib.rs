@@ -24,6 +24,7 @@ mod ingest;
 mod location;
 mod query;
 mod store;
+mod text;
 pub mod trend;
 
 pub use add::Added;
@@ -36,6 +37,7 @@ pub use ingest::read as read_folder;
 pub use ingest::{Folder, IndexFacts, LimitRow, ParamRow};
 pub use location::Location;
 pub use query::{Filter, RunDetail, RunSummary, StoredFile};
+pub use text::{list_table, show_text};
 
 /// Result of archive operations.
 pub type Result<T> = std::result::Result<T, ArchiveError>;

@@ -7,11 +7,13 @@
 //!   ─ build::build ─► Certificate ─ render::{markdown, html, pdf} / serde_json
 //! ```
 //!
-//! Nothing here opens a file or the archive: the CLI (`ratecal certificate`) reads the run
-//! folder, verifies its seal, takes the number from the archive and hands everything in.
+//! [`issue`] is where a certificate is issued: it reads the laboratory's file and the run
+//! folder (through `ratecal-folder`'s reader), applies the traceability rules and takes the
+//! number from the archive; everything below it is handed its data.
 
 pub mod budget;
 mod build;
+pub mod issue;
 mod model;
 pub mod render;
 pub mod terms;

@@ -1,16 +1,9 @@
 //! `ratecal analyze RUN_DIR... [--procedure PROCEDURE] [--out results.json]`: fits,
-//! uncertainties and acceptance for one recording, or repeatability over several runs.
-//! Exit codes: 0 the verdict is pass or not_judged (no acceptance check to judge), 3 it is
-//! not (a failed check, a check that could not be evaluated, a failed sanity check, an
-//! aborted run), 1 input error (a refused recording: time going backwards, clocks that do
-//! not overlap...), 2 usage error (clap).
+//! uncertainties and acceptance for one recording, or repeatability over several runs
+//! (`ratecal_ops::analyze`). Exit codes: 0 the verdict is pass or not_judged, 3 it is not,
+//! 1 input error, 2 usage error (clap).
 
-use super::procedure::{self, FsSources};
-use ratecal_analysis::fit::{self, Options};
-use ratecal_analysis::measured::format_measured;
-use ratecal_analysis::results::{Parameter, Results, RunVerdict};
-use ratecal_check::{CheckOptions, check_text};
-use ratecal_plan::Plan;
+use ratecal_ops::analyze::{Request, analyze};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -39,185 +32,12 @@ pub struct Args {
 }
 
 /// Runs the subcommand.
-pub fn main(args: Args) -> ExitCode {
-    // Writing into a run folder: its lock first, so a second writer is refused at once.
-    let _lock = match args
-        .out
-        .as_deref()
-        .map(|p| ratecal_folder::lock::for_file(p, &ratecal_folder::sealing::command_line()))
-    {
-        Some(Err(e)) => {
-            errln!("{e:?}");
-            return ExitCode::from(1);
-        }
-        Some(Ok(l)) => l,
-        None => None,
-    };
-    let load = |p: &std::path::Path| load_plan(p, args.allow_changed);
-    let (plan, sha256) = match args.procedure.as_deref().map(load).transpose() {
-        Ok(Some((p, h))) => (Some(p), h),
-        Ok(None) => (None, None),
-        Err(()) => return ExitCode::from(1),
-    };
-    let mut runs = Vec::with_capacity(args.runs.len());
-    for dir in &args.runs {
-        match fit::Streamed::open(dir) {
-            Ok(r) => runs.push((dir.display().to_string(), r)),
-            Err(e) => {
-                errln!("{:?}", miette::Report::new(e));
-                return ExitCode::from(1);
-            }
-        }
-    }
-    let opts = Options {
-        with: args.with.clone(),
-        ..Options::default()
-    };
-    // The IMU stream is read a window at a time: a cell found bad there is refused as a
-    // whole read would have refused it.
-    let mut results = match fit::analyze_runs(&runs, plan.as_ref(), &opts) {
-        Ok(r) => r,
-        Err(e) => {
-            errln!("{:?}", miette::Report::new(e));
-            return ExitCode::from(1);
-        }
-    };
-    // The procedure given on the command line is identified by its own canonical hash.
-    if let (Some(h), Some(p)) = (sha256, results.model.procedure.as_mut()) {
-        p.sha256 = h;
-    }
-    let json = results.to_json();
-    match &args.out {
-        Some(path) => {
-            // A file ratecal writes into a sealed run folder joins the seal, with the
-            // command, in one committed change.
-            let bytes = (json + "\n").into_bytes();
-            if let Err(e) = ratecal_folder::sealing::write_file(
-                path,
-                bytes,
-                &ratecal_folder::sealing::command_line(),
-            ) {
-                errln!("error: cannot write {}: {e}", path.display());
-                return ExitCode::from(1);
-            }
-        }
-        None => outln!("{json}"),
-    }
-    summary(&results);
-    exit_code(results.verdict)
-}
-
-/// 0 for a pass and for nothing judged, 3 for every other verdict (spec/cli.md).
-pub(crate) fn exit_code(v: RunVerdict) -> ExitCode {
-    match v {
-        RunVerdict::Pass | RunVerdict::NotJudged => ExitCode::SUCCESS,
-        _ => ExitCode::from(3),
-    }
-}
-
-/// Loads and checks the procedure (a file, a folder's newest version, `folder@version`)
-/// with the SHA-256 of its canonical text; a checked plan serialized as JSON is accepted
-/// too (no hash then). Diagnostics go to standard error.
-pub(crate) fn load_plan(
-    arg: &std::path::Path,
-    allow_changed: bool,
-) -> Result<(Plan, Option<String>), ()> {
-    if arg.extension().is_some_and(|e| e == "json") {
-        let text = std::fs::read_to_string(arg)
-            .map_err(|e| errln!("error: cannot read {}: {e}", arg.display()))?;
-        return serde_json::from_str(&text)
-            .map(|p| (p, None))
-            .map_err(|e| errln!("error: {}: not a checked plan: {e}", arg.display()));
-    }
-    let file = procedure::read(&arg.display().to_string()).map_err(|d| procedure::report(&d))?;
-    procedure::released_unchanged(&file, allow_changed)?;
-    match check_text(
-        &file.display,
-        &file.text,
-        &FsSources,
-        &CheckOptions::default(),
-    ) {
-        Ok(checked) => {
-            checked.warnings.iter().for_each(procedure::report);
-            let sha256 = ratecal_grammar::canonical(&file.text)
-                .ok()
-                .map(|c| c.sha256);
-            Ok((checked.plan, sha256))
-        }
-        Err(diags) => {
-            diags.iter().for_each(procedure::report);
-            Err(())
-        }
-    }
-}
-
-/// A short human summary on standard error (standard output may hold the JSON).
-fn summary(r: &Results) {
-    errln!("ratecal analyze: {}", r.recording.paths.join(", "));
-    match &r.model.procedure {
-        Some(p) if r.model.selection == "procedure" => {
-            errln!("model: the fits of procedure {} {}", p.name, p.version)
-        }
-        Some(p) => errln!(
-            "model: segments chosen by kind (procedure {} {} has no fit statements)",
-            p.name,
-            p.version
-        ),
-        _ => errln!(
-            "model: segments chosen by kind (no --procedure: no procedure's fits or thresholds apply)"
-        ),
-    }
-    for f in &r.model.fits {
-        errln!("  fit {f}");
-    }
-    for (name, p) in &r.parameters {
-        match p {
-            Parameter::Estimate { value, u, unit } => {
-                errln!("  {name:<32} {}", format_measured(*value, *u, unit))
-            }
-            Parameter::Unobservable { .. } => errln!("  {name:<32} not observable"),
-        }
-    }
-    for a in &r.acceptance {
-        errln!("  [{}] {}", a.verdict.label(), a.name);
-    }
-    for line in verdict_lines(r) {
-        errln!("{line}");
-    }
-}
-
-/// The end of every terminal summary (`analyze`, `run`): the sanity checks that did not
-/// pass, the warnings with their count (the count results.json and the report give), the
-/// verdict and why it is what it is.
-pub(crate) fn verdict_lines(r: &Results) -> Vec<String> {
-    use ratecal_analysis::results::SanityStatus;
-    let mut out = Vec::new();
-    let passed = r
-        .sanity
-        .iter()
-        .filter(|c| c.status == SanityStatus::Pass)
-        .count();
-    out.push(format!(
-        "sanity: {passed} of {} checks pass",
-        r.sanity.len()
-    ));
-    for c in r.sanity.iter().filter(|c| c.status != SanityStatus::Pass) {
-        out.push(format!(
-            "  [{}] {}: {}",
-            c.status.label(),
-            c.check,
-            c.detail
-        ));
-    }
-    out.push(format!("warnings: {}", r.warnings.len()));
-    for w in &r.warnings {
-        out.push(format!("  warning: {w}"));
-    }
-    let why = r
-        .verdict_reason
-        .as_ref()
-        .map(|w| format!(" ({w})"))
-        .unwrap_or_default();
-    out.push(format!("verdict: {}{why}", r.verdict.label()));
-    out
+pub fn main(a: Args) -> ExitCode {
+    ExitCode::from(analyze(&Request {
+        runs: a.runs,
+        procedure: a.procedure,
+        with: a.with,
+        out: a.out,
+        allow_changed: a.allow_changed,
+    }))
 }

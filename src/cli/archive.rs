@@ -6,7 +6,7 @@ use clap::{Subcommand, ValueEnum};
 use miette::Report;
 use ratecal_archive::trend::TrendOptions;
 use ratecal_archive::{Archive, Filter, Location};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Arguments of `ratecal archive`.
@@ -129,14 +129,14 @@ pub fn main(args: Args) -> ExitCode {
     {
         Ok(rt) => rt,
         Err(e) => {
-            eprintln!("{:?}", miette::miette!("cannot start the runtime: {e}"));
+            errln!("{:?}", miette::miette!("cannot start the runtime: {e}"));
             return ExitCode::from(1);
         }
     };
     match rt.block_on(run(&loc, args.command)) {
         Ok(code) => code,
         Err(report) => {
-            eprintln!("{report:?}");
+            errln!("{report:?}");
             ExitCode::from(1)
         }
     }
@@ -181,22 +181,22 @@ async fn run(loc: &Location, cmd: Command) -> Result<ExitCode, Report> {
             };
             let runs = archive.list(&f).await?;
             match format {
-                Format::Json => println!("{}", to_json(&runs)?),
-                Format::Table => print!("{}", list_table(&runs)),
+                Format::Json => outln!("{}", to_json(&runs)?),
+                Format::Table => out!("{}", ratecal_archive::list_table(&runs)),
             }
             ExitCode::SUCCESS
         }
         Command::Show { id, format } => {
             let d = archive.show(&id).await?;
             match format {
-                Format::Json => println!("{}", to_json(&d)?),
-                Format::Table => print!("{}", show_text(&d)),
+                Format::Json => outln!("{}", to_json(&d)?),
+                Format::Table => out!("{}", ratecal_archive::show_text(&d)),
             }
             ExitCode::SUCCESS
         }
         Command::Export { id, dir } => {
             let (id, n) = archive.export(&id, &dir).await?;
-            println!("exported run {id}: {n} file(s) to {}", dir.display());
+            outln!("exported run {id}: {n} file(s) to {}", dir.display());
             ExitCode::SUCCESS
         }
         Command::Trend {
@@ -214,15 +214,15 @@ async fn run(loc: &Location, cmd: Command) -> Result<ExitCode, Report> {
             };
             let t = archive.trend(&serial, &opt).await?;
             match format {
-                TrendFormat::Json => println!("{}", to_json(&t)?),
-                TrendFormat::Table => print!("{}", t.text()),
-                TrendFormat::Svg => print!("{}", t.svg()),
+                TrendFormat::Json => outln!("{}", to_json(&t)?),
+                TrendFormat::Table => out!("{}", t.text()),
+                TrendFormat::Svg => out!("{}", t.svg()),
             }
             if recommend_interval {
                 match t.recommended_interval() {
-                    Some((_, line)) if format == TrendFormat::Table => println!("{line}"),
-                    Some((_, line)) => eprintln!("{line}"),
-                    None => eprintln!(
+                    Some((_, line)) if format == TrendFormat::Table => outln!("{line}"),
+                    Some((_, line)) => errln!("{line}"),
+                    None => errln!(
                         "no recommended recalibration: the history determines no drift \
                          against an acceptance limit"
                     ),
@@ -232,7 +232,7 @@ async fn run(loc: &Location, cmd: Command) -> Result<ExitCode, Report> {
         }
         Command::Backup { dest } => {
             let (runs, files) = archive.backup(&dest).await?;
-            println!(
+            outln!(
                 "backup: {runs} run(s), {files} stored file(s) in {} (open it with --archive {})",
                 dest.display(),
                 dest.display()
@@ -242,8 +242,8 @@ async fn run(loc: &Location, cmd: Command) -> Result<ExitCode, Report> {
         Command::Check { format, fix } => {
             let r = archive.check_fix(fix).await?;
             match format {
-                Format::Json => println!("{}", to_json(&r)?),
-                Format::Table => print!("{}", r.text()),
+                Format::Json => outln!("{}", to_json(&r)?),
+                Format::Table => out!("{}", r.text()),
             }
             if r.ok() {
                 ExitCode::SUCCESS
@@ -260,11 +260,11 @@ async fn run(loc: &Location, cmd: Command) -> Result<ExitCode, Report> {
 async fn add(archive: &Archive, runs: &[PathBuf]) -> ExitCode {
     let mut ok = true;
     for dir in runs {
-        match add_one(archive, dir).await {
-            Ok(line) => println!("{line}"),
+        match ratecal_ops::archive::add_one(archive, dir).await {
+            Ok(line) => outln!("{line}"),
             Err(e) => {
                 ok = false;
-                eprintln!("{e:?}");
+                errln!("{e:?}");
             }
         }
     }
@@ -272,90 +272,6 @@ async fn add(archive: &Archive, runs: &[PathBuf]) -> ExitCode {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(1)
-    }
-}
-
-async fn add_one(archive: &Archive, dir: &Path) -> Result<String, Report> {
-    let report = ratecal_folder::verify::verify_folder(dir, None)?;
-    if !report.intact() {
-        return Err(miette::miette!(
-            code = "archive::altered",
-            help = "the archive keeps runs as they were recorded; archive the original folder",
-            "{} was altered since the run; not archived:\n{}",
-            dir.display(),
-            report.text().trim_end()
-        ));
-    }
-    let added = archive.add(dir).await?;
-    Ok(if added.new {
-        format!(
-            "archived {} as {} ({} file(s))",
-            dir.display(),
-            added.id,
-            added.files
-        )
-    } else {
-        format!("{} is already archived as {}", dir.display(), added.id)
-    })
-}
-
-/// The unit's trend across the calibrations the configured archive holds (`--archive` or
-/// `RATECAL_ARCHIVE`), as `archive trend --format json` gives it, for a report's
-/// conclusions; `None` without an archive, without a serial, or when it cannot be read (a
-/// report never fails for want of its history: a warning says why).
-pub fn trend_json(archive: Option<&str>, serial: Option<&str>) -> Option<serde_json::Value> {
-    let serial = serial.filter(|s| !s.is_empty())?;
-    if !Location::configured(archive) {
-        return None;
-    }
-    let loc = Location::resolve(archive, None);
-    let rt = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()
-        .ok()?;
-    let opt = TrendOptions {
-        params: Vec::new(),
-        include_dry_runs: false,
-        confidence: 0.95,
-    };
-    let res = rt.block_on(async {
-        let a = Archive::open_existing(&loc).await?;
-        let t = a.trend(serial, &opt).await;
-        a.close().await;
-        t
-    });
-    match res {
-        Ok(t) => serde_json::to_value(&t).ok(),
-        Err(e) => {
-            eprintln!("warning: the report leaves out the archive's history of {serial}:\n{e:?}");
-            None
-        }
-    }
-}
-
-/// `ratecal run`'s hook: adds the finished run when an archive is named (`--archive` or
-/// `RATECAL_ARCHIVE`); a failure is a warning, never the run's exit code.
-pub fn after_run(archive: Option<&str>, dir: &Path) {
-    if !Location::configured(archive) {
-        return;
-    }
-    let loc = Location::resolve(archive, None);
-    let Ok(rt) = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()
-    else {
-        eprintln!("warning: the run was not archived (cannot start the runtime)");
-        return;
-    };
-    let res = rt.block_on(async {
-        let a = Archive::open(&loc).await?;
-        let line = add_one(&a, dir).await;
-        a.close().await;
-        line
-    });
-    match res {
-        Ok(line) => println!("{line} in {}", loc.display()),
-        Err(e) => eprintln!("warning: the run was not archived:\n{e:?}"),
     }
 }
 
@@ -379,65 +295,4 @@ fn date_arg(d: &str) -> Result<String, Report> {
 
 fn to_json<T: serde::Serialize>(v: &T) -> Result<String, Report> {
     serde_json::to_string_pretty(v).map_err(|e| miette::miette!("cannot write JSON: {e}"))
-}
-
-fn list_table(runs: &[ratecal_archive::RunSummary]) -> String {
-    let mut s = format!(
-        "{:<16}  {:<12}  {:<12}  {:<20}  {:<8}  {:<20}  {:<10}  {}\n",
-        "ID", "SERIAL", "MODEL", "PROCEDURE", "VERSION", "STARTED", "VERDICT", "DRY RUN"
-    );
-    for r in runs {
-        s.push_str(&format!(
-            "{:<16}  {:<12}  {:<12}  {:<20}  {:<8}  {:<20}  {:<10}  {}\n",
-            r.id,
-            r.serial,
-            r.model,
-            r.procedure,
-            r.version,
-            r.started,
-            r.verdict,
-            if r.dry_run { "yes" } else { "no" }
-        ));
-    }
-    s.push_str(&format!("{} run(s)\n", runs.len()));
-    s
-}
-
-fn show_text(d: &ratecal_archive::RunDetail) -> String {
-    let r = &d.summary;
-    let mut s = format!(
-        "run {} ({})\n  imu: {} serial {}\n  procedure: {} {} (sha256 {})\n  station: {}\n  \
-         operator: {}\n  started: {}\n  ended: {}\n  status: {}, verdict: {}{}\n  environment: {}\n",
-        r.id,
-        r.name,
-        r.model,
-        r.serial,
-        r.procedure,
-        r.version,
-        d.procedure_sha256,
-        r.station,
-        r.operator.as_deref().unwrap_or("-"),
-        r.started,
-        d.ended.as_deref().unwrap_or("-"),
-        d.status,
-        r.verdict,
-        if r.dry_run { " (dry run)" } else { "" },
-        d.environment
-    );
-    s.push_str(&format!("parameters ({}):\n", d.parameters.len()));
-    for p in &d.parameters {
-        s.push_str(&format!(
-            "  {:<28} {}\n",
-            p.name,
-            ratecal_analysis::measured::format_measured(p.value, p.u, &p.unit)
-        ));
-    }
-    s.push_str(&format!("files ({}):\n", d.files.len()));
-    for f in &d.files {
-        s.push_str(&format!(
-            "  {:<28} {:>10} B  {}\n",
-            f.path, f.size, f.sha256
-        ));
-    }
-    s
 }

@@ -1,9 +1,10 @@
 //! `ratecal check`: syntax, units, names, station limits, observability and duration of
 //! each procedure given; every diagnostic at once. Exit 0 (warnings allowed), 1 errors.
 
-use super::procedure::{self, FsSources};
-use ratecal_check::{CheckOptions, StationLimits, check_text};
+use ratecal_check::{CheckOptions, check_text};
 use ratecal_drivers::Station;
+use ratecal_ops::procedure::{self, FsSources};
+use ratecal_ops::station::station_limits;
 use std::process::ExitCode;
 
 /// Arguments of `ratecal check`.
@@ -37,17 +38,6 @@ pub fn human_duration(s: f64) -> String {
     }
 }
 
-/// The limits `check` compares a plan with, from a station description.
-pub fn station_limits(st: &Station) -> StationLimits {
-    StationLimits {
-        max_rate_dps: st.table.max_rate.get(),
-        max_accel_dps2: st.table.max_accel_dps2,
-        gyro_range_dps: st.imu.gyro_range.get(),
-        accel_range_mps2: st.imu.accel_range.get(),
-        geometry: st.geometry(),
-    }
-}
-
 /// Runs the subcommand.
 pub fn main(args: Args) -> ExitCode {
     let mut opts = CheckOptions::default();
@@ -75,7 +65,7 @@ pub fn main(args: Args) -> ExitCode {
     for input in &args.inputs {
         // A procedure folder also obeys the version rules of versions.lock (audit).
         if std::path::Path::new(input).is_dir() {
-            for d in super::log::check_folder(std::path::Path::new(input)) {
+            for d in ratecal_ops::versions::check_folder(std::path::Path::new(input)) {
                 procedure::report(&d);
                 failed |= d.is_error();
             }

@@ -2,10 +2,8 @@
 //! versions (files or `folder@version`), compared after parameters and imports are
 //! resolved. Exit codes like diff(1): 0 no semantic change, 1 changes, 2 error.
 
-use super::procedure::{self, FsSources};
 use ratecal_audit::{self as audit, render};
-use ratecal_check::{CheckOptions, check_text};
-use ratecal_plan::Plan;
+use ratecal_ops::procedure::load;
 use std::io::IsTerminal;
 use std::process::ExitCode;
 
@@ -28,48 +26,6 @@ pub struct Args {
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Text)]
     format: Format,
-}
-
-/// A procedure loaded for auditing.
-pub(crate) struct Loaded {
-    /// Its checked plan.
-    pub plan: Plan,
-    /// SHA-256 of its canonical text.
-    pub sha256: String,
-}
-
-/// Resolves `file | folder | folder@version`, reads, checks and hashes a procedure. Its
-/// diagnostics go to standard error; `None` when it cannot be used.
-pub(crate) fn load(spec: &str) -> Option<Loaded> {
-    match procedure::read(spec) {
-        Ok(f) => load_text(&f.display, &f.text),
-        Err(d) => {
-            procedure::report(&d);
-            None
-        }
-    }
-}
-
-/// Checks and hashes one procedure text (diagnostics to standard error).
-pub(crate) fn load_text(display: &str, text: &str) -> Option<Loaded> {
-    let checked = match check_text(display, text, &FsSources, &CheckOptions::default()) {
-        Ok(c) => c,
-        Err(diags) => {
-            diags.iter().for_each(procedure::report);
-            return None;
-        }
-    };
-    let sha256 = match ratecal_grammar::canonical(text) {
-        Ok(c) => c.sha256,
-        Err(d) => {
-            procedure::report(&d);
-            return None;
-        }
-    };
-    Some(Loaded {
-        plan: checked.plan,
-        sha256,
-    })
 }
 
 /// Runs the subcommand.

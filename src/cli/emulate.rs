@@ -42,7 +42,7 @@ pub fn main(args: Args) -> ExitCode {
 }
 
 fn run(args: Args) -> Result<(), Report> {
-    let st = super::run::station_file(&args.station)?;
+    let st = ratecal_ops::run::station_file(&args.station)?;
     let rt = tokio::runtime::Builder::new_current_thread()
         .enable_all()
         .build()

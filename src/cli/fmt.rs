@@ -1,7 +1,7 @@
 //! `ratecal fmt`: rewrite procedures in canonical layout; `--check` only reports the files
 //! that are not canonical (exit 1).
 
-use super::procedure;
+use ratecal_ops::procedure;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 

@@ -1,5 +1,5 @@
-//! One module per subcommand. Each parses its arguments (clap), builds what the engine
-//! needs (files, station, drivers) and maps outcomes to the exit codes of spec/cli.md.
+//! One module per subcommand. Each parses its arguments (clap), calls one library function
+//! (`ratecal_ops`, or a stage crate) and prints; exit codes as spec/cli.md gives them.
 
 pub mod analyze;
 pub mod approve;
@@ -13,9 +13,6 @@ pub mod fmt;
 pub mod import;
 pub mod key;
 pub mod log;
-pub mod procedure;
 pub mod report;
 pub mod run;
-pub mod station_effects;
-pub mod twin;
 pub mod verify;

@@ -1,6 +1,7 @@
 //! The progress bar of `ratecal run` (indicatif), shown only when stderr is a terminal.
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use ratecal_ops::run::{Shown, hms};
 use ratecal_run::Progress;
 use std::io::IsTerminal;
 
@@ -32,9 +33,10 @@ impl Bar {
             shown: None,
         }
     }
+}
 
-    /// Removes the bar.
-    pub fn finish(&self) {
+impl Shown for Bar {
+    fn finish(&mut self) {
         if let Some(b) = &self.bar {
             b.finish_and_clear();
         }
@@ -94,10 +96,4 @@ fn ask(text: &str) -> bool {
         return false;
     }
     !matches!(line.trim(), "n" | "no")
-}
-
-/// `1:02:03` from seconds.
-pub fn hms(s: f64) -> String {
-    let s = s.max(0.0).round() as u64;
-    format!("{}:{:02}:{:02}", s / 3600, s / 60 % 60, s % 60)
 }

@@ -1,7 +1,7 @@
 //! The one place `ratecal run` turns procedure text into a plan: parse, canonical hash,
 //! check against the station's limits (the same check as `ratecal check --station`).
 
-use crate::cli::procedure;
+use crate::procedure;
 use miette::Report;
 use ratecal_check::{CheckOptions, Sources, check_text};
 use ratecal_drivers::Station;
@@ -18,7 +18,7 @@ pub fn plan(
 ) -> Result<(Plan, String), Report> {
     let name = path.display().to_string();
     let opts = CheckOptions {
-        station: Some(crate::cli::check::station_limits(station)),
+        station: Some(crate::station::station_limits(station)),
     };
     match check_text(&name, text, sources, &opts) {
         Ok(checked) => {

@@ -6,7 +6,7 @@
 //! Each import is stored under `imports/` at its path relative to the procedure's folder,
 //! `..` written as `^` (`import "../lab/limits.rcal"` becomes `imports/^/lab/limits.rcal`).
 
-use crate::cli::procedure::FsSources;
+use crate::procedure::FsSources;
 use ratecal_check::Sources;
 use ratecal_recording::sha256_hex;
 use std::cell::RefCell;

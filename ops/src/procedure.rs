@@ -1,12 +1,13 @@
-//! Procedure arguments shared by `check`, `fmt`, `run` and `diff`: a file, a folder (its
-//! newest version) or `folder@version`; reading it, and imports from the filesystem.
+//! Procedure arguments shared by `check`, `fmt`, `run`, `diff` and `explain`: a file, a
+//! folder (its newest version, by `plan::versions`' rule of version numbers) or
+//! `folder@version`; reading it, imports from the filesystem, and the checked plan.
 
-use ratecal_check::Sources;
+use ratecal_check::{CheckOptions, Sources, check_text};
 use ratecal_grammar::Diagnostic;
+use ratecal_plan::Plan;
 use std::path::{Path, PathBuf};
 
-/// Extension of procedure files.
-pub const EXTENSION: &str = "rcal";
+pub use ratecal_plan::versions::EXTENSION;
 
 /// A procedure file read from disk.
 #[derive(Debug, Clone)]
@@ -27,36 +28,10 @@ fn io_error(what: &str, path: &Path, e: &std::io::Error) -> Diagnostic {
     .help("give a procedure file, a procedure folder, or folder@version")
 }
 
-/// Parses a version file stem (`1.2.3`, `1.2.3-rc1`) into a sortable key.
-fn version_key(stem: &str) -> Option<(u64, u64, u64, bool, String)> {
-    let (core, pre) = match stem.split_once(['-', '+']) {
-        Some((c, p)) => (c, Some(p)),
-        None => (stem, None),
-    };
-    let mut it = core.split('.').map(|p| p.parse::<u64>().ok());
-    let (a, b, c) = (it.next()??, it.next()??, it.next()??);
-    if it.next().is_some() {
-        return None;
-    }
-    // A release sorts after its pre-releases.
-    Some((a, b, c, pre.is_none(), pre.unwrap_or("").to_string()))
-}
-
 /// Every version file of a procedure folder, oldest first.
 pub fn versions(dir: &Path) -> Result<Vec<(String, PathBuf)>, Diagnostic> {
-    let entries = std::fs::read_dir(dir).map_err(|e| io_error("folder", dir, &e))?;
-    let mut out = Vec::new();
-    for e in entries.flatten() {
-        let p = e.path();
-        if p.extension().is_some_and(|x| x == EXTENSION)
-            && let Some(stem) = p.file_stem().and_then(|s| s.to_str())
-            && version_key(stem).is_some()
-        {
-            out.push((stem.to_string(), p));
-        }
-    }
-    out.sort_by_key(|(v, _)| version_key(v));
-    Ok(out)
+    let files = crate::versions::version_files(dir).map_err(|e| io_error("folder", dir, &e))?;
+    Ok(files.into_iter().map(|(v, p)| (v.to_string(), p)).collect())
 }
 
 /// Resolves an argument to a file: a file, a folder's newest version, or `folder@version`.
@@ -135,15 +110,18 @@ impl Sources for FsSources {
     }
 }
 
-/// Prints a diagnostic on standard error.
+/// Says a diagnostic on standard error.
 pub fn report(d: &Diagnostic) {
-    crate::out::stderr(format_args!("{}", d.render()), false);
+    crate::console::err(format_args!("{}", d.render()), false);
 }
 
 /// Whether a version file was changed after its release (its folder's versions.lock records
 /// another hash): refused with `check::changed_after_release` unless `allow`, when it is
 /// reported as a warning and described for the manifest (`Ok(Some(..))`).
-pub fn released_unchanged(file: &ProcedureFile, allow: bool) -> Result<Option<String>, ()> {
+pub fn released_unchanged(
+    file: &ProcedureFile,
+    allow: bool,
+) -> Result<Option<String>, crate::console::Reported> {
     use ratecal_audit::versions::{LOCK_FILE, changed_after_release};
     let Some(dir) = file.path.parent() else {
         return Ok(None);
@@ -161,7 +139,7 @@ pub fn released_unchanged(file: &ProcedureFile, allow: bool) -> Result<Option<St
     };
     if !allow {
         report(&d);
-        return Err(());
+        return Err(crate::console::Reported);
     }
     errln!(
         "warning: {} was changed after its release; run anyway (--allow-changed)",
@@ -171,4 +149,46 @@ pub fn released_unchanged(file: &ProcedureFile, allow: bool) -> Result<Option<St
         "{} differs from the text released in {LOCK_FILE}",
         file.display
     )))
+}
+
+/// A procedure loaded for auditing.
+pub struct Loaded {
+    /// Its checked plan.
+    pub plan: Plan,
+    /// SHA-256 of its canonical text.
+    pub sha256: String,
+}
+
+/// Resolves `file | folder | folder@version`, reads, checks and hashes a procedure. Its
+/// diagnostics go to standard error; `None` when it cannot be used.
+pub fn load(spec: &str) -> Option<Loaded> {
+    match read(spec) {
+        Ok(f) => load_text(&f.display, &f.text),
+        Err(d) => {
+            report(&d);
+            None
+        }
+    }
+}
+
+/// Checks and hashes one procedure text (diagnostics to standard error).
+pub fn load_text(display: &str, text: &str) -> Option<Loaded> {
+    let checked = match check_text(display, text, &FsSources, &CheckOptions::default()) {
+        Ok(c) => c,
+        Err(diags) => {
+            diags.iter().for_each(report);
+            return None;
+        }
+    };
+    let sha256 = match ratecal_grammar::canonical(text) {
+        Ok(c) => c.sha256,
+        Err(d) => {
+            report(&d);
+            return None;
+        }
+    };
+    Some(Loaded {
+        plan: checked.plan,
+        sha256,
+    })
 }

@@ -8,7 +8,6 @@
 mod check;
 mod finish;
 mod imports;
-mod progress;
 mod resume;
 mod setup;
 
@@ -16,51 +15,51 @@ use ed25519_dalek::SigningKey;
 use miette::Report;
 use ratecal_folder::lock::FolderLock;
 use ratecal_recording::{Columns, RecordingWriter};
-use ratecal_run::{RunOptions, execute};
+use ratecal_run::{Progress, RunOptions, execute};
 use std::path::{Path, PathBuf};
-use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-/// Arguments of `ratecal run`.
-#[derive(clap::Args)]
-pub struct Args {
-    /// Procedure file, or procedure folder (its latest version).
-    #[arg(required_unless_present = "resume")]
-    procedure: Option<PathBuf>,
-    /// Station file (YAML); the embedded default simulated station without it.
-    #[arg(long)]
-    station: Option<PathBuf>,
-    /// Run folder to create (default: runs/<procedure>-<UTC timestamp>).
-    #[arg(long)]
-    out: Option<PathBuf>,
-    /// Simulate the station (table and IMU) whatever drivers the station file names.
-    #[arg(long)]
-    dry_run: bool,
+/// What `ratecal run` is asked.
+pub struct Request {
+    /// Procedure file or folder (absent with `resume`).
+    pub procedure: Option<PathBuf>,
+    /// Station file; the embedded station without it.
+    pub station: Option<PathBuf>,
+    /// Run folder to create.
+    pub out: Option<PathBuf>,
+    /// Simulate the station.
+    pub dry_run: bool,
     /// Seed of the simulated station.
-    #[arg(long, default_value_t = 1)]
-    seed: u64,
-    /// Continue an interrupted run from its last completed step (procedure and station
-    /// come from the run folder).
-    #[arg(long, value_name = "RUN_DIR", conflicts_with_all = ["procedure", "station", "out", "serial"])]
-    resume: Option<PathBuf>,
-    /// Operator name, recorded in the manifest.
-    #[arg(long)]
-    operator: Option<String>,
-    /// The IMU's serial number for this run (the manifest's `imu.serial`, the archive's
-    /// index, the certificate), instead of the station file's `imu.serial`.
-    #[arg(long, value_name = "SN")]
-    serial: Option<String>,
-    /// Sign the run folder's seal with the lab's private key (`ratecal key new` wrote it).
-    #[arg(long, value_name = "LAB_KEY")]
-    sign: Option<PathBuf>,
-    /// Run a released version although its text no longer matches versions.lock (the
-    /// manifest and the report record it).
-    #[arg(long)]
-    allow_changed: bool,
-    /// Archive the run here (folder or postgres:// URL; also $RATECAL_ARCHIVE).
-    #[arg(long, value_name = "DIR_OR_URL")]
-    archive: Option<String>,
+    pub seed: u64,
+    /// A run folder to continue.
+    pub resume: Option<PathBuf>,
+    /// Operator name.
+    pub operator: Option<String>,
+    /// The IMU's serial number for this run.
+    pub serial: Option<String>,
+    /// The lab's private key, to sign the seal.
+    pub sign: Option<PathBuf>,
+    /// Run a released version changed after release.
+    pub allow_changed: bool,
+    /// Archive the run there.
+    pub archive: Option<String>,
+}
+
+/// What shows the run's progress on the terminal: made once the plan's estimated duration
+/// (s) and whether the station is simulated are known.
+pub type Display = Box<dyn FnOnce(f64, bool) -> Box<dyn Shown>>;
+
+/// A progress display that is taken down when the run ends.
+pub trait Shown: Progress {
+    /// Takes the display down.
+    fn finish(&mut self);
+}
+
+/// `1:02:03` from seconds.
+pub fn hms(s: f64) -> String {
+    let s = s.max(0.0).round() as u64;
+    format!("{}:{:02}:{:02}", s / 3600, s / 60 % 60, s % 60)
 }
 
 /// Reads a station file (for `ratecal emulate`: every driver simulated, faults kept).
@@ -68,14 +67,14 @@ pub fn station_file(path: &Path) -> Result<setup::LoadedStation, Report> {
     setup::station(Some(path), true)
 }
 
-/// Runs the subcommand.
-pub fn main(args: Args) -> ExitCode {
+/// Runs (or resumes) the procedure; the exit code of spec/cli.md.
+pub fn run(args: Request, display: Display) -> u8 {
     survive_file_size_limit();
-    match run(args) {
+    match run_or_resume(args, display) {
         Ok(code) => code,
         Err(report) => {
             errln!("{report:?}");
-            ExitCode::from(1)
+            1
         }
     }
 }
@@ -113,7 +112,7 @@ pub(crate) struct Prepared {
     staged: bool,
 }
 
-fn run(args: Args) -> Result<ExitCode, Report> {
+fn run_or_resume(args: Request, display: Display) -> Result<u8, Report> {
     // The key is read first: a run is not started only to find it cannot be signed.
     let key = args
         .sign
@@ -132,7 +131,7 @@ fn run(args: Args) -> Result<ExitCode, Report> {
                     key.as_ref(),
                     args.archive.as_deref(),
                 );
-                super::archive::after_run(args.archive.as_deref(), dir);
+                crate::archive::after_run(args.archive.as_deref(), dir);
                 return Ok(code);
             }
         },
@@ -140,10 +139,10 @@ fn run(args: Args) -> Result<ExitCode, Report> {
     };
     let dir = prep.dir.clone();
     let staged = prep.staged;
-    match execute_prepared(prep, key.as_ref(), args.archive.as_deref()) {
+    match execute_prepared(prep, key.as_ref(), args.archive.as_deref(), display) {
         Ok(code) => {
             // Archived once sealed; a failure to archive is a warning, never the run's fate.
-            super::archive::after_run(args.archive.as_deref(), &dir);
+            crate::archive::after_run(args.archive.as_deref(), &dir);
             Ok(code)
         }
         Err(report) if staged && ratecal_recording::commit::pending_intent(&dir).is_none() => {
@@ -170,7 +169,8 @@ fn execute_prepared(
     prep: Prepared,
     key: Option<&SigningKey>,
     archive: Option<&str>,
-) -> Result<ExitCode, Report> {
+    display: Display,
+) -> Result<u8, Report> {
     let Prepared {
         dir,
         plan,
@@ -187,7 +187,7 @@ fn execute_prepared(
     }
     let cancel = Arc::new(AtomicBool::new(false));
     opts.cancel = Some(cancel.clone());
-    let mut bar = progress::Bar::new(plan.estimated_duration_s, simulated);
+    let mut bar = display(plan.estimated_duration_s, simulated);
 
     // Ctrl-C (and SIGTERM) take the abort path: the table is brought to a safe stop and
     // every sample so far is kept. The handler is a thread of its own, so that a simulated
@@ -218,7 +218,7 @@ fn execute_prepared(
                 table.as_mut(),
                 imu.as_mut(),
                 &mut writer,
-                &mut bar,
+                bar.as_mut(),
                 &opts,
             )
             .await,
@@ -263,7 +263,7 @@ fn link_timeout_s(station: &ratecal_drivers::Station) -> Option<f64> {
     table.into_iter().chain(imu).reduce(f64::max)
 }
 
-fn prepare_new(args: &Args) -> Result<(Prepared, FolderLock), Report> {
+fn prepare_new(args: &Request) -> Result<(Prepared, FolderLock), Report> {
     let proc_path = setup::procedure_file(args.procedure.as_deref().unwrap_or(Path::new(".")))?;
     // Without --station the procedure's geometry picks the embedded station.
     let builtin = std::fs::read_to_string(&proc_path)

@@ -65,7 +65,7 @@ pub fn station_for(
         }
     };
     let mut station = Station::from_yaml(&yaml, &name).map_err(|e| Report::new(*e))?;
-    crate::cli::station_effects::load(&mut station, &yaml, path)?;
+    crate::station::load(&mut station, &yaml, path)?;
     if dry_run {
         station.table.driver = ratecal_drivers::DriverSpec::sim();
         station.imu.driver = ratecal_drivers::DriverSpec::sim();
@@ -76,11 +76,11 @@ pub fn station_for(
 /// Refuses a released version changed after its release (unless `allow`); with `allow`,
 /// what the manifest records.
 pub fn released_unchanged(path: &Path, allow: bool) -> Result<Option<String>, Report> {
-    let file = crate::cli::procedure::read(&path.display().to_string()).map_err(|d| {
-        crate::cli::procedure::report(&d);
+    let file = crate::procedure::read(&path.display().to_string()).map_err(|d| {
+        crate::procedure::report(&d);
         miette!("no procedure to run")
     })?;
-    crate::cli::procedure::released_unchanged(&file, allow).map_err(|()| {
+    crate::procedure::released_unchanged(&file, allow).map_err(|_| {
         miette!(
             "{}: changed after its release; nothing was run",
             file.display
@@ -103,8 +103,8 @@ pub struct LoadedProcedure {
 /// Finds the procedure file: a file, a procedure folder (its newest version) or
 /// `folder@version`.
 pub fn procedure_file(arg: &Path) -> Result<PathBuf, Report> {
-    crate::cli::procedure::resolve(&arg.to_string_lossy()).map_err(|d| {
-        crate::cli::procedure::report(&d);
+    crate::procedure::resolve(&arg.to_string_lossy()).map_err(|d| {
+        crate::procedure::report(&d);
         miette!("no procedure to run")
     })
 }

@@ -42,7 +42,7 @@ pub struct Contradiction {
 
 /// Reads the twin: a station file, or a run folder's `station.yaml`. Prints the located
 /// error on failure.
-pub fn read(arg: &Path) -> Result<TwinFile, ()> {
+pub(crate) fn read(arg: &Path) -> Result<TwinFile, ()> {
     let path = if arg.is_dir() {
         arg.join("station.yaml")
     } else {
@@ -52,10 +52,10 @@ pub fn read(arg: &Path) -> Result<TwinFile, ()> {
         errln!("error: cannot read the twin {}: {e}", path.display());
     })?;
     let mut station = Station::from_yaml(&text, &path.display().to_string()).map_err(|e| {
-        eprintln!("{:?}", miette::Report::new(*e));
+        errln!("{:?}", miette::Report::new(*e));
     })?;
-    let user = super::station_effects::load(&mut station, &text, Some(&path)).map_err(|e| {
-        eprintln!("{e:?}");
+    let user = crate::station::load(&mut station, &text, Some(&path)).map_err(|e| {
+        errln!("{e:?}");
     })?;
     Ok(TwinFile {
         path,

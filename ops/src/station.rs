@@ -4,6 +4,7 @@
 
 use miette::{NamedSource, Report, SourceSpan, miette};
 use ratecal_analysis::explain::{self, UserEffect};
+use ratecal_check::StationLimits;
 use ratecal_drivers::station::{self, Station};
 use ratecal_physics::Effect;
 use ratecal_physics::effects::Term;
@@ -83,4 +84,15 @@ pub fn load(
     }
     station.user_terms.0 = terms;
     Ok(effects)
+}
+
+/// The limits `check` compares a plan with, from a station description.
+pub fn station_limits(st: &Station) -> StationLimits {
+    StationLimits {
+        max_rate_dps: st.table.max_rate.get(),
+        max_accel_dps2: st.table.max_accel_dps2,
+        gyro_range_dps: st.imu.gyro_range.get(),
+        accel_range_mps2: st.imu.accel_range.get(),
+        geometry: st.geometry(),
+    }
 }

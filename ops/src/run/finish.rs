@@ -10,7 +10,6 @@ use ratecal_plan::Plan;
 use ratecal_recording::{manifest_yaml, parse_manifest, rfc3339};
 use ratecal_run::{JournalEntry, JournalEvent, RunOutcome, RunStatus};
 use std::path::Path;
-use std::process::ExitCode;
 
 /// A run that ended (completed or aborted), to analyse, report and seal.
 pub struct End<'a> {
@@ -32,14 +31,14 @@ pub struct End<'a> {
 
 impl End<'_> {
     /// Summary, analysis, reports, seal; the exit code of spec/cli.md.
-    pub fn finish(&self) -> ExitCode {
+    pub fn finish(&self) -> u8 {
         let (dir, out) = (self.dir, self.outcome);
         let run_s = out.t_end - out.t_start;
         outln!("run folder: {}", dir.display());
         let clock = if self.simulated { "simulated" } else { "run" };
         outln!(
             "duration: {} {clock}, {:.1} s real ({:.0}x)",
-            super::progress::hms(run_s),
+            super::hms(run_s),
             self.wall_s,
             run_s / self.wall_s.max(1e-9)
         );
@@ -119,14 +118,14 @@ impl End<'_> {
         if let Err(e) = ratecal_folder::sealing::write(dir, self.key) {
             errln!("cannot seal {}: {e}", dir.display());
             self.warn_not_at_rest();
-            return ExitCode::from(1);
+            return 1;
         }
         outln!("sealed: {}", dir.join("seal.json").display());
         self.warn_not_at_rest();
         match verdict {
-            _ if aborted => ExitCode::from(4),
-            Some(v) => crate::cli::analyze::exit_code(v),
-            None => ExitCode::from(1),
+            _ if aborted => 4,
+            Some(v) => crate::analyze::exit_code(v),
+            None => 1,
         }
     }
 }
@@ -169,7 +168,7 @@ pub fn seal_recorded(
     status: &str,
     key: Option<&SigningKey>,
     archive: Option<&str>,
-) -> ExitCode {
+) -> u8 {
     let verdict = analyze(dir, plan, archive);
     let warnings = journal_warnings(dir);
     if verdict.is_none() {
@@ -180,7 +179,7 @@ pub fn seal_recorded(
     }
     if let Err(e) = ratecal_folder::sealing::write(dir, key) {
         errln!("cannot seal {}: {e}", dir.display());
-        return ExitCode::from(1);
+        return 1;
     }
     outln!("sealed: {}", dir.join("seal.json").display());
     if status != "completed" {
@@ -198,9 +197,9 @@ pub fn seal_recorded(
         errln!("{line}");
     }
     match verdict {
-        _ if status != "completed" => ExitCode::from(4),
-        Some(v) => crate::cli::analyze::exit_code(v),
-        None => ExitCode::from(1),
+        _ if status != "completed" => 4,
+        Some(v) => crate::analyze::exit_code(v),
+        None => 1,
     }
 }
 
@@ -267,7 +266,7 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
     }
     // Sanity, warnings (the run's and the analysis's: the count results.json and the
     // report give) and the verdict, as `ratecal analyze` tells them.
-    for line in crate::cli::analyze::verdict_lines(&results) {
+    for line in crate::analyze::verdict_lines(&results) {
         outln!("{line}");
     }
     outln!("results: {}", dir.join("results.json").display());
@@ -282,9 +281,9 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
         temperature,
         env!("CARGO_PKG_VERSION"),
     );
-    let serial = crate::cli::report::serial_of(&input);
-    input.archive_trend = crate::cli::archive::trend_json(archive, serial.as_deref());
-    match crate::cli::report::write_reports(dir, &input, None) {
+    let serial = crate::report::serial_of(&input);
+    input.archive_trend = crate::archive::trend_json(archive, serial.as_deref());
+    match crate::report::write_reports(dir, &input, None) {
         Ok(paths) => {
             for p in paths {
                 outln!("report: {}", p.display());

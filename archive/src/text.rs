@@ -1,0 +1,67 @@
+//! The archive's listings as text, for a person: `archive list` and `archive show`.
+
+use crate::{RunDetail, RunSummary};
+use ratecal_analysis::measured::format_measured;
+
+/// `archive list` as a table, one run a line, with the count.
+pub fn list_table(runs: &[RunSummary]) -> String {
+    let mut s = format!(
+        "{:<16}  {:<12}  {:<12}  {:<20}  {:<8}  {:<20}  {:<10}  {}\n",
+        "ID", "SERIAL", "MODEL", "PROCEDURE", "VERSION", "STARTED", "VERDICT", "DRY RUN"
+    );
+    for r in runs {
+        s.push_str(&format!(
+            "{:<16}  {:<12}  {:<12}  {:<20}  {:<8}  {:<20}  {:<10}  {}\n",
+            r.id,
+            r.serial,
+            r.model,
+            r.procedure,
+            r.version,
+            r.started,
+            r.verdict,
+            if r.dry_run { "yes" } else { "no" }
+        ));
+    }
+    s.push_str(&format!("{} run(s)\n", runs.len()));
+    s
+}
+
+/// `archive show` in words: the run, its parameters and its stored files.
+pub fn show_text(d: &RunDetail) -> String {
+    let r = &d.summary;
+    let mut s = format!(
+        "run {} ({})\n  imu: {} serial {}\n  procedure: {} {} (sha256 {})\n  station: {}\n  \
+         operator: {}\n  started: {}\n  ended: {}\n  status: {}, verdict: {}{}\n  environment: {}\n",
+        r.id,
+        r.name,
+        r.model,
+        r.serial,
+        r.procedure,
+        r.version,
+        d.procedure_sha256,
+        r.station,
+        r.operator.as_deref().unwrap_or("-"),
+        r.started,
+        d.ended.as_deref().unwrap_or("-"),
+        d.status,
+        r.verdict,
+        if r.dry_run { " (dry run)" } else { "" },
+        d.environment
+    );
+    s.push_str(&format!("parameters ({}):\n", d.parameters.len()));
+    for p in &d.parameters {
+        s.push_str(&format!(
+            "  {:<28} {}\n",
+            p.name,
+            format_measured(p.value, p.u, &p.unit)
+        ));
+    }
+    s.push_str(&format!("files ({}):\n", d.files.len()));
+    for f in &d.files {
+        s.push_str(&format!(
+            "  {:<28} {:>10} B  {}\n",
+            f.path, f.size, f.sha256
+        ));
+    }
+    s
+}

@@ -1,0 +1,311 @@
+//! Issuing a certificate of a run folder (`ratecal certificate`): the laboratory's file read
+//! and checked, the run's results, manifest, plan and station copy read through the folder
+//! reader, the traceability rules applied (the table's calibration stated and not expired on
+//! the date of calibration, unless the issuer allows it, which the certificate then says),
+//! the number taken from the archive's sequence (the same on reissue, the next with
+//! `amend`) and the approval taken from the seal.
+
+use crate::terms::{Stated, TemperatureCoefficients};
+use crate::{ApprovalBlock, Certificate, Input, Lab, StationId, render};
+use miette::{Diagnostic, NamedSource, SourceSpan};
+use ratecal_analysis::results::Results;
+use ratecal_archive::{Archive, Location, days_from_iso};
+use ratecal_drivers::Station;
+use ratecal_folder::RunFolder;
+use std::path::{Path, PathBuf};
+
+/// What a certificate is issued from, and the choices the issuer made.
+#[derive(Debug, Clone, Default)]
+pub struct Request {
+    /// Run folder (sealed, approved, archived).
+    pub run_dir: PathBuf,
+    /// The laboratory's file.
+    pub lab: PathBuf,
+    /// The customer, as the certificate names them.
+    pub customer: Option<String>,
+    /// The customer's order reference.
+    pub order: Option<String>,
+    /// The archive holding the run and the number sequence.
+    pub archive: Option<String>,
+    /// An amended certificate: a new number that names the one it replaces.
+    pub amend: bool,
+    /// Issue although the table's calibration had expired (printed).
+    pub allow_expired: bool,
+    /// Issue although the station states no calibration of the table (printed).
+    pub allow_untraceable: bool,
+}
+
+/// A refusal located in a YAML file.
+#[derive(Debug, thiserror::Error, Diagnostic)]
+#[error("{message}")]
+#[diagnostic(code(certificate::refused))]
+struct Located {
+    message: String,
+    #[source_code]
+    src: NamedSource<String>,
+    #[label("{label}")]
+    span: SourceSpan,
+    label: String,
+    #[help]
+    help: String,
+}
+
+/// The span of `key: value` in YAML `text`, searched after the key `after` (block or flow
+/// style): enough to point at a key of a small hand-written file.
+fn key_span(text: &str, after: Option<&str>, key: &str) -> SourceSpan {
+    let from = after.and_then(|a| find_key(text, 0, a)).unwrap_or(0);
+    let Some(start) = find_key(text, from, key) else {
+        return (from, 0).into();
+    };
+    let len = text[start..]
+        .find(['\n', ',', '}'])
+        .unwrap_or(text.len() - start);
+    (start, text[start..start + len].trim_end().len()).into()
+}
+
+/// Where `key:` starts at or after byte `from`, as a key (after indentation, `{` or `,`).
+fn find_key(text: &str, from: usize, key: &str) -> Option<usize> {
+    let pat = format!("{key}:");
+    let mut at = from;
+    while let Some(i) = text[at..].find(&pat) {
+        let s = at + i;
+        let before = text[..s].chars().next_back();
+        if before.is_none_or(|c| c == ' ' || c == '\n' || c == '{' || c == ',') {
+            return Some(s);
+        }
+        at = s + pat.len();
+    }
+    None
+}
+
+fn io(path: &Path, e: impl std::fmt::Display, help: &str) -> miette::Report {
+    miette::miette!(
+        code = "certificate::io",
+        help = help.to_string(),
+        "cannot read {}: {e}",
+        path.display()
+    )
+}
+
+fn read_text(path: &Path, help: &str) -> miette::Result<String> {
+    std::fs::read_to_string(path).map_err(|e| io(path, e, help))
+}
+
+fn read_lab(path: &Path) -> miette::Result<Lab> {
+    let text = read_text(
+        path,
+        "give the laboratory's file (docs/examples/lab.yaml shows one)",
+    )?;
+    let name = path.display().to_string();
+    let lab: Lab = serde_saphyr::from_str(&text).map_err(|e| {
+        let span = e
+            .location()
+            .filter(|l| l.line() > 0)
+            .map(|l| ratecal_drivers::yaml_offset(&text, l.line(), l.column()))
+            .unwrap_or(0);
+        Located {
+            message: format!("{name} is not a laboratory file"),
+            src: NamedSource::new(name.clone(), text.clone()),
+            span: (span, 0).into(),
+            label: e.to_string().lines().next().unwrap_or("here").to_string(),
+            help: "keys: name, address, accreditation, certificate_prefix, optional logo \
+                   (docs/certificate.md)"
+                .into(),
+        }
+    })?;
+    let p = &lab.certificate_prefix;
+    if p.is_empty() || !p.chars().all(|c| c.is_ascii_alphanumeric() || c == '-') {
+        return Err(Located {
+            message: format!("certificate_prefix `{p}` cannot start a certificate number"),
+            span: key_span(&text, None, "certificate_prefix"),
+            src: NamedSource::new(name, text),
+            label: "letters, digits and dashes only".into(),
+            help: "e.g. `certificate_prefix: RCL`: numbers read RCL-2026-000001".into(),
+        }
+        .into());
+    }
+    if let Some(logo) = &lab.logo {
+        let file = path.parent().unwrap_or(Path::new(".")).join(logo);
+        if let Err(why) = logo_kind(&file) {
+            return Err(Located {
+                message: format!("the logo `{logo}` cannot be used"),
+                span: key_span(&text, None, "logo"),
+                src: NamedSource::new(name, text),
+                label: why,
+                help: "a PNG or JPEG file, its path relative to the laboratory file; or \
+                       remove the key"
+                    .into(),
+            }
+            .into());
+        }
+    }
+    Ok(lab)
+}
+
+/// The logo `file`, read and decoded (a PNG or JPEG), or why it cannot be drawn.
+fn logo_kind(file: &Path) -> Result<render::Logo, String> {
+    let bytes = std::fs::read(file).map_err(|e| format!("{}: {e}", file.display()))?;
+    render::Logo::from_bytes(&bytes).map_err(|why| format!("{}: {why}", file.display()))
+}
+
+/// The laboratory's logo, when `LAB.yaml` names one (checked by [`read_lab`]).
+pub fn lab_logo(lab_file: &Path, lab: &Lab) -> Option<render::Logo> {
+    let logo = lab.logo.as_ref()?;
+    logo_kind(&lab_file.parent().unwrap_or(Path::new(".")).join(logo)).ok()
+}
+
+pub async fn issue(args: &Request) -> miette::Result<Certificate> {
+    let dir = &args.run_dir;
+    let lab = read_lab(&args.lab)?;
+    let run = RunFolder::new(dir);
+    let results: Results = run.results()?;
+    let (_, manifest) = run.manifest("give the folder `ratecal run` wrote")?;
+    let plan = run.plan();
+    let (station_name, station_text) = run.station_text()?;
+    let station =
+        Station::from_yaml(&station_text, &station_name).map_err(|e| miette::Report::new(*e))?;
+    let calibration_date: String = manifest
+        .run
+        .as_ref()
+        .map(|r| r.started.chars().take(10).collect())
+        .unwrap_or_default();
+    let mut notes = Vec::new();
+    let located =
+        |message: String, after: Option<&str>, key: &str, label: &str, help: &str| Located {
+            message,
+            span: key_span(&station_text, after, key),
+            src: NamedSource::new(station_name.clone(), station_text.clone()),
+            label: label.into(),
+            help: help.into(),
+        };
+    let cal = station.table.calibration.clone();
+    match &cal {
+        None if !args.allow_untraceable => {
+            return Err(located(
+                "the station states no calibration of the rate table: the results would not be traceable".into(),
+                None,
+                "table",
+                "no `calibration: { certificate, issued_by, due }` here",
+                "state the table's calibration certificate in the station file, or give \
+                 --allow-untraceable (printed on the certificate)",
+            )
+            .into());
+        }
+        None => notes.push(
+            "Issued with --allow-untraceable: the station states no calibration of the rate \
+             table; the results are not shown to be traceable."
+                .into(),
+        ),
+        Some(c) => {
+            let due = days_from_iso(&c.due);
+            let on = days_from_iso(&calibration_date);
+            let expired = match (due, on) {
+                (Some(d), Some(o)) => o > d,
+                _ => true,
+            };
+            if expired && !args.allow_expired {
+                return Err(located(
+                    format!(
+                        "the rate table's calibration ({}) was due {}, before the calibration date {calibration_date}",
+                        c.certificate, c.due
+                    ),
+                    Some("calibration"),
+                    "due",
+                    "expired on the date of calibration",
+                    "recalibrate the table and state its new certificate, or give \
+                     --allow-expired (printed on the certificate)",
+                )
+                .into());
+            }
+            if expired {
+                notes.push(format!(
+                    "Issued with --allow-expired: the rate table's calibration {} was due {}, \
+                     before the date of calibration.",
+                    c.certificate, c.due
+                ));
+            }
+        }
+    }
+    // The archive must hold this very folder (its content address).
+    let folder = ratecal_archive::read_folder(dir)?;
+    let loc = Location::resolve(args.archive.as_deref(), None);
+    let archive = Archive::open_existing(&loc).await?;
+    if !archive.exists(&folder.facts.id).await? {
+        return Err(miette::miette!(
+            code = "certificate::not_archived",
+            help = format!(
+                "add it first: `ratecal archive add {}` (after `ratecal approve`)",
+                dir.display()
+            ),
+            "{} (archive id {}) is not in the archive {}",
+            dir.display(),
+            folder.facts.id,
+            archive.location()
+        ));
+    }
+    let now = ratecal_recording::rfc3339(std::time::SystemTime::now());
+    let year: i32 = now[..4].parse().unwrap_or(1970);
+    let issued = archive
+        .certificate_number(
+            &folder.facts.id,
+            &lab.certificate_prefix,
+            year,
+            args.amend,
+            &now,
+        )
+        .await?;
+    archive.close().await;
+    let approval = run.seal().and_then(|s| s.approval).map(|a| ApprovalBlock {
+        signer: a.signer,
+        role: a.role,
+        time: a.time,
+        key_fingerprint: a.key_fingerprint,
+    });
+    let t = &station.table;
+    let deg = std::f64::consts::PI / 180.0;
+    let input = Input {
+        number: issued.number,
+        replaces: issued.replaces,
+        issue_date: issued.issued.chars().take(10).collect(),
+        lab,
+        customer: args.customer.clone(),
+        order: args.order.clone(),
+        results: &results,
+        manifest: &manifest,
+        plan: plan.as_ref(),
+        archive_id: folder.facts.id.clone(),
+        station: StationId {
+            name: station.name.clone(),
+            table_model: t.model.clone(),
+            manufacturer: t.manufacturer.clone(),
+            serial: t.serial.clone(),
+            accuracy_class: t.accuracy_class.clone(),
+        },
+        stated: Stated {
+            rate_accuracy: t.rate_accuracy.map(|r| r.get()),
+            position_accuracy_rad: t.position_accuracy.map(|a| a.get() * deg),
+            axis_orthogonality_rad: t.axis_orthogonality.map(|a| a.get() * deg),
+            gravity_u_mps2: station.site.gravity_u_mps2,
+            gravity_mps2: manifest.station.site.gravity_mps2,
+            clock_accuracy: station.daq.and_then(|d| d.clock_accuracy).map(|r| r.get()),
+            temperature_stability_c: station.site.temperature_stability.map(|t| t.get()),
+            temperature_coefficients: station
+                .imu
+                .temperature_coefficients
+                .map(|c| TemperatureCoefficients {
+                    accel_bias: c.accel_bias,
+                    gyro_bias: c.gyro_bias,
+                    accel_scale: c.accel_scale,
+                    gyro_scale: c.gyro_scale,
+                })
+                .unwrap_or_default(),
+        },
+        reference: match cal {
+            Some(c) => [Some(c.certificate), Some(c.issued_by), Some(c.due)],
+            None => [None, None, None],
+        },
+        notes,
+        approval,
+    };
+    Ok(crate::build(input))
+}
