@@ -180,7 +180,7 @@ fn accel_thermal_drift_is_found_through_the_warm_up() {
 }
 
 /// The false-discovery rate over 50 null recordings (a defect-free IMU: only the Earth's
-/// rate may be reported, and nothing may be left unexplained). Slow: `cargo test --release -p ratecal-engine --test explain_sim
+/// rate may be reported, and nothing may be left unexplained). Slow: `cargo test --release -p ratecal-analysis --test explain_sim
 /// -- --ignored --nocapture`.
 #[test]
 #[ignore = "50 simulated recordings; run in release"]

@@ -3,8 +3,9 @@
 
 use crate::{ArchiveError, Result};
 use ratecal_folder::hashes::sha256_hex;
+use ratecal_folder::names::{MANIFEST, RESULTS};
 use ratecal_folder::seal::is_scratch;
-use ratecal_recording::{FileState, Manifest, hash_folder, regular};
+use ratecal_recording::{FileState, Manifest, hash_folder, parse_manifest, regular};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -95,16 +96,17 @@ pub fn read(dir: &Path) -> Result<Folder> {
         path: dir.to_path_buf(),
         why,
     };
-    let manifest_path = dir.join("manifest.yaml");
+    let manifest_path = dir.join(MANIFEST);
     let text = regular(&manifest_path)
         .and_then(|()| std::fs::read_to_string(&manifest_path))
         .map_err(|e| not_run(format!("manifest.yaml: {e}")))?;
-    let manifest: Manifest = serde_saphyr::from_str(&text)
+    // The one manifest rule every command reads by (spec/recording-format.md).
+    let manifest: Manifest = parse_manifest(MANIFEST, &text)
         .map_err(|e| not_run(format!("manifest.yaml does not parse: {e}")))?;
     let mut files = Vec::new();
     walk(dir, &mut files)?;
     files.sort();
-    let results = std::fs::read(dir.join("results.json"))
+    let results = std::fs::read(dir.join(RESULTS))
         .ok()
         .and_then(|b| serde_json::from_slice::<Value>(&b).ok());
     let mut facts = facts(&manifest, results.as_ref());

@@ -90,6 +90,13 @@ impl VerifyReport {
         self.checks.iter().filter(|c| c.status != Status::Intact)
     }
 
+    /// The names of the files [`altered`](Self::altered) lists, comma-separated: what a
+    /// refusal names.
+    pub fn altered_names(&self) -> String {
+        let names: Vec<&str> = self.altered().map(|c| c.file.as_str()).collect();
+        names.join(", ")
+    }
+
     /// A report for people: one line per file, then the verdict.
     pub fn text(&self) -> String {
         let mut s = String::new();

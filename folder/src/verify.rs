@@ -74,7 +74,6 @@ pub fn require_intact(dir: &Path, command: &str) -> Result<(), miette::Report> {
     if report.intact() {
         return Ok(());
     }
-    let names: Vec<&str> = report.altered().map(|c| c.file.as_str()).collect();
     Err(miette::miette!(
         code = "verify::altered",
         help = format!(
@@ -83,7 +82,7 @@ pub fn require_intact(dir: &Path, command: &str) -> Result<(), miette::Report> {
         ),
         "{} fails its seal ({}): no {command} from it",
         dir.display(),
-        names.join(", ")
+        report.altered_names()
     ))
 }
 

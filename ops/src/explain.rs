@@ -8,6 +8,7 @@
 use crate::procedure;
 use ratecal_analysis::explain::{self, AdoptTarget, NominalModel, Options, UserEffect};
 use ratecal_analysis::fit::{Source, Streamed};
+use ratecal_folder::names::EXPLAIN;
 use ratecal_physics::Effect;
 use ratecal_render as render;
 use std::path::{Path, PathBuf};
@@ -112,235 +113,68 @@ fn adopt_target(arg: &Path) -> Option<AdoptTarget> {
     })
 }
 
+/// A command that stops with this exit code, its diagnostics said.
+type Exit = u8;
+
 /// Explains the recording; the exit code of spec/cli.md (0 nothing found, 1 findings, 2
 /// error, 4 the seal fails).
 pub fn explain(args: &Request) -> u8 {
+    match explain_or_exit(args) {
+        Ok(code) | Err(code) => code,
+    }
+}
+
+fn explain_or_exit(args: &Request) -> Result<u8, Exit> {
     // A folder whose seal fails (or a run never sealed) is not explained, and its seal
     // gains nothing (exit 4, as `report`).
     if let Err(e) = ratecal_folder::verify::require_intact(&args.run, "explanation") {
         errln!("{e:?}");
-        return 4;
+        return Err(4);
     }
     // The IMU stream is read a window at a time (`fit::Streamed`), as `analyze` reads it.
-    let rec = match Streamed::open(&args.run) {
-        Ok(r) => r,
-        Err(e) => {
-            errln!("{:?}", miette::Report::new(e));
-            return 2;
-        }
-    };
+    let rec = Streamed::open(&args.run).map_err(|e| {
+        errln!("{:?}", miette::Report::new(e));
+        2
+    })?;
     // A ratecal run folder gains explain.json: its lock first, so a second writer is
     // refused at once (exit 2, an error as spec/cli.md has it for explain).
-    let _lock = if rec.manifest().run.is_some() {
-        match ratecal_folder::lock::acquire(&args.run, &ratecal_folder::sealing::command_line()) {
-            Ok(l) => Some(l),
-            Err(e) => {
-                errln!("{e:?}");
-                return 2;
-            }
-        }
-    } else {
-        None
-    };
-    let Ok(mut user) = load_effects(&args.effects) else {
-        return 2;
-    };
-    let nominal = match &args.procedure {
-        None => NominalModel::seed(),
-        Some(p) => match crate::analyze::load_plan(p, args.allow_changed) {
-            Ok((plan, _)) => {
-                NominalModel::from_plan(&plan, rec.manifest().station.site.latitude_deg)
-            }
-            Err(()) => return 2,
-        },
-    };
-    let twin_file = match &args.twin {
-        None => None,
-        Some(p) => {
-            let Ok(f) = crate::twin::read(p) else {
-                return 2;
-            };
-            if let Err(e) = crate::twin::refuse(&f, rec.manifest()) {
-                errln!("{:?}", miette::Report::new(*e));
-                return 2;
-            }
-            // The twin's user effects are explain's candidates too (its terms need their
-            // columns); one already given with --effects is that one.
-            for e in &f.user {
-                if !user.iter().any(|u| u.id() == e.id()) {
-                    user.push(e);
-                }
-            }
-            Some(f)
-        }
-    };
-    let opts = Options {
-        path: args.run.display().to_string(),
-        user,
-        without: args.without.clone(),
-        ..Options::default()
-    };
-    let explained = match &twin_file {
-        None => explain::explain_source(&rec, &nominal, &opts).map(|x| (x, None)),
-        Some(f) => {
-            let twin = crate::twin::twin_of(&f.station);
-            ratecal_analysis::twin::compare_source(&rec, &twin, &opts).map(|(x, r)| (x, Some(r)))
-        }
-    };
-    let (mut x, mut twin) = match explained {
-        Ok(x) => x,
-        Err(e) => {
-            errln!("{:?}", miette::Report::new(e));
-            return 2;
-        }
-    };
-    if let (Some(f), Some(r)) = (&twin_file, &mut twin) {
-        r.station = args
-            .twin
-            .as_ref()
-            .map(|p| p.display().to_string())
-            .unwrap_or_default();
-        if let Some(out) = &args.write_twin {
-            // Discovered physics joins the twin as its draft effect file, written beside
-            // the corrected twin and referenced from it.
-            if let Err(e) = crate::twin::write_drafts(&x, &mut r.changes, out, &args.run) {
-                errln!(
-                    "error: cannot write the draft effect beside {}: {e}",
-                    out.display()
-                );
-                return 2;
-            }
-            match crate::twin::corrected(f, &r.changes, out) {
-                Ok((text, diff)) => {
-                    if let Err(e) = std::fs::write(out, &text) {
-                        errln!(
-                            "error: cannot write the corrected twin {}: {e}",
-                            out.display()
-                        );
-                        return 2;
-                    }
-                    r.written = Some(out.display().to_string());
-                    r.diff = Some(diff);
-                }
-                Err(e) => {
-                    errln!("error: cannot correct the twin: {e}");
-                    return 2;
-                }
-            }
-        }
-    }
-    // Only the registry's effects can be declared in a procedure.
-    let ids: Vec<String> = x
-        .findings
-        .iter()
-        .filter(|f| f.defined_in.is_none() && !f.discovered)
-        .map(|f| f.effect.clone())
-        .collect();
-    if let Some(p) = &args.procedure
-        && !ids.is_empty()
-    {
-        let ids: Vec<&str> = ids.iter().map(String::as_str).collect();
-        match adopt_target(p).map(|t| explain::adoption(&t, &ids)) {
-            Some(Ok(a)) => {
-                x.adopt_diff = a.diff;
-                for id in a.not_placed {
-                    x.warnings.push(format!(
-                        "{id}: the procedure has no fit statement of the sensors it acts on to declare it"
-                    ));
-                }
-            }
-            Some(Err(e)) => x.warnings.push(format!("no adoption diff: {e}")),
-            None => x.warnings.push(format!(
-                "no adoption diff: {} is not a procedure file",
-                p.display()
-            )),
-        }
-    }
     let in_run = rec.manifest().run.is_some();
-    let drafts: Vec<(String, String)> = x
-        .findings
-        .iter()
-        .filter_map(|f| {
-            let text = explain::draft::effect_file(f, &args.run.display().to_string())?;
-            Some((explain::draft::file_name(f), text))
-        })
-        .collect();
-    let draft_dir = args
-        .draft_effects
-        .clone()
-        .or(in_run.then(|| args.run.clone()));
-    if let Some(dir) = &draft_dir {
-        for (f, (name, _)) in x.findings.iter().filter(|f| f.discovered).zip(&drafts) {
-            x.draft_effects.push(explain::UserEffectOut {
-                effect: f.effect.clone(),
-                file: dir.join(name).display().to_string(),
-            });
-        }
-    }
+    let _lock = match in_run {
+        true => Some(
+            ratecal_folder::lock::acquire(&args.run, &ratecal_folder::sealing::command_line())
+                .map_err(|e| {
+                    errln!("{e:?}");
+                    2
+                })?,
+        ),
+        false => None,
+    };
+    let (mut x, twin) = compute(args, &rec)?;
+    adopt(args, &mut x);
+    let drafts = drafts(args, in_run, &mut x);
     let mut value = serde_json::to_value(&x).expect("plain data serializes");
     if let Some(r) = &twin {
         value["twin"] = serde_json::to_value(r).expect("plain data serializes");
     }
     let json = serde_json::to_string_pretty(&value).expect("plain data serializes");
-    let mut figures: Vec<(String, String)> =
-        render::explain_figures(&serde_json::to_value(&x).expect("plain data serializes"))
-            .into_iter()
-            .filter_map(|(effect, svg)| Some((format!("explain-{effect}.svg"), svg?)))
-            .collect();
-    if let Some(svg) = twin
-        .as_ref()
-        .and_then(|_| render::twin_residual_figure(&value))
-    {
-        figures.push(("explain-twin.svg".into(), svg));
-    }
-    // The twin's time series, one figure per kind of segment where it disagrees.
-    for (kind, svg) in render::twin_figures(&value) {
-        figures.push((format!("explain-twin-{kind}.svg"), svg));
-    }
+    let figures = figures(&x, twin.is_some(), &value);
     // Kept in a ratecal run folder (not in another system's recording): its report shows it.
     if in_run {
-        let mut files = vec![("explain.json".to_string(), format!("{json}\n"))];
+        let mut files = vec![(EXPLAIN.to_string(), format!("{json}\n"))];
         files.extend(drafts.iter().cloned());
-        files.extend(
-            figures
-                .iter()
-                .map(|(n, svg)| (n.clone(), format!("{svg}\n"))),
-        );
+        files.extend(figures.iter().cloned());
         if let Err(e) = write(&args.run, &files, true) {
             errln!("warning: cannot keep explain.json and its figures in the run folder: {e}");
         }
     }
     if let Some(dir) = &args.plots {
-        let same = in_run && same_dir(dir, &args.run);
-        let files: Vec<(String, String)> = figures
-            .iter()
-            .map(|(n, svg)| (n.clone(), format!("{svg}\n")))
-            .collect();
-        if !same && let Err(e) = write(dir, &files, false) {
-            errln!(
-                "error: cannot write the figures into {}: {e}",
-                dir.display()
-            );
-            return 2;
-        }
-        for (name, _) in &files {
-            errln!("figure: {}", dir.join(name).display());
-        }
+        write_beside(dir, &figures, in_run && same_dir(dir, &args.run), "figure")?;
     }
     if let Some(dir) = &args.draft_effects
         && !(in_run && same_dir(dir, &args.run))
         && !drafts.is_empty()
     {
-        if let Err(e) = write(dir, &drafts, false) {
-            errln!(
-                "error: cannot write the draft effect files into {}: {e}",
-                dir.display()
-            );
-            return 2;
-        }
-        for (name, _) in &drafts {
-            errln!("draft effect: {}", dir.join(name).display());
-        }
+        write_beside(dir, &drafts, false, "draft effect")?;
     }
     let out = match args.format {
         Format::Json => json + "\n",
@@ -353,14 +187,229 @@ pub fn explain(args: &Request) -> u8 {
         }
     };
     crate::console::out(format_args!("{out}"), false);
-    if let Some(r) = &twin {
-        return if r.needs_change { 1 } else { 0 };
+    Ok(match &twin {
+        Some(r) => u8::from(r.needs_change),
+        None => u8::from(!(x.findings.is_empty() && x.unexplained.is_empty())),
+    })
+}
+
+/// The explanation, against the nominal model or the station's twin (with the corrected
+/// twin written when asked).
+fn compute(
+    args: &Request,
+    rec: &Streamed,
+) -> Result<
+    (
+        explain::Explanation,
+        Option<ratecal_analysis::twin::TwinReport>,
+    ),
+    Exit,
+> {
+    let mut user = load_effects(&args.effects).map_err(|()| 2)?;
+    let nominal = match &args.procedure {
+        None => NominalModel::seed(),
+        Some(p) => {
+            let (plan, _) = crate::analyze::load_plan(p, args.allow_changed).map_err(|()| 2)?;
+            NominalModel::from_plan(&plan, rec.manifest().station.site.latitude_deg)
+        }
+    };
+    let twin_file = args
+        .twin
+        .as_ref()
+        .map(|p| twin_file(p, rec, &mut user))
+        .transpose()?;
+    let opts = Options {
+        path: args.run.display().to_string(),
+        user,
+        without: args.without.clone(),
+        ..Options::default()
+    };
+    let explained = match &twin_file {
+        None => explain::explain_source(rec, &nominal, &opts).map(|x| (x, None)),
+        Some(f) => {
+            let twin = crate::twin::twin_of(&f.station);
+            ratecal_analysis::twin::compare_source(rec, &twin, &opts).map(|(x, r)| (x, Some(r)))
+        }
+    };
+    let (x, mut twin) = explained.map_err(|e| {
+        errln!("{:?}", miette::Report::new(e));
+        2
+    })?;
+    if let (Some(f), Some(r)) = (&twin_file, &mut twin) {
+        r.station = args
+            .twin
+            .as_ref()
+            .map(|p| p.display().to_string())
+            .unwrap_or_default();
+        if let Some(out) = &args.write_twin {
+            write_twin(f, &x, r, out, &args.run)?;
+        }
     }
-    if x.findings.is_empty() && x.unexplained.is_empty() {
-        0
-    } else {
-        1
+    Ok((x, twin))
+}
+
+/// The twin's station file, read and held against the manifest; its user effects join
+/// explain's candidates (its terms need their columns; one given with --effects is that one).
+fn twin_file(
+    path: &Path,
+    rec: &Streamed,
+    user: &mut Vec<&'static UserEffect>,
+) -> Result<crate::twin::TwinFile, Exit> {
+    let f = crate::twin::read(path).map_err(|()| 2)?;
+    if let Err(e) = crate::twin::refuse(&f, rec.manifest()) {
+        errln!("{:?}", miette::Report::new(*e));
+        return Err(2);
     }
+    for e in &f.user {
+        if !user.iter().any(|u| u.id() == e.id()) {
+            user.push(e);
+        }
+    }
+    Ok(f)
+}
+
+/// Writes the corrected twin at `out` with the draft effects of discovered physics beside
+/// it (referenced from it), and records both in the report.
+fn write_twin(
+    f: &crate::twin::TwinFile,
+    x: &explain::Explanation,
+    r: &mut ratecal_analysis::twin::TwinReport,
+    out: &Path,
+    run: &Path,
+) -> Result<(), Exit> {
+    if let Err(e) = crate::twin::write_drafts(x, &mut r.changes, out, run) {
+        errln!(
+            "error: cannot write the draft effect beside {}: {e}",
+            out.display()
+        );
+        return Err(2);
+    }
+    let (text, diff) = crate::twin::corrected(f, &r.changes, out).map_err(|e| {
+        errln!("error: cannot correct the twin: {e}");
+        2
+    })?;
+    std::fs::write(out, &text).map_err(|e| {
+        errln!(
+            "error: cannot write the corrected twin {}: {e}",
+            out.display()
+        );
+        2
+    })?;
+    r.written = Some(out.display().to_string());
+    r.diff = Some(diff);
+    Ok(())
+}
+
+/// With `--procedure`, the diff that declares the registry's findings in it (only the
+/// registry's effects can be declared in a procedure).
+fn adopt(args: &Request, x: &mut explain::Explanation) {
+    let ids: Vec<String> = x
+        .findings
+        .iter()
+        .filter(|f| f.defined_in.is_none() && !f.discovered)
+        .map(|f| f.effect.clone())
+        .collect();
+    let Some(p) = &args.procedure else { return };
+    if ids.is_empty() {
+        return;
+    }
+    let ids: Vec<&str> = ids.iter().map(String::as_str).collect();
+    match adopt_target(p).map(|t| explain::adoption(&t, &ids)) {
+        Some(Ok(a)) => {
+            x.adopt_diff = a.diff;
+            for id in a.not_placed {
+                x.warnings.push(format!(
+                    "{id}: the procedure has no fit statement of the sensors it acts on to declare it"
+                ));
+            }
+        }
+        Some(Err(e)) => x.warnings.push(format!("no adoption diff: {e}")),
+        None => x.warnings.push(format!(
+            "no adoption diff: {} is not a procedure file",
+            p.display()
+        )),
+    }
+}
+
+/// The draft effect file (name, text) of every discovered finding, listed in the
+/// explanation where they will be written.
+fn drafts(args: &Request, in_run: bool, x: &mut explain::Explanation) -> Vec<(String, String)> {
+    let drafts: Vec<(String, String)> = x
+        .findings
+        .iter()
+        .filter_map(|f| {
+            let text = explain::draft::effect_file(f, &args.run.display().to_string())?;
+            Some((explain::draft::file_name(f), text))
+        })
+        .collect();
+    let dir = args
+        .draft_effects
+        .clone()
+        .or(in_run.then(|| args.run.clone()));
+    if let Some(dir) = &dir {
+        let listed: Vec<explain::UserEffectOut> = x
+            .findings
+            .iter()
+            .filter(|f| f.discovered)
+            .zip(&drafts)
+            .map(|(f, (name, _))| explain::UserEffectOut {
+                effect: f.effect.clone(),
+                file: dir.join(name).display().to_string(),
+            })
+            .collect();
+        x.draft_effects.extend(listed);
+    }
+    drafts
+}
+
+/// Each finding's before/after figure, the twin's residual figure and its time series, as
+/// files (name, text).
+fn figures(
+    x: &explain::Explanation,
+    with_twin: bool,
+    value: &serde_json::Value,
+) -> Vec<(String, String)> {
+    let mut figures: Vec<(String, String)> =
+        render::explain_figures(&serde_json::to_value(x).expect("plain data serializes"))
+            .into_iter()
+            .filter_map(|(effect, svg)| Some((format!("explain-{effect}.svg"), svg?)))
+            .collect();
+    if let Some(svg) = with_twin
+        .then(|| render::twin_residual_figure(value))
+        .flatten()
+    {
+        figures.push(("explain-twin.svg".into(), svg));
+    }
+    // The twin's time series, one figure per kind of segment where it disagrees.
+    for (kind, svg) in render::twin_figures(value) {
+        figures.push((format!("explain-twin-{kind}.svg"), svg));
+    }
+    figures
+        .into_iter()
+        .map(|(n, svg)| (n, format!("{svg}\n")))
+        .collect()
+}
+
+/// Writes `files` into `dir` (unless it is the run folder, which has them) and names each.
+fn write_beside(
+    dir: &Path,
+    files: &[(String, String)],
+    same: bool,
+    what: &str,
+) -> Result<(), Exit> {
+    if !same && let Err(e) = write(dir, files, false) {
+        let kind = if what == "figure" {
+            "the figures"
+        } else {
+            "the draft effect files"
+        };
+        errln!("error: cannot write {kind} into {}: {e}", dir.display());
+        return Err(2);
+    }
+    for (name, _) in files {
+        errln!("{what}: {}", dir.join(name).display());
+    }
+    Ok(())
 }
 
 /// Writes `files` (name, text) into `dir`; in a sealed run folder (`seal`), records them as

@@ -7,6 +7,7 @@ use miette::{Diagnostic, NamedSource, SourceSpan};
 use ratecal_analysis::explain::Rms;
 use ratecal_analysis::twin::{Change, Twin};
 use ratecal_drivers::station::{self, SetValue, Station};
+use ratecal_folder::names::STATION;
 use ratecal_recording::Manifest;
 use std::path::{Path, PathBuf};
 
@@ -44,7 +45,7 @@ pub struct Contradiction {
 /// error on failure.
 pub(crate) fn read(arg: &Path) -> Result<TwinFile, ()> {
     let path = if arg.is_dir() {
-        arg.join("station.yaml")
+        arg.join(STATION)
     } else {
         arg.to_path_buf()
     };

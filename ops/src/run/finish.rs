@@ -6,6 +6,7 @@ use ed25519_dalek::SigningKey;
 use miette::Report;
 use ratecal_analysis::measured::{format_measured, format_value};
 use ratecal_analysis::results::RunVerdict;
+use ratecal_folder::names::{JOURNAL, MANIFEST, PLAN, RESULTS, SEAL_FILE};
 use ratecal_plan::Plan;
 use ratecal_recording::{manifest_yaml, parse_manifest, rfc3339};
 use ratecal_run::{JournalEntry, JournalEvent, RunOutcome, RunStatus};
@@ -120,7 +121,7 @@ impl End<'_> {
             self.warn_not_at_rest();
             return 1;
         }
-        outln!("sealed: {}", dir.join("seal.json").display());
+        outln!("sealed: {}", dir.join(SEAL_FILE).display());
         self.warn_not_at_rest();
         match verdict {
             _ if aborted => 4,
@@ -153,11 +154,8 @@ impl End<'_> {
 
 /// The failed write the manifest records, if any.
 fn write_failure(dir: &Path) -> Option<ratecal_recording::WriteFailure> {
-    let text = std::fs::read_to_string(dir.join("manifest.yaml")).ok()?;
-    parse_manifest("manifest.yaml", &text)
-        .ok()?
-        .run?
-        .write_failure
+    let text = std::fs::read_to_string(dir.join(MANIFEST)).ok()?;
+    parse_manifest(MANIFEST, &text).ok()?.run?.write_failure
 }
 
 /// A run that ended but was never sealed (a crash after its manifest said so), finished by
@@ -181,7 +179,7 @@ pub fn seal_recorded(
         errln!("cannot seal {}: {e}", dir.display());
         return 1;
     }
-    outln!("sealed: {}", dir.join("seal.json").display());
+    outln!("sealed: {}", dir.join(SEAL_FILE).display());
     if status != "completed" {
         outln!(
             "the run {status} before its end; continue it with `ratecal run --resume {}`",
@@ -205,7 +203,7 @@ pub fn seal_recorded(
 
 /// Every warning of the run (all its parts, resumed or not) with its text, from the journal.
 pub fn journal_warnings(dir: &Path) -> Vec<String> {
-    let text = std::fs::read_to_string(dir.join("journal.jsonl")).unwrap_or_default();
+    let text = std::fs::read_to_string(dir.join(JOURNAL)).unwrap_or_default();
     text.lines()
         .filter_map(|l| serde_json::from_str::<JournalEntry>(l).ok())
         .filter_map(|e| {
@@ -242,7 +240,7 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
         .ok()?;
     let run_warnings = journal_warnings(dir);
     results.warnings.splice(0..0, run_warnings);
-    if let Err(e) = std::fs::write(dir.join("results.json"), results.to_json()) {
+    if let Err(e) = std::fs::write(dir.join(RESULTS), results.to_json()) {
         errln!("cannot write results.json: {e}");
         return None;
     }
@@ -269,10 +267,10 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
     for line in crate::analyze::verdict_lines(&results) {
         outln!("{line}");
     }
-    outln!("results: {}", dir.join("results.json").display());
+    outln!("results: {}", dir.join(RESULTS).display());
     // The checked plan beside the results lets `ratecal report` describe the process later.
     if let Ok(json) = serde_json::to_string_pretty(plan) {
-        let _ = std::fs::write(dir.join("plan.json"), json);
+        let _ = std::fs::write(dir.join(PLAN), json);
     }
     let mut input = ratecal_render::ReportInput::from_run(
         &results,
@@ -301,16 +299,16 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
 /// Records that the run failed after its folder existed (`status: failed` and why), then
 /// seals what the folder holds.
 pub fn mark_failed(dir: &Path, why: &str, key: Option<&SigningKey>) -> std::io::Result<()> {
-    let path = dir.join("manifest.yaml");
+    let path = dir.join(MANIFEST);
     let text = std::fs::read_to_string(&path)?;
     let mut m =
-        parse_manifest("manifest.yaml", &text).map_err(|e| std::io::Error::other(e.to_string()))?;
+        parse_manifest(MANIFEST, &text).map_err(|e| std::io::Error::other(e.to_string()))?;
     if let Some(run) = m.run.as_mut() {
         run.status = "failed".into();
         run.failure = Some(why.to_string());
         run.ended = Some(rfc3339(std::time::SystemTime::now()));
     }
-    ratecal_recording::commit::write_atomic(dir, "manifest.yaml", manifest_yaml(&m)?.as_bytes())?;
+    ratecal_recording::commit::write_atomic(dir, MANIFEST, manifest_yaml(&m)?.as_bytes())?;
     outln!("FAILED: {why}");
     outln!("the run folder {} records the failure", dir.display());
     ratecal_folder::sealing::write(dir, key)

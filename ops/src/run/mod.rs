@@ -5,6 +5,7 @@
 //! aborted, 1 input error (or a run that failed: its folder
 //! ends with `status: failed`), 2 usage.
 
+use ratecal_folder::names::{MANIFEST, PROCEDURE, STATION};
 mod check;
 mod finish;
 mod imports;
@@ -279,7 +280,7 @@ fn prepare_new(args: &Request) -> Result<(Prepared, FolderLock), Report> {
         .out
         .clone()
         .unwrap_or_else(|| setup::default_out(&pr.plan.name));
-    if dir.join("manifest.yaml").exists() {
+    if dir.join(MANIFEST).exists() {
         return Err(miette::miette!(
             help = "choose another --out, or continue it with --resume",
             "{} already holds a run",
@@ -291,16 +292,16 @@ fn prepare_new(args: &Request) -> Result<(Prepared, FolderLock), Report> {
     std::fs::create_dir_all(&dir).map_err(io)?;
     let lock = ratecal_folder::lock::acquire(&dir, &ratecal_folder::sealing::command_line())?;
     // Asked again under the lock: another `run --out` may have started it meanwhile.
-    if dir.join("manifest.yaml").exists() {
+    if dir.join(MANIFEST).exists() {
         return Err(miette::miette!(
             help = "choose another --out, or continue it with --resume",
             "{} already holds a run",
             dir.display()
         ));
     }
-    std::fs::write(dir.join("procedure.rcal"), &pr.text).map_err(io)?;
+    std::fs::write(dir.join(PROCEDURE), &pr.text).map_err(io)?;
     pr.imports.save(&dir).map_err(io)?;
-    std::fs::write(dir.join("station.yaml"), &st.yaml).map_err(io)?;
+    std::fs::write(dir.join(STATION), &st.yaml).map_err(io)?;
     let facts = setup::RunFacts {
         dir: &dir,
         dry_run: args.dry_run || args.station.is_none(),

@@ -11,11 +11,9 @@
 use super::{Prepared, imports, setup};
 use miette::{Report, miette};
 use ratecal_folder::lock::FolderLock;
+use ratecal_folder::names::{IMU, JOURNAL, MANIFEST, PROCEDURE, STATION, TABLE};
+use ratecal_folder::names::{SEAL_FILE, SEAL_HASH_FILE};
 use ratecal_folder::state::{State, state_of};
-use ratecal_folder::{
-    names::{SEAL_FILE, SEAL_HASH_FILE},
-    seal::verify_hashes,
-};
 use ratecal_recording::commit::{
     Intent, PENDING_DIR, Recovered, commit, crash_point, pending_dir, recover, sync_dir,
 };
@@ -26,7 +24,7 @@ use ratecal_run::{JournalEntry, JournalEvent, RunOptions, resume_point};
 use std::path::{Path, PathBuf};
 
 /// The files a resumed sealed run continues on staged copies of.
-const STAGED: [&str; 4] = ["imu.csv", "table.csv", "journal.jsonl", "manifest.yaml"];
+const STAGED: [&str; 4] = [IMU, TABLE, JOURNAL, MANIFEST];
 
 /// What `--resume` does with a folder.
 pub enum Resume {
@@ -85,12 +83,12 @@ pub fn prepare(dir: &Path) -> Result<(Resume, FolderLock), Report> {
         }
         State::RecordedUnsealed(status) => {
             unaltered_streams(dir)?;
-            let text = std::fs::read_to_string(dir.join("manifest.yaml")).map_err(io)?;
-            let manifest = parse_manifest("manifest.yaml", &text).map_err(Report::new)?;
+            let text = std::fs::read_to_string(dir.join(MANIFEST)).map_err(io)?;
+            let manifest = parse_manifest(MANIFEST, &text).map_err(Report::new)?;
             same_inputs(dir, &manifest)?;
             let dry_run = manifest.run.as_ref().is_some_and(|r| r.dry_run);
-            let st = setup::station(Some(&dir.join("station.yaml")), dry_run)?;
-            let pr = setup::procedure(&dir.join("procedure.rcal"), &st.station, Some(dir))?;
+            let st = setup::station(Some(&dir.join(STATION)), dry_run)?;
+            let pr = setup::procedure(&dir.join(PROCEDURE), &st.station, Some(dir))?;
             outln!(
                 "{}: a run that ended ({status}) but was never sealed; its streams match the \
                  journal's running hash: analysing, reporting and sealing it",
@@ -142,7 +140,7 @@ pub fn commit_staged(dir: &Path) -> std::io::Result<()> {
         },
     };
     let line = serde_json::to_string(&entry).map_err(std::io::Error::other)?;
-    let journal = dir.join(PENDING_DIR).join("journal.jsonl");
+    let journal = dir.join(PENDING_DIR).join(JOURNAL);
     let mut f = std::fs::OpenOptions::new().append(true).open(&journal)?;
     std::io::Write::write_all(&mut f, format!("{line}\n").as_bytes())?;
     f.sync_all()?;
@@ -165,11 +163,11 @@ fn continue_run(dir: &Path, stage: Option<PathBuf>) -> Result<Prepared, Report> 
         )
     };
     let write_dir = stage.clone().unwrap_or_else(|| dir.to_path_buf());
-    let journal = std::fs::read_to_string(write_dir.join("journal.jsonl")).map_err(io)?;
+    let journal = std::fs::read_to_string(write_dir.join(JOURNAL)).map_err(io)?;
     let point = resume_point(&journal);
     // Checked before anything in the folder is opened for writing.
-    let text = std::fs::read_to_string(write_dir.join("manifest.yaml")).map_err(io)?;
-    let manifest = parse_manifest("manifest.yaml", &text).map_err(Report::new)?;
+    let text = std::fs::read_to_string(write_dir.join(MANIFEST)).map_err(io)?;
+    let manifest = parse_manifest(MANIFEST, &text).map_err(Report::new)?;
     same_inputs(dir, &manifest)?;
     let (mut writer, last_t) = RecordingWriter::append(&write_dir, stage.is_some())
         .map_err(|e| altered_stream(dir, &e.to_string()))?;
@@ -180,8 +178,8 @@ fn continue_run(dir: &Path, stage: Option<PathBuf>) -> Result<Prepared, Report> 
         .as_ref()
         .and_then(|r| r.seed)
         .unwrap_or(1);
-    let st = setup::station(Some(&dir.join("station.yaml")), dry_run)?;
-    let pr = setup::procedure(&dir.join("procedure.rcal"), &st.station, Some(dir))?;
+    let st = setup::station(Some(&dir.join(STATION)), dry_run)?;
+    let pr = setup::procedure(&dir.join(PROCEDURE), &st.station, Some(dir))?;
     let cut_tail = writer.cut_tails().clone();
     let m = writer.manifest_mut();
     m.segments.truncate(point.segments);
@@ -263,17 +261,13 @@ fn unaltered_streams(dir: &Path) -> Result<(), Report> {
 
 /// A sealed folder (an aborted run is sealed) must still match its seal.
 fn unaltered(dir: &Path) -> Result<(), Report> {
-    let Ok(seal) = std::fs::read_to_string(dir.join(SEAL_FILE)) else {
+    if std::fs::read_to_string(dir.join(SEAL_FILE)).is_err() {
         return Ok(());
-    };
-    let hash = std::fs::read_to_string(dir.join(SEAL_HASH_FILE)).ok();
-    let files = ratecal_folder::sealing::folder_files(dir)
-        .map_err(|e| miette!("cannot read {}: {e}", dir.display()))?;
-    let report = verify_hashes(Some(&seal), hash.as_deref(), &files, None);
+    }
+    let report = ratecal_folder::verify::verify_folder(dir, None)?;
     if report.intact() {
         return Ok(());
     }
-    let names: Vec<&str> = report.altered().map(|c| c.file.as_str()).collect();
     Err(miette!(
         code = "run::resume_altered",
         help = format!(
@@ -282,7 +276,7 @@ fn unaltered(dir: &Path) -> Result<(), Report> {
         ),
         "{} was altered since it was sealed ({}): not resumed",
         dir.display(),
-        names.join(", ")
+        report.altered_names()
     ))
 }
 
@@ -297,19 +291,15 @@ fn same_inputs(dir: &Path, m: &Manifest) -> Result<(), Report> {
     };
     let read = |name: &str| std::fs::read(dir.join(name)).ok();
     if let Some(p) = &m.procedure {
-        let canon = read("procedure.rcal")
+        let canon = read(PROCEDURE)
             .and_then(|b| String::from_utf8(b).ok())
             .and_then(|t| ratecal_grammar::canonical(&t).ok())
             .map(|c| c.sha256);
-        compare("procedure.rcal", &p.sha256, canon);
+        compare(PROCEDURE, &p.sha256, canon);
     }
     if let Some(run) = &m.run {
         if let Some(s) = &run.station_sha256 {
-            compare(
-                "station.yaml",
-                s,
-                read("station.yaml").map(|b| sha256_hex(&b)),
-            );
+            compare(STATION, s, read(STATION).map(|b| sha256_hex(&b)));
         }
         let prefix = format!("{}/", imports::IMPORTS_DIR);
         for (name, sha) in run
