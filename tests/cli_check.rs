@@ -37,7 +37,7 @@ fn check_bundled_procedures() {
 
 #[test]
 fn check_errors_usage_and_missing_files() {
-    let (code, _, err) = ratecal(&["check", "engine/tests/fixtures/err_seed_attitude_4.rcal"]);
+    let (code, _, err) = ratecal(&["check", "check/tests/fixtures/err_seed_attitude_4.rcal"]);
     assert_eq!(code, 1);
     assert!(
         err.contains("check::unobservable") && err.contains("err_seed_attitude_4.rcal:51:"),

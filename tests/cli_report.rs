@@ -8,7 +8,7 @@ use std::process::Command;
 /// its manifest from the fixtures: a report needs results.json and the manifest only.
 fn run_dir() -> tempfile::TempDir {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let fixtures = root.join("engine/tests/fixtures/report");
+    let fixtures = root.join("render/tests/fixtures/report");
     let example = PathBuf::from("/work/shared/examples/standard-with-lever-arm");
     let dir = tempfile::tempdir().unwrap();
     if example.is_dir() {
