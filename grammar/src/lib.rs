@@ -15,6 +15,7 @@ mod diag;
 pub mod effect;
 mod fmt;
 mod lower;
+mod syntax;
 
 pub use diag::{Diagnostic, Severity, Source, source};
 pub use fmt::{format_abort, format_value};

@@ -3,6 +3,7 @@
 
 use crate::ast::*;
 use crate::diag::Diagnostic;
+use crate::syntax::{self, Language};
 use pest::Parser;
 use pest::iterators::Pair;
 
@@ -14,7 +15,8 @@ type P<'a> = Pair<'a, Rule>;
 
 /// Parses a file (without attaching comments).
 pub(crate) fn parse_file(text: &str) -> Result<File, Diagnostic> {
-    let mut pairs = Grammar::parse(Rule::file, text).map_err(|e| syntax_error(e, text))?;
+    let mut pairs =
+        Grammar::parse(Rule::file, text).map_err(|e| syntax::error(e, text, &SYNTAX))?;
     let file = pairs
         .next()
         .ok_or_else(|| Diagnostic::error("syntax::empty", "empty parse"))?;
@@ -33,43 +35,18 @@ pub(crate) fn parse_file(text: &str) -> Result<File, Diagnostic> {
     })
 }
 
-fn syntax_error(e: pest::error::Error<Rule>, text: &str) -> Diagnostic {
-    use pest::error::{ErrorVariant, InputLocation};
-    let pos = match e.location {
-        InputLocation::Pos(p) => p,
-        InputLocation::Span((s, _)) => s,
-    };
-    let expected = match &e.variant {
-        ErrorVariant::ParsingError { positives, .. } => {
-            let mut names: Vec<&str> = positives.iter().filter_map(|r| rule_name(*r)).collect();
-            names.sort_unstable();
-            names.dedup();
-            names
-        }
-        ErrorVariant::CustomError { .. } => Vec::new(),
-    };
-    let what = match expected.len() {
-        0 => "unexpected input".to_string(),
-        1 => format!("expected {}", expected[0]),
-        _ => {
-            let (last, rest) = expected.split_last().unwrap_or((&"", &[]));
-            format!("expected {} or {}", rest.join(", "), last)
-        }
-    };
-    let mut help = "see docs/language.md for the form of each statement".to_string();
-    // A keyword where a name was expected: say so.
-    if let Some(rest) = text.get(pos..)
-        && let Ok(mut kw) = Grammar::parse(Rule::reserved, rest)
-        && let Some(kw) = kw.next()
-    {
-        help = format!(
-            "`{}` is a keyword and cannot be used as a name; pick another name",
-            kw.as_str()
-        );
-    }
-    Diagnostic::error("syntax::unexpected", format!("syntax error: {what}"))
-        .label(Span::new(pos, pos), what)
-        .help(help)
+/// How this language words its syntax errors.
+const SYNTAX: Language<Rule> = Language {
+    code: "syntax::unexpected",
+    help: "see docs/language.md for the form of each statement",
+    rule_name,
+    keyword,
+};
+
+/// The keyword that `rest` begins with, if any.
+fn keyword(rest: &str) -> Option<&str> {
+    let mut kw = Grammar::parse(Rule::reserved, rest).ok()?;
+    kw.next().map(|kw| kw.as_str())
 }
 
 fn rule_name(r: Rule) -> Option<&'static str> {

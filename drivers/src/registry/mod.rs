@@ -1,11 +1,9 @@
-//! The one list of driver kinds, and `build`, which turns a station into a table and an
-//! IMU driver. Adding a driver means adding it here, with the settings it takes: the
-//! station file's `driver:` values are parsed against this list (`spec.rs`), and
-//! `describe` and the CLI ask it.
+//! How each kind of driver is built, and `build`, which turns a station into a table and an
+//! IMU driver. Adding a driver means adding its kind, with the settings it takes, to the
+//! one list of kinds (`station/driver.rs`: the station file's `driver:` values are parsed
+//! against it, and `describe` and the CLI ask it), and its builders here.
 
-mod spec;
-
-pub use spec::{DriverSpec, Settings};
+pub use crate::station::{DRIVERS, DriverKind, DriverSpec, Settings, kind};
 
 use crate::link::{Endpoint, FramedImu, LinkTable};
 use crate::sim::{SharedWorld, SimImu, SimTable};
@@ -39,78 +37,43 @@ impl Context<'_> {
 type TableBuilder = fn(&mut Context<'_>, &Settings) -> Result<Box<dyn TableDriver>, DriverError>;
 type ImuBuilder = fn(&mut Context<'_>, &Settings) -> Result<Box<dyn ImuDriver>, DriverError>;
 
-/// A kind of driver the registry knows.
+/// How a kind is built: its table and IMU builders (`None`: the kind cannot drive that
+/// device).
 #[derive(Clone, Copy)]
-pub struct DriverKind {
-    /// Name as written in a station file (`driver: sim`, `driver: { tcp: ... }`).
-    pub name: &'static str,
-    /// Whether it is a simulation (runs on the paused clock) rather than a device.
-    pub simulated: bool,
-    /// Whether its samples carry their host arrival time (`t_host`, a column of the
-    /// recording's streams).
-    pub host_arrival: bool,
-    /// The settings it takes, each with whether it is required (none: written `driver:
-    /// NAME`).
-    pub keys: &'static [(&'static str, bool)],
+pub struct Builders {
     /// Builds the table driver, if the kind can drive a table.
     pub table: Option<TableBuilder>,
     /// Builds the IMU driver, if the kind can read an IMU.
     pub imu: Option<ImuBuilder>,
-    /// One line for people.
-    pub about: &'static str,
 }
 
-impl std::fmt::Debug for DriverKind {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "DriverKind({})", self.name)
+/// The builders of a kind.
+pub fn builders(kind: &DriverKind) -> Builders {
+    match kind.name {
+        "sim" => Builders {
+            table: Some(|c, _| Ok(Box::new(SimTable::new(c.station, c.world(), c.seed)))),
+            imu: Some(sim_imu),
+        },
+        "tcp" | "serial" => Builders {
+            table: Some(link_table),
+            imu: Some(framed_imu),
+        },
+        "replay" => Builders {
+            table: Some(|c, s| {
+                let dir = required(s.recording.as_ref(), "recording")?;
+                Ok(Box::new(crate::replay::ReplayTable::open(dir, c.station)?))
+            }),
+            imu: Some(|c, s| {
+                let dir = required(s.recording.as_ref(), "recording")?;
+                Ok(Box::new(crate::replay::ReplayImu::open(dir, c.station)?))
+            }),
+        },
+        _ => Builders {
+            table: None,
+            imu: None,
+        },
     }
 }
-
-/// Every driver kind.
-pub const DRIVERS: &[DriverKind] = &[
-    DriverKind {
-        name: "sim",
-        simulated: true,
-        host_arrival: false,
-        keys: &[],
-        table: Some(|c, _| Ok(Box::new(SimTable::new(c.station, c.world(), c.seed)))),
-        imu: Some(sim_imu),
-        about: "simulated station (physics.md), seeded, virtual time",
-    },
-    DriverKind {
-        name: "tcp",
-        simulated: false,
-        host_arrival: true,
-        keys: &[("address", true), ("timeout", false)],
-        table: Some(link_table),
-        imu: Some(framed_imu),
-        about: "table over the line protocol, IMU over binary frames (docs/protocols.md), TCP",
-    },
-    DriverKind {
-        name: "serial",
-        simulated: false,
-        host_arrival: true,
-        keys: &[("port", true), ("baud", false), ("timeout", false)],
-        table: Some(link_table),
-        imu: Some(framed_imu),
-        about: "the same protocols over a serial port (tokio-serial)",
-    },
-    DriverKind {
-        name: "replay",
-        simulated: false,
-        host_arrival: false,
-        keys: &[("recording", true)],
-        table: Some(|c, s| {
-            let dir = required(s.recording.as_ref(), "recording")?;
-            Ok(Box::new(crate::replay::ReplayTable::open(dir, c.station)?))
-        }),
-        imu: Some(|c, s| {
-            let dir = required(s.recording.as_ref(), "recording")?;
-            Ok(Box::new(crate::replay::ReplayImu::open(dir, c.station)?))
-        }),
-        about: "replays the streams of a recording folder in time",
-    },
-];
 
 /// A required setting (the station loader checked it: missing is an internal error).
 fn required<'a>(v: Option<&'a String>, key: &str) -> Result<&'a String, DriverError> {
@@ -168,14 +131,9 @@ fn framed_imu(c: &mut Context<'_>, s: &Settings) -> Result<Box<dyn ImuDriver>, D
     Ok(Box::new(FramedImu::spawn(endpoint, info, timeout, c.start)))
 }
 
-/// The registered kind of a name.
-pub fn kind(name: &str) -> Option<&'static DriverKind> {
-    DRIVERS.iter().find(|k| k.name == name)
-}
-
 /// Whether both of a station's drivers are simulations (the run may use virtual time).
 pub fn simulated(station: &Station) -> bool {
-    station.table.driver.kind.simulated && station.imu.driver.kind.simulated
+    station.simulated()
 }
 
 /// A station's table and IMU drivers.
@@ -197,9 +155,12 @@ pub fn build(station: &Station, seed: u64) -> Result<Drivers, DriverError> {
             format!("the `{}` driver cannot run {what}", k.name),
         )
     };
-    let table =
-        table.kind.table.ok_or_else(|| no("a table", table.kind))?(&mut ctx, &table.settings)?;
-    let imu = imu.kind.imu.ok_or_else(|| no("an IMU", imu.kind))?(&mut ctx, &imu.settings)?;
+    let table = builders(table.kind)
+        .table
+        .ok_or_else(|| no("a table", table.kind))?(&mut ctx, &table.settings)?;
+    let imu = builders(imu.kind)
+        .imu
+        .ok_or_else(|| no("an IMU", imu.kind))?(&mut ctx, &imu.settings)?;
     Ok((table, imu))
 }
 
@@ -235,10 +196,18 @@ mod tests {
             ),
         ] {
             let s = Station::from_yaml(&yaml(t, i), "s.yaml").unwrap();
-            assert!(s.table.driver.kind.table.is_some());
-            assert!(s.imu.driver.kind.imu.is_some());
+            assert!(builders(s.table.driver.kind).table.is_some());
+            assert!(builders(s.imu.driver.kind).imu.is_some());
             assert!(!simulated(&s));
         }
         assert!(simulated(&Station::default_sim()));
+    }
+
+    #[test]
+    fn every_kind_has_its_builders() {
+        for k in DRIVERS {
+            let b = builders(k);
+            assert!(b.table.is_some() && b.imu.is_some(), "{}", k.name);
+        }
     }
 }

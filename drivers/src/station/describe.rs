@@ -52,6 +52,11 @@ pub struct Environment {
 }
 
 impl Station {
+    /// Whether both of its drivers are simulations (a run may use virtual time).
+    pub fn simulated(&self) -> bool {
+        self.table.driver.kind.simulated && self.imu.driver.kind.simulated
+    }
+
     /// The facts a manifest records about this station.
     pub fn describe(&self) -> StationInfo {
         StationInfo {
@@ -64,7 +69,7 @@ impl Station {
                 grade: self.imu.grade.clone(),
             },
             table_model: self.table.model.clone(),
-            simulated: crate::registry::simulated(self),
+            simulated: self.simulated(),
             environment: self.environment.map(|e| Environment {
                 temperature_c: e.temperature.map(|t| t.0),
                 humidity_pct: e.humidity.map(|h| h.0 * 100.0),

@@ -2,12 +2,12 @@
 //! carry their units (see `quantity.rs`), keys whose name ends in a unit take bare numbers.
 //! `docs/station.md` documents every key.
 
+use super::driver::DriverSpec;
 use super::effects::{EffectsSpec, TableEffectsSpec};
 use super::quantity::{
     Accel, AccelDensity, Angle, Freq, Pressure, Rate, RateDensity, RateWalk, Ratio, Rotation, Temp,
     TempDelta, TempRate, Time, UnitVec, damping, finite, fraction, frequency, positive,
 };
-use crate::registry::DriverSpec;
 use serde::{Deserialize, Serialize};
 
 use super::faults::FaultSpec;

@@ -2,6 +2,7 @@
 //! Parsing refuses unknown keys and wrong units with a diagnostic located in the file.
 
 mod describe;
+mod driver;
 mod edit;
 mod effects;
 mod faults;
@@ -9,6 +10,7 @@ mod file;
 mod quantity;
 
 pub use describe::{Environment, ImuIdentity, StationInfo};
+pub use driver::{DRIVERS, DriverKind, DriverSpec, Settings, kind};
 
 pub use edit::{SetValue, edit, locate, number};
 pub use effects::{EffectsSpec, TableEffectsSpec};

@@ -7,6 +7,7 @@ use super::{
 };
 use crate::ast::{Span, Spanned};
 use crate::diag::Diagnostic;
+use crate::syntax::{self, Language};
 use pest::Parser;
 use pest::iterators::Pair;
 
@@ -18,7 +19,8 @@ type P<'a> = Pair<'a, Rule>;
 
 /// Parses a file.
 pub(crate) fn parse_file(text: &str) -> Result<EffectFile, Diagnostic> {
-    let mut pairs = Grammar::parse(Rule::file, text).map_err(|e| syntax_error(e, text))?;
+    let mut pairs =
+        Grammar::parse(Rule::file, text).map_err(|e| syntax::error(e, text, &SYNTAX))?;
     let file = pairs
         .next()
         .ok_or_else(|| Diagnostic::error("effect::syntax", "empty parse"))?;
@@ -39,38 +41,18 @@ pub(crate) fn parse_file(text: &str) -> Result<EffectFile, Diagnostic> {
     }
 }
 
-fn syntax_error(e: pest::error::Error<Rule>, text: &str) -> Diagnostic {
-    use pest::error::{ErrorVariant, InputLocation};
-    let pos = match e.location {
-        InputLocation::Pos(p) => p,
-        InputLocation::Span((s, _)) => s,
-    };
-    let mut expected: Vec<&str> = match &e.variant {
-        ErrorVariant::ParsingError { positives, .. } => {
-            positives.iter().filter_map(|r| rule_name(*r)).collect()
-        }
-        ErrorVariant::CustomError { .. } => Vec::new(),
-    };
-    expected.sort_unstable();
-    expected.dedup();
-    let what = match expected.split_last() {
-        None => "unexpected input".to_string(),
-        Some((only, [])) => format!("expected {only}"),
-        Some((last, rest)) => format!("expected {} or {last}", rest.join(", ")),
-    };
-    let mut help = "an effect file holds `effect <name> { explanation \"...\" param <name> unit \"...\" needs \"...\" <channel> += <expression> }`; see docs/user-effects.md".to_string();
-    if let Some(rest) = text.get(pos..)
-        && let Ok(mut kw) = Grammar::parse(Rule::keyword, rest)
-        && let Some(kw) = kw.next()
-    {
-        help = format!(
-            "`{}` is a keyword and cannot be used as a name; pick another name",
-            kw.as_str()
-        );
-    }
-    Diagnostic::error("effect::syntax", format!("syntax error: {what}"))
-        .label(Span::new(pos, pos), what)
-        .help(help)
+/// How this language words its syntax errors.
+const SYNTAX: Language<Rule> = Language {
+    code: "effect::syntax",
+    help: "an effect file holds `effect <name> { explanation \"...\" param <name> unit \"...\" needs \"...\" <channel> += <expression> }`; see docs/user-effects.md",
+    rule_name,
+    keyword,
+};
+
+/// The keyword that `rest` begins with, if any.
+fn keyword(rest: &str) -> Option<&str> {
+    let mut kw = Grammar::parse(Rule::keyword, rest).ok()?;
+    kw.next().map(|kw| kw.as_str())
 }
 
 fn rule_name(r: Rule) -> Option<&'static str> {

@@ -1,12 +1,12 @@
 //! The nominal biases: outputs at zero input.
 
-use super::{Effect, Param, Partials, Sensor, Signals, per_axis};
+use super::{Descriptor, Effect, Partials, Sensor, Signals, per_axis};
 
 /// A bias of one sensor triad.
 #[derive(Debug)]
 pub struct Bias {
     sensor: Sensor,
-    params: &'static [Param],
+    descriptor: &'static Descriptor,
 }
 
 const NEEDS: [&str; 3] = ["any data of the sensor"; 3];
@@ -21,51 +21,40 @@ const GYRO_MAX: f64 = 30.0;
 /// `accel_bias`: accelerometer outputs at zero input, m/s^2.
 pub static ACCEL_BIAS: Bias = Bias {
     sensor: Sensor::Accel,
-    params: &per_axis!(Sensor::Accel, "m/s^2", NEEDS, ACCEL_MAX),
+    descriptor: &Descriptor {
+        id: "accel_bias",
+        explanation: "each accelerometer reads a constant offset at zero input",
+        follows: "nothing: a constant",
+        params: &per_axis!(Sensor::Accel, "m/s^2", NEEDS, ACCEL_MAX),
+        sensors: Sensor::Accel.only(),
+        nominal: true,
+        sensed: false,
+        station_side: false,
+        uses_temperature: false,
+        varies_at_rest: false,
+    },
 };
 
 /// `gyro_bias`: gyro outputs at zero input, deg/s.
 pub static GYRO_BIAS: Bias = Bias {
     sensor: Sensor::Gyro,
-    params: &per_axis!(Sensor::Gyro, "deg/s", NEEDS, GYRO_MAX),
+    descriptor: &Descriptor {
+        id: "gyro_bias",
+        explanation: "each gyro reads a constant offset at zero input",
+        follows: "nothing: a constant",
+        params: &per_axis!(Sensor::Gyro, "deg/s", NEEDS, GYRO_MAX),
+        sensors: Sensor::Gyro.only(),
+        nominal: true,
+        sensed: false,
+        station_side: false,
+        uses_temperature: false,
+        varies_at_rest: false,
+    },
 };
 
 impl Effect for Bias {
-    fn varies_at_rest(&self) -> bool {
-        false
-    }
-
-    fn id(&self) -> &'static str {
-        match self.sensor {
-            Sensor::Accel => "accel_bias",
-            Sensor::Gyro => "gyro_bias",
-        }
-    }
-
-    fn explanation(&self) -> &'static str {
-        match self.sensor {
-            Sensor::Accel => "each accelerometer reads a constant offset at zero input",
-            Sensor::Gyro => "each gyro reads a constant offset at zero input",
-        }
-    }
-
-    fn follows(&self) -> &'static str {
-        match self.sensor {
-            Sensor::Accel => "nothing: a constant",
-            Sensor::Gyro => "nothing: a constant",
-        }
-    }
-
-    fn params(&self) -> &'static [Param] {
-        self.params
-    }
-
-    fn nominal(&self) -> bool {
-        true
-    }
-
-    fn sensors(&self) -> &'static [Sensor] {
-        self.sensor.only()
+    fn descriptor(&self) -> Option<&'static Descriptor> {
+        Some(self.descriptor)
     }
 
     fn regressors(&self, _s: &Signals, out: &mut [Partials]) {

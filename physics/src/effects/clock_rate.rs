@@ -8,7 +8,7 @@
 //! the recording (60 ppm is 0.1 s after half an hour). With a time offset as well, the
 //! motion seen at stamp `t` is that of table time `t / (1 + eps) - tau`.
 
-use super::{Effect, Param, Partials, Sensor, Signals};
+use super::{Descriptor, Effect, Param, Partials, Sensor, Signals};
 use crate::DEG;
 
 /// The `clock_rate` effect (`ppm`).
@@ -35,25 +35,23 @@ impl ClockRate {
     }
 }
 
+/// What `clock_rate` is.
+static DESCRIPTOR: Descriptor = Descriptor {
+    id: "clock_rate",
+    explanation: "the IMU's sample clock runs fast or slow against the table's: the samples drift in time against the table's feedback",
+    follows: "the rate of change of the reference, times the time since the start",
+    params: &PARAMS,
+    sensors: &[Sensor::Accel, Sensor::Gyro],
+    nominal: false,
+    sensed: false,
+    station_side: false,
+    uses_temperature: false,
+    varies_at_rest: true,
+};
+
 impl Effect for ClockRate {
-    fn id(&self) -> &'static str {
-        "clock_rate"
-    }
-
-    fn explanation(&self) -> &'static str {
-        "the IMU's sample clock runs fast or slow against the table's: the samples drift in time against the table's feedback"
-    }
-
-    fn follows(&self) -> &'static str {
-        "the rate of change of the reference, times the time since the start"
-    }
-
-    fn params(&self) -> &'static [Param] {
-        &PARAMS
-    }
-
-    fn sensors(&self) -> &'static [Sensor] {
-        &[Sensor::Accel, Sensor::Gyro]
+    fn descriptor(&self) -> Option<&'static Descriptor> {
+        Some(&DESCRIPTOR)
     }
 
     /// `y(t / (1 + eps)) = y(t) - t eps dy/dt` to first order (`eps = ppm * 1e-6`).

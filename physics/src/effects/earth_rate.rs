@@ -4,7 +4,7 @@
 //! 15.04 deg/h in all), which the attitude turns into body axes; the latitude follows from
 //! their ratio (physics.md names it as the effect's optional parameter).
 
-use super::{Effect, Param, Partials, Sensor, Signals};
+use super::{Descriptor, Effect, Param, Partials, Sensor, Signals};
 use crate::{DEG, EARTH_RATE_RADPS};
 
 /// The `earth_rate` effect.
@@ -59,29 +59,23 @@ impl EarthRate {
     }
 }
 
+/// What `earth_rate` is.
+static DESCRIPTOR: Descriptor = Descriptor {
+    id: "earth_rate",
+    explanation: "the gyros sense the Earth's rotation (15 deg/h), projected on the body axes by the attitude",
+    follows: "the attitude (static segments differ by the Earth rate's projection)",
+    params: &PARAMS,
+    sensors: &[Sensor::Gyro],
+    nominal: false,
+    sensed: false,
+    station_side: false,
+    uses_temperature: false,
+    varies_at_rest: false,
+};
+
 impl Effect for EarthRate {
-    fn varies_at_rest(&self) -> bool {
-        false
-    }
-
-    fn id(&self) -> &'static str {
-        "earth_rate"
-    }
-
-    fn explanation(&self) -> &'static str {
-        "the gyros sense the Earth's rotation (15 deg/h), projected on the body axes by the attitude"
-    }
-
-    fn follows(&self) -> &'static str {
-        "the attitude (static segments differ by the Earth rate's projection)"
-    }
-
-    fn params(&self) -> &'static [Param] {
-        &PARAMS
-    }
-
-    fn sensors(&self) -> &'static [Sensor] {
-        &[Sensor::Gyro]
+    fn descriptor(&self) -> Option<&'static Descriptor> {
+        Some(&DESCRIPTOR)
     }
 
     fn regressors(&self, s: &Signals, out: &mut [Partials]) {

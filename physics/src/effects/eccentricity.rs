@@ -10,7 +10,7 @@
 //! (`s = e cos(phi)`, `c = e sin(phi)`; parameters `<axis>_sin_arcsec`,
 //! `<axis>_cos_arcsec`); [`Eccentricity::amplitude_phase`] gives `e` and `phi` back.
 
-use super::{Effect, Param, Partials, Sensor, Signals};
+use super::{Descriptor, Effect, Param, Partials, Sensor, Signals};
 use crate::{AxisMotion, DEG, TableState};
 
 /// One arc second, rad.
@@ -80,33 +80,23 @@ impl Eccentricity {
     }
 }
 
+/// What `table_encoder_eccentricity` is.
+static DESCRIPTOR: Descriptor = Descriptor {
+    id: "table_encoder_eccentricity",
+    explanation: "the table's angle encoders are eccentric: the reported angle and rate carry an error that repeats once per revolution (a station error, not the IMU's)",
+    follows: "the sine and cosine of a table angle (once per revolution)",
+    params: &PARAMS,
+    sensors: &[Sensor::Accel, Sensor::Gyro],
+    nominal: false,
+    sensed: false,
+    station_side: true,
+    uses_temperature: false,
+    varies_at_rest: false,
+};
+
 impl Effect for Eccentricity {
-    fn varies_at_rest(&self) -> bool {
-        false
-    }
-
-    fn id(&self) -> &'static str {
-        "table_encoder_eccentricity"
-    }
-
-    fn explanation(&self) -> &'static str {
-        "the table's angle encoders are eccentric: the reported angle and rate carry an error that repeats once per revolution (a station error, not the IMU's)"
-    }
-
-    fn follows(&self) -> &'static str {
-        "the sine and cosine of a table angle (once per revolution)"
-    }
-
-    fn params(&self) -> &'static [Param] {
-        &PARAMS
-    }
-
-    fn sensors(&self) -> &'static [Sensor] {
-        &[Sensor::Accel, Sensor::Gyro]
-    }
-
-    fn station_side(&self) -> bool {
-        true
+    fn descriptor(&self) -> Option<&'static Descriptor> {
+        Some(&DESCRIPTOR)
     }
 
     /// The signals are those of the reported (encoder) motion; the true motion differs by

@@ -1,7 +1,7 @@
 //! `g_sensitivity`: the gyro bias depends on specific force (`G`; `<i><j>_dps_per_g` =
 //! `G[i][j]` * g).
 
-use super::{Effect, Param, Partials, Sensor, Signals};
+use super::{Descriptor, Effect, Param, Partials, Sensor, Signals};
 
 /// The `g_sensitivity` effect.
 #[derive(Debug)]
@@ -36,29 +36,23 @@ static PARAMS: [Param; 9] = [
     p("zz_dps_per_g", 2, "attitudes with gravity along +Z and -Z"),
 ];
 
+/// What `g_sensitivity` is.
+static DESCRIPTOR: Descriptor = Descriptor {
+    id: "g_sensitivity",
+    explanation: "the gyro bias depends on the specific force: it changes with the attitude relative to gravity",
+    follows: "the attitude relative to gravity (specific force)",
+    params: &PARAMS,
+    sensors: &[Sensor::Gyro],
+    nominal: false,
+    sensed: false,
+    station_side: false,
+    uses_temperature: false,
+    varies_at_rest: false,
+};
+
 impl Effect for GSensitivity {
-    fn varies_at_rest(&self) -> bool {
-        false
-    }
-
-    fn id(&self) -> &'static str {
-        "g_sensitivity"
-    }
-
-    fn explanation(&self) -> &'static str {
-        "the gyro bias depends on the specific force: it changes with the attitude relative to gravity"
-    }
-
-    fn follows(&self) -> &'static str {
-        "the attitude relative to gravity (specific force)"
-    }
-
-    fn params(&self) -> &'static [Param] {
-        &PARAMS
-    }
-
-    fn sensors(&self) -> &'static [Sensor] {
-        &[Sensor::Gyro]
+    fn descriptor(&self) -> Option<&'static Descriptor> {
+        Some(&DESCRIPTOR)
     }
 
     fn regressors(&self, s: &Signals, out: &mut [Partials]) {

@@ -1,7 +1,7 @@
 //! `lever_arm`: accelerometer sensing points away from the table's centre of rotation
 //! feel centripetal and tangential acceleration (mounting offset and size effect).
 
-use super::{Effect, Param, Partials, Sensor, Signals};
+use super::{Descriptor, Effect, Param, Partials, Sensor, Signals};
 
 /// The `lever_arm` effect: `r<i><j>_mm` is the j-component (body axes) of accelerometer
 /// i's sensing point, mm.
@@ -64,33 +64,23 @@ static PARAMS: [Param; 9] = [
     p("rzz_mm", 2, "rotate about X or Y"),
 ];
 
+/// What `lever_arm` is.
+static DESCRIPTOR: Descriptor = Descriptor {
+    id: "lever_arm",
+    explanation: "the accelerometers' sensing points are not at the table's centre of rotation: they feel centripetal and tangential acceleration",
+    follows: "the rate squared and the angular acceleration",
+    params: &PARAMS,
+    sensors: &[Sensor::Accel],
+    nominal: false,
+    sensed: true,
+    station_side: false,
+    uses_temperature: false,
+    varies_at_rest: false,
+};
+
 impl Effect for LeverArm {
-    fn varies_at_rest(&self) -> bool {
-        false
-    }
-
-    fn id(&self) -> &'static str {
-        "lever_arm"
-    }
-
-    fn explanation(&self) -> &'static str {
-        "the accelerometers' sensing points are not at the table's centre of rotation: they feel centripetal and tangential acceleration"
-    }
-
-    fn follows(&self) -> &'static str {
-        "the rate squared and the angular acceleration"
-    }
-
-    fn params(&self) -> &'static [Param] {
-        &PARAMS
-    }
-
-    fn sensors(&self) -> &'static [Sensor] {
-        &[Sensor::Accel]
-    }
-
-    fn sensed(&self) -> bool {
-        true
+    fn descriptor(&self) -> Option<&'static Descriptor> {
+        Some(&DESCRIPTOR)
     }
 
     fn regressors(&self, s: &Signals, out: &mut [Partials]) {

@@ -45,7 +45,7 @@ pub enum Sensor {
 
 impl Sensor {
     /// This sensor alone: the `sensors()` of an effect on one triad.
-    pub fn only(self) -> &'static [Sensor] {
+    pub const fn only(self) -> &'static [Sensor] {
         match self {
             Sensor::Accel => &[Sensor::Accel],
             Sensor::Gyro => &[Sensor::Gyro],
@@ -118,19 +118,72 @@ impl Partials {
     }
 }
 
-/// One term of the measurement model.
-pub trait Effect: Send + Sync + std::fmt::Debug {
+/// What an effect is, apart from its maths: its id, its parameters, its words for a report
+/// and how the simulator and the analysis treat it. Every registry effect has one, a
+/// constant, that [`Effect::descriptor`] returns.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Descriptor {
     /// Canonical id (`lever_arm`; the nominal terms are `accel_bias`, `gyro_scale`, ...).
-    fn id(&self) -> &'static str;
+    pub id: &'static str,
     /// What physics it is, in one line an engineer reads in a report.
-    fn explanation(&self) -> &'static str;
+    pub explanation: &'static str,
     /// What a residual that this term explains correlates with, for locating it.
-    fn follows(&self) -> &'static str;
+    pub follows: &'static str,
     /// Its parameters, in the catalogue's order.
-    fn params(&self) -> &'static [Param];
+    pub params: &'static [Param],
+    /// The sensors whose outputs it touches.
+    pub sensors: &'static [Sensor],
     /// Whether it belongs to the nominal model (bias, scale) rather than the catalogue.
+    pub nominal: bool,
+    /// Whether its accelerometer contribution is part of the specific force the
+    /// accelerometers sense (the lever arm), to which scale and cross-coupling then apply
+    /// (`a = K_a s + b_a`).
+    pub sensed: bool,
+    /// Whether it is an error of the station (the table's feedback), not of the IMU:
+    /// reports call it a station error, and the simulator applies it to the table's
+    /// motion rather than to the IMU's outputs.
+    pub station_side: bool,
+    /// Whether its regressors read the IMU temperature (`Signals::dtemp_c`): the analysis
+    /// then needs the reference temperature before the samples pass.
+    pub uses_temperature: bool,
+    /// Whether its regressors can change while the motion does not: they read the time
+    /// stamp or the temperature (`Signals::t_s`, `Signals::dtemp_c`). The analysis
+    /// evaluates a term that says no once for a stretch at rest. Yes is always right; a
+    /// term that says no must be a function of the motion alone.
+    pub varies_at_rest: bool,
+}
+
+/// One term of the measurement model: a [`Descriptor`] and its maths.
+///
+/// A registry effect answers [`Effect::descriptor`], and the accessors (`id`, `params`,
+/// ...) read it. An effect made at run time (explain's user effects and probes) has no
+/// constant descriptor: it answers the accessors itself, and the flags it does not answer
+/// keep their catalogue defaults.
+pub trait Effect: Send + Sync + std::fmt::Debug {
+    /// What it is, apart from its maths (`None`: an effect made at run time, which answers
+    /// the accessors itself).
+    fn descriptor(&self) -> Option<&'static Descriptor> {
+        None
+    }
+    /// Canonical id: [`Descriptor::id`].
+    fn id(&self) -> &'static str {
+        described(self).id
+    }
+    /// [`Descriptor::explanation`].
+    fn explanation(&self) -> &'static str {
+        described(self).explanation
+    }
+    /// [`Descriptor::follows`].
+    fn follows(&self) -> &'static str {
+        described(self).follows
+    }
+    /// Its parameters, in the catalogue's order: [`Descriptor::params`].
+    fn params(&self) -> &'static [Param] {
+        described(self).params
+    }
+    /// [`Descriptor::nominal`] (no for an effect made at run time).
     fn nominal(&self) -> bool {
-        false
+        self.descriptor().is_some_and(|d| d.nominal)
     }
     /// Partial derivatives of the outputs with respect to each parameter at this instant,
     /// written to `out` (as long as [`Effect::params`]).
@@ -148,11 +201,9 @@ pub trait Effect: Send + Sync + std::fmt::Debug {
         }
         out
     }
-    /// Whether its accelerometer contribution is part of the specific force the
-    /// accelerometers sense (the lever arm), to which scale and cross-coupling then apply
-    /// (`a = K_a s + b_a`).
+    /// [`Descriptor::sensed`] (no for an effect made at run time).
     fn sensed(&self) -> bool {
-        false
+        self.descriptor().is_some_and(|d| d.sensed)
     }
     /// How much later than the motion the samples are stamped, s (the time offset).
     fn delay_s(&self, _values: &[f64]) -> f64 {
@@ -164,26 +215,28 @@ pub trait Effect: Send + Sync + std::fmt::Debug {
     fn delay_at_s(&self, values: &[f64], _t_s: f64) -> f64 {
         self.delay_s(values)
     }
-    /// Whether it is an error of the station (the table's feedback), not of the IMU:
-    /// reports call it a station error, and the simulator applies it to the table's
-    /// motion rather than to the IMU's outputs.
+    /// [`Descriptor::station_side`] (no for an effect made at run time).
     fn station_side(&self) -> bool {
-        false
+        self.descriptor().is_some_and(|d| d.station_side)
     }
-    /// The sensors whose outputs it touches.
-    fn sensors(&self) -> &'static [Sensor];
-    /// Whether its regressors read the IMU temperature (`Signals::dtemp_c`): the analysis
-    /// then needs the reference temperature before the samples pass.
+    /// The sensors whose outputs it touches: [`Descriptor::sensors`].
+    fn sensors(&self) -> &'static [Sensor] {
+        described(self).sensors
+    }
+    /// [`Descriptor::uses_temperature`] (no for an effect made at run time).
     fn uses_temperature(&self) -> bool {
-        false
+        self.descriptor().is_some_and(|d| d.uses_temperature)
     }
-    /// Whether its regressors can change while the motion does not: they read the time
-    /// stamp or the temperature (`Signals::t_s`, `Signals::dtemp_c`). The analysis
-    /// evaluates a term that says no once for a stretch at rest. The default, yes, is always
-    /// right; a term that says no must be a function of the motion alone.
+    /// [`Descriptor::varies_at_rest`] (yes, always right, for an effect made at run time).
     fn varies_at_rest(&self) -> bool {
-        true
+        self.descriptor().is_none_or(|d| d.varies_at_rest)
     }
+}
+
+/// The descriptor of an effect that reads its accessors from it.
+fn described<E: Effect + ?Sized>(e: &E) -> &'static Descriptor {
+    e.descriptor()
+        .expect("an effect without a descriptor answers id, explanation, follows, params and sensors itself")
 }
 
 /// Every effect, the nominal terms first, then the catalogue in physics.md's order, then

@@ -1,6 +1,6 @@
 //! `gyro_scale_nonlinearity`: each gyro output gains `n_i w_i |w_i|` (ppm per deg/s).
 
-use super::{Effect, Param, Partials, Sensor, Signals, per_axis};
+use super::{Descriptor, Effect, Param, Partials, Sensor, Signals, per_axis};
 
 /// The `gyro_scale_nonlinearity` effect.
 #[derive(Debug)]
@@ -22,29 +22,23 @@ static PARAMS: [Param; 3] = per_axis!(
     50.0
 );
 
+/// What `gyro_scale_nonlinearity` is.
+static DESCRIPTOR: Descriptor = Descriptor {
+    id: "gyro_scale_nonlinearity",
+    explanation: "the gyro scale factor changes with the rate: the output error grows with the square of the rate",
+    follows: "the signed square of the rate",
+    params: &PARAMS,
+    sensors: &[Sensor::Gyro],
+    nominal: false,
+    sensed: false,
+    station_side: false,
+    uses_temperature: false,
+    varies_at_rest: false,
+};
+
 impl Effect for Nonlinearity {
-    fn varies_at_rest(&self) -> bool {
-        false
-    }
-
-    fn id(&self) -> &'static str {
-        "gyro_scale_nonlinearity"
-    }
-
-    fn explanation(&self) -> &'static str {
-        "the gyro scale factor changes with the rate: the output error grows with the square of the rate"
-    }
-
-    fn follows(&self) -> &'static str {
-        "the signed square of the rate"
-    }
-
-    fn params(&self) -> &'static [Param] {
-        &PARAMS
-    }
-
-    fn sensors(&self) -> &'static [Sensor] {
-        &[Sensor::Gyro]
+    fn descriptor(&self) -> Option<&'static Descriptor> {
+        Some(&DESCRIPTOR)
     }
 
     fn regressors(&self, s: &Signals, out: &mut [Partials]) {

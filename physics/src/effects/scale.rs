@@ -1,12 +1,12 @@
 //! The nominal scale-factor errors: `K - 1` on the diagonal of the sensitivity matrices.
 
-use super::{Effect, Param, Partials, Sensor, Signals, per_axis};
+use super::{Descriptor, Effect, Partials, Sensor, Signals, per_axis};
 
 /// A scale-factor error of one sensor triad, ppm.
 #[derive(Debug)]
 pub struct Scale {
     sensor: Sensor,
-    params: &'static [Param],
+    descriptor: &'static Descriptor,
 }
 
 /// Largest plausible scale-factor error, ppm: consumer MEMS sensitivities are specified to
@@ -16,65 +16,54 @@ const MAX_PPM: f64 = 50_000.0;
 /// `accel_scale`: accelerometer scale-factor errors, ppm.
 pub static ACCEL_SCALE: Scale = Scale {
     sensor: Sensor::Accel,
-    params: &per_axis!(
-        Sensor::Accel,
-        "ppm",
-        [
-            "attitudes with gravity along +X and -X",
-            "attitudes with gravity along +Y and -Y",
-            "attitudes with gravity along +Z and -Z"
-        ],
-        MAX_PPM
-    ),
+    descriptor: &Descriptor {
+        id: "accel_scale",
+        explanation: "each accelerometer's sensitivity differs from nominal",
+        follows: "the specific force along the axis",
+        params: &per_axis!(
+            Sensor::Accel,
+            "ppm",
+            [
+                "attitudes with gravity along +X and -X",
+                "attitudes with gravity along +Y and -Y",
+                "attitudes with gravity along +Z and -Z"
+            ],
+            MAX_PPM
+        ),
+        sensors: Sensor::Accel.only(),
+        nominal: true,
+        sensed: false,
+        station_side: false,
+        uses_temperature: false,
+        varies_at_rest: false,
+    },
 };
 
 /// `gyro_scale`: gyro scale-factor errors, ppm.
 pub static GYRO_SCALE: Scale = Scale {
     sensor: Sensor::Gyro,
-    params: &per_axis!(
-        Sensor::Gyro,
-        "ppm",
-        ["rotate about X", "rotate about Y", "rotate about Z"],
-        MAX_PPM
-    ),
+    descriptor: &Descriptor {
+        id: "gyro_scale",
+        explanation: "each gyro's sensitivity differs from nominal",
+        follows: "the rate about the axis",
+        params: &per_axis!(
+            Sensor::Gyro,
+            "ppm",
+            ["rotate about X", "rotate about Y", "rotate about Z"],
+            MAX_PPM
+        ),
+        sensors: Sensor::Gyro.only(),
+        nominal: true,
+        sensed: false,
+        station_side: false,
+        uses_temperature: false,
+        varies_at_rest: false,
+    },
 };
 
 impl Effect for Scale {
-    fn varies_at_rest(&self) -> bool {
-        false
-    }
-
-    fn id(&self) -> &'static str {
-        match self.sensor {
-            Sensor::Accel => "accel_scale",
-            Sensor::Gyro => "gyro_scale",
-        }
-    }
-
-    fn explanation(&self) -> &'static str {
-        match self.sensor {
-            Sensor::Accel => "each accelerometer's sensitivity differs from nominal",
-            Sensor::Gyro => "each gyro's sensitivity differs from nominal",
-        }
-    }
-
-    fn follows(&self) -> &'static str {
-        match self.sensor {
-            Sensor::Accel => "the specific force along the axis",
-            Sensor::Gyro => "the rate about the axis",
-        }
-    }
-
-    fn params(&self) -> &'static [Param] {
-        self.params
-    }
-
-    fn nominal(&self) -> bool {
-        true
-    }
-
-    fn sensors(&self) -> &'static [Sensor] {
-        self.sensor.only()
+    fn descriptor(&self) -> Option<&'static Descriptor> {
+        Some(self.descriptor)
     }
 
     fn regressors(&self, s: &Signals, out: &mut [Partials]) {

@@ -1,7 +1,7 @@
 //! `accel_second_order`: each accelerometer output gains `K2_i f_i^2 / g` (IEEE 1293's
 //! second-order nonlinearity coefficient, ug/g^2).
 
-use super::{Effect, Param, Partials, Sensor, Signals, per_axis};
+use super::{Descriptor, Effect, Param, Partials, Sensor, Signals, per_axis};
 
 /// The `accel_second_order` effect.
 #[derive(Debug)]
@@ -23,29 +23,23 @@ static PARAMS: [Param; 3] = per_axis!(
     5000.0
 );
 
+/// What `accel_second_order` is.
+static DESCRIPTOR: Descriptor = Descriptor {
+    id: "accel_second_order",
+    explanation: "the accelerometer output grows with the square of the specific force (second-order nonlinearity, K2)",
+    follows: "the square of the specific force along the axis",
+    params: &PARAMS,
+    sensors: &[Sensor::Accel],
+    nominal: false,
+    sensed: false,
+    station_side: false,
+    uses_temperature: false,
+    varies_at_rest: false,
+};
+
 impl Effect for SecondOrder {
-    fn varies_at_rest(&self) -> bool {
-        false
-    }
-
-    fn id(&self) -> &'static str {
-        "accel_second_order"
-    }
-
-    fn explanation(&self) -> &'static str {
-        "the accelerometer output grows with the square of the specific force (second-order nonlinearity, K2)"
-    }
-
-    fn follows(&self) -> &'static str {
-        "the square of the specific force along the axis"
-    }
-
-    fn params(&self) -> &'static [Param] {
-        &PARAMS
-    }
-
-    fn sensors(&self) -> &'static [Sensor] {
-        &[Sensor::Accel]
+    fn descriptor(&self) -> Option<&'static Descriptor> {
+        Some(&DESCRIPTOR)
     }
 
     /// `K2 [ug/g^2] * 1e-6 g (f_i / g)^2 = K2 * 1e-6 f_i^2 / g` (m/s^2), with `g` the

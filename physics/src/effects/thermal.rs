@@ -1,13 +1,13 @@
 //! `gyro_thermal_drift` and `accel_thermal_drift`: biases that follow the IMU's internal
 //! temperature, `b(T) = b0 + k (T - T_ref)`.
 
-use super::{Effect, Param, Partials, Sensor, Signals, per_axis};
+use super::{Descriptor, Effect, Partials, Sensor, Signals, per_axis};
 
 /// The thermal drift of one sensor triad's biases.
 #[derive(Debug)]
 pub struct ThermalDrift {
     sensor: Sensor,
-    params: &'static [Param],
+    descriptor: &'static Descriptor,
 }
 
 const NEEDS: [&str; 3] = ["a change of the IMU's temperature during the data"; 3];
@@ -22,44 +22,40 @@ const ACCEL_MAX: f64 = 0.02;
 /// `gyro_thermal_drift`, deg/s per degC.
 pub static GYRO_THERMAL_DRIFT: ThermalDrift = ThermalDrift {
     sensor: Sensor::Gyro,
-    params: &per_axis!(Sensor::Gyro, "deg/s per degC", NEEDS, GYRO_MAX),
+    descriptor: &Descriptor {
+        id: "gyro_thermal_drift",
+        explanation: "the gyro biases follow the IMU's internal temperature",
+        follows: "the IMU temperature",
+        params: &per_axis!(Sensor::Gyro, "deg/s per degC", NEEDS, GYRO_MAX),
+        sensors: Sensor::Gyro.only(),
+        nominal: false,
+        sensed: false,
+        station_side: false,
+        uses_temperature: true,
+        varies_at_rest: true,
+    },
 };
 
 /// `accel_thermal_drift`, m/s^2 per degC.
 pub static ACCEL_THERMAL_DRIFT: ThermalDrift = ThermalDrift {
     sensor: Sensor::Accel,
-    params: &per_axis!(Sensor::Accel, "m/s^2 per degC", NEEDS, ACCEL_MAX),
+    descriptor: &Descriptor {
+        id: "accel_thermal_drift",
+        explanation: "the accelerometer biases follow the IMU's internal temperature",
+        follows: "the IMU temperature",
+        params: &per_axis!(Sensor::Accel, "m/s^2 per degC", NEEDS, ACCEL_MAX),
+        sensors: Sensor::Accel.only(),
+        nominal: false,
+        sensed: false,
+        station_side: false,
+        uses_temperature: true,
+        varies_at_rest: true,
+    },
 };
 
 impl Effect for ThermalDrift {
-    fn id(&self) -> &'static str {
-        match self.sensor {
-            Sensor::Accel => "accel_thermal_drift",
-            Sensor::Gyro => "gyro_thermal_drift",
-        }
-    }
-
-    fn explanation(&self) -> &'static str {
-        match self.sensor {
-            Sensor::Accel => "the accelerometer biases follow the IMU's internal temperature",
-            Sensor::Gyro => "the gyro biases follow the IMU's internal temperature",
-        }
-    }
-
-    fn follows(&self) -> &'static str {
-        "the IMU temperature"
-    }
-
-    fn params(&self) -> &'static [Param] {
-        self.params
-    }
-
-    fn uses_temperature(&self) -> bool {
-        true
-    }
-
-    fn sensors(&self) -> &'static [Sensor] {
-        self.sensor.only()
+    fn descriptor(&self) -> Option<&'static Descriptor> {
+        Some(self.descriptor)
     }
 
     fn regressors(&self, s: &Signals, out: &mut [Partials]) {

@@ -1,7 +1,7 @@
 //! `time_offset`: the IMU and table clocks disagree; the sample stamped `t` measured the
 //! motion at `t - tau`.
 
-use super::{Effect, Param, Partials, Sensor, Signals};
+use super::{Descriptor, Effect, Param, Partials, Sensor, Signals};
 use crate::DEG;
 
 /// The `time_offset` effect (`tau_ms`).
@@ -20,29 +20,23 @@ static PARAMS: [Param; 1] = [Param {
     max_abs: 1000.0,
 }];
 
+/// What `time_offset` is.
+static DESCRIPTOR: Descriptor = Descriptor {
+    id: "time_offset",
+    explanation: "the IMU and table clocks disagree: the IMU samples lag (or lead) the table's feedback",
+    follows: "the rate of change of the reference",
+    params: &PARAMS,
+    sensors: &[Sensor::Accel, Sensor::Gyro],
+    nominal: false,
+    sensed: false,
+    station_side: false,
+    uses_temperature: false,
+    varies_at_rest: false,
+};
+
 impl Effect for TimeOffset {
-    fn varies_at_rest(&self) -> bool {
-        false
-    }
-
-    fn id(&self) -> &'static str {
-        "time_offset"
-    }
-
-    fn explanation(&self) -> &'static str {
-        "the IMU and table clocks disagree: the IMU samples lag (or lead) the table's feedback"
-    }
-
-    fn follows(&self) -> &'static str {
-        "the rate of change of the reference"
-    }
-
-    fn params(&self) -> &'static [Param] {
-        &PARAMS
-    }
-
-    fn sensors(&self) -> &'static [Sensor] {
-        &[Sensor::Accel, Sensor::Gyro]
+    fn descriptor(&self) -> Option<&'static Descriptor> {
+        Some(&DESCRIPTOR)
     }
 
     /// y(t - tau) = y(t) - tau dy/dt to first order.

@@ -7,7 +7,7 @@
 
 use super::csvread::{cell_offset, row_start};
 use super::io_error;
-use super::manifest::find_segment;
+use super::locate::find_segment;
 use crate::Manifest;
 use crate::error::{RecordingError, empty_stream, line_col, line_col_bytes};
 use crate::excerpt::Excerpt;

@@ -74,15 +74,3 @@ pub fn parse_manifest(file: &str, text: &str) -> Result<Manifest, RecordingError
     super::validate::manifest(file, text, &manifest)?;
     Ok(manifest)
 }
-
-/// Byte offset of the start of the line that declares segment `id` (at or after `from`).
-pub(crate) fn find_segment(text: &str, id: &str, from: usize) -> usize {
-    let at = |needle: &str| text[from..].find(needle).map(|p| p + from);
-    let hit = at(&format!("\"{id}\""))
-        .or_else(|| at(&format!("'{id}'")))
-        .or_else(|| at(&format!("id: {id}")));
-    match hit {
-        Some(p) => text[..p].rfind('\n').map_or(0, |n| n + 1),
-        None => text.find("segments").unwrap_or(0),
-    }
-}

@@ -8,6 +8,7 @@ mod csvread;
 mod fast;
 mod index;
 mod lines;
+mod locate;
 mod manifest;
 mod number;
 mod scan;

@@ -5,6 +5,7 @@
 // A refused manifest is built once per read: the error's size costs nothing.
 #![allow(clippy::result_large_err)]
 
+use super::locate::{find_segment, locate};
 use crate::error::{RecordingError, line_col};
 use crate::excerpt::Excerpt;
 use crate::{Manifest, Mount};
@@ -67,7 +68,7 @@ pub(crate) fn manifest(file: &str, text: &str, m: &Manifest) -> Result<(), Recor
     }
     let mut from = text.find("segments").unwrap_or(0);
     for seg in &m.segments {
-        from = super::manifest::find_segment(text, &seg.id, from);
+        from = find_segment(text, &seg.id, from);
         if let Some(problem) = seg.mount.as_ref().and_then(not_a_rotation) {
             return Err(at("rotation", from, problem, MOUNT_HELP));
         }
@@ -106,51 +107,9 @@ fn not_a_rotation(m: &Mount) -> Option<String> {
         .map(|why| format!("the mount rotation {why}"))
 }
 
-/// Byte offset and length of `key` and its value at or after `from` (the whole text's
-/// start if the key is not written there).
-fn locate(text: &str, key: &str, from: usize) -> (usize, usize) {
-    let from = from.min(text.len());
-    let Some(start) = text[from..].find(key).map(|p| p + from) else {
-        return (from, 1);
-    };
-    let rest = &text[start + key.len()..];
-    let value = rest.trim_start_matches([':', ' ']);
-    let skipped = rest.len() - value.len();
-    let mut depth = 0i32;
-    let mut end = value.len();
-    for (i, c) in value.char_indices() {
-        match c {
-            '[' => depth += 1,
-            ']' => {
-                depth -= 1;
-                if depth == 0 {
-                    end = i + 1;
-                    break;
-                }
-            }
-            ',' | '}' | '\n' | '\r' if depth == 0 => {
-                end = i;
-                break;
-            }
-            _ => {}
-        }
-    }
-    (start, key.len() + skipped + value[..end].trim_end().len())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn a_key_is_located_with_its_value() {
-        let text = "site: { latitude_deg: 95, gravity_mps2: .nan }\nm: [[1, 0], [0, 1]], x";
-        let (o, l) = locate(text, "gravity_mps2", 0);
-        assert_eq!(&text[o..o + l], "gravity_mps2: .nan");
-        let (o, l) = locate(text, "m", 40);
-        assert_eq!(&text[o..o + l], "m: [[1, 0], [0, 1]]");
-        assert_eq!(locate(text, "absent", 3), (3, 1));
-    }
 
     #[test]
     fn rotations_proper_and_not() {

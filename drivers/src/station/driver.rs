@@ -1,14 +1,74 @@
-//! A station file's `driver:` value: a kind the registry lists, by name, and its settings
-//! (`driver: sim`, `driver: { tcp: { address: "host:port", timeout: "2 s" } }`). Only the
-//! registry knows the kinds: a name it does not list is refused with the closest one, and
-//! each kind says which settings it takes and needs.
+//! A station file's `driver:` value: a kind of driver, by name, and its settings
+//! (`driver: sim`, `driver: { tcp: { address: "host:port", timeout: "2 s" } }`). Here is
+//! the one list of kinds: a name it does not list is refused with the closest one, and
+//! each kind says which settings it takes and needs. How each kind is built is the
+//! registry's (`registry::builders`).
 
-use super::{DRIVERS, DriverKind, kind};
-use crate::station::Time;
+use super::quantity::Time;
 use serde::de::{self, Deserializer, MapAccess, Visitor};
 use serde::ser::{SerializeMap, Serializer};
 use serde::{Deserialize, Serialize};
 use std::fmt;
+
+/// A kind of driver the registry knows.
+#[derive(Clone, Copy)]
+pub struct DriverKind {
+    /// Name as written in a station file (`driver: sim`, `driver: { tcp: ... }`).
+    pub name: &'static str,
+    /// Whether it is a simulation (runs on the paused clock) rather than a device.
+    pub simulated: bool,
+    /// Whether its samples carry their host arrival time (`t_host`, a column of the
+    /// recording's streams).
+    pub host_arrival: bool,
+    /// The settings it takes, each with whether it is required (none: written `driver:
+    /// NAME`).
+    pub keys: &'static [(&'static str, bool)],
+    /// One line for people.
+    pub about: &'static str,
+}
+
+impl fmt::Debug for DriverKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "DriverKind({})", self.name)
+    }
+}
+
+/// Every driver kind.
+pub const DRIVERS: &[DriverKind] = &[
+    DriverKind {
+        name: "sim",
+        simulated: true,
+        host_arrival: false,
+        keys: &[],
+        about: "simulated station (physics.md), seeded, virtual time",
+    },
+    DriverKind {
+        name: "tcp",
+        simulated: false,
+        host_arrival: true,
+        keys: &[("address", true), ("timeout", false)],
+        about: "table over the line protocol, IMU over binary frames (docs/protocols.md), TCP",
+    },
+    DriverKind {
+        name: "serial",
+        simulated: false,
+        host_arrival: true,
+        keys: &[("port", true), ("baud", false), ("timeout", false)],
+        about: "the same protocols over a serial port (tokio-serial)",
+    },
+    DriverKind {
+        name: "replay",
+        simulated: false,
+        host_arrival: false,
+        keys: &[("recording", true)],
+        about: "replays the streams of a recording folder in time",
+    },
+];
+
+/// The registered kind of a name.
+pub fn kind(name: &str) -> Option<&'static DriverKind> {
+    DRIVERS.iter().find(|k| k.name == name)
+}
 
 /// The settings of a hardware or replay driver; the kind says which it takes
 /// (`DriverKind::keys`).
