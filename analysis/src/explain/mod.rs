@@ -7,6 +7,12 @@
 //! wandering bias) and confirmed on segments held out of every fit. Candidates are the
 //! registry's effects and the user effects of `*.effect` files ([`user`]); with a
 //! procedure, [`adoption`] writes the diff that declares the findings in its fits.
+//!
+//! The modules stand in layers, each using only those below it, so that each can be read
+//! (and changed) without the ones above: [`stats`] (pure statistics), [`probe`] and the
+//! Earth's rate candidate ([`earth::candidate`]) at the bottom; [`data`] (the
+//! accumulation) over them; [`model`] over `data`; [`select`] and [`earth`] over `model`;
+//! discovery, location, timing and the output over those.
 
 // Numeric loops index the six channels of several arrays at once.
 #![allow(clippy::needless_range_loop)]
@@ -23,6 +29,7 @@ mod output;
 mod plausible;
 mod probe;
 mod select;
+mod stats;
 mod text;
 mod timing;
 mod unexplained;

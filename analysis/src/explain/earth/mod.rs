@@ -1,105 +1,19 @@
-//! The Earth's rate as explain tries it: physics it already knows, not a free vector.
+//! The Earth's rate in explain's final model: when the candidate ([`candidate`]) is
+//! selected, it is replaced by the registry's `earth_rate` held at the manifest's
+//! latitude with only the heading free, and its free scale tells whether what the gyros
+//! saw was the Earth's rate at all.
 //!
-//! The Earth turns at 15.041 deg/h about its axis and the manifest gives the site's
-//! latitude, so the only legitimate unknown is the table's true heading (the azimuth of
-//! its axes, which a lab may not know to the degree). The candidate has two columns: the
-//! Earth's rate at the manifest's latitude as the station believes it is oriented (its
-//! coefficient `scale` is 1 when the physics holds) and the rate along the lab's East axis
-//! (`east_dph`), which a heading error turns the horizontal component into. A `scale` far
-//! from 1 means the gyros see an attitude-dependent rate that is not the Earth's; the final
-//! model then holds the Earth's rate at its physical value, and what mimics it is left to
-//! the tests for what remains unexplained.
+//! The candidate lives in a module of its own because the recording's accumulation
+//! ([`super::data`]) adds it to the layout, while holding it needs the models fitted
+//! over that accumulation.
 
+pub(crate) mod candidate;
+
+use super::data::Data;
+use super::model::{Terms, fit};
+use super::stats::p_value;
+use candidate::{components, heading_deg};
 use ratecal_physics::DEG;
-use ratecal_physics::effects::{EarthRate, Effect, Param, Partials, Sensor, Signals};
-
-/// The candidate (its id is the registry's `earth_rate`).
-#[derive(Debug)]
-pub(crate) struct EarthHeld;
-
-/// The instance explain adds to its layout.
-pub(crate) static EARTH_HELD: EarthHeld = EarthHeld;
-
-static PARAMS: [Param; 2] = [
-    Param {
-        name: "scale",
-        unit: "1",
-        channel: None,
-        needs: "static attitudes that turn the Earth's axis through the gyro axes",
-        // Judged against 1 by explain itself, not by a magnitude.
-        max_abs: f64::INFINITY,
-    },
-    Param {
-        name: "east_dph",
-        unit: "deg/h",
-        channel: None,
-        needs: "static attitudes that turn the lab's East axis through the gyro axes",
-        // No component of the Earth's rate exceeds it.
-        max_abs: ratecal_physics::EARTH_RATE_RADPS / DEG * 3600.0,
-    },
-];
-
-impl Effect for EarthHeld {
-    fn varies_at_rest(&self) -> bool {
-        false
-    }
-
-    fn id(&self) -> &'static str {
-        "earth_rate"
-    }
-
-    fn explanation(&self) -> &'static str {
-        ratecal_physics::effect("earth_rate").map_or("", |e| e.explanation())
-    }
-
-    fn follows(&self) -> &'static str {
-        ratecal_physics::effect("earth_rate").map_or("", |e| e.follows())
-    }
-
-    fn params(&self) -> &'static [Param] {
-        &PARAMS
-    }
-
-    fn sensors(&self) -> &'static [Sensor] {
-        &[Sensor::Gyro]
-    }
-
-    fn regressors(&self, s: &Signals, out: &mut [Partials]) {
-        out[0] = Partials {
-            gyro: s.earth_b / DEG,
-            ..Default::default()
-        };
-        out[1] = Partials {
-            gyro: s.c_bl.column(0) / 3600.0,
-            ..Default::default()
-        };
-    }
-}
-
-/// The horizontal and vertical components of the Earth's rate at a latitude, deg/h.
-pub(crate) fn components(latitude_deg: f64) -> (f64, f64) {
-    let [n, u] = EarthRate::values(latitude_deg);
-    (n, u)
-}
-
-/// The heading (deg) a fitted East component gives, with its u: the lab's North axis
-/// points `heading` east of true north, so true north has an East component of
-/// `-h sin(heading)` in lab axes. `None` when the component exceeds the horizontal rate
-/// itself by more than its uncertainty allows.
-pub(crate) fn heading_deg(east_dph: f64, u_dph: f64, latitude_deg: f64) -> Option<(f64, f64)> {
-    let (h, _) = components(latitude_deg);
-    if h <= 0.0 {
-        return None;
-    }
-    let x = -east_dph / h;
-    if x.abs() > 1.0 + 3.0 * u_dph / h {
-        return None;
-    }
-    let x = x.clamp(-1.0, 1.0);
-    let psi = x.asin();
-    let u = u_dph / (h * psi.cos().max(1e-3));
-    Some((psi / DEG, u / DEG))
-}
 
 /// The Earth's rate held at its physical value in a final model.
 #[derive(Debug, Clone)]
@@ -113,11 +27,7 @@ pub(crate) struct Held {
 /// When `terms` holds the candidate, replaces it by the Earth's rate at the manifest's
 /// latitude (the registry's `earth_rate`, fixed) with only the East component free (the
 /// heading), in two passes so that a heading of tens of degrees is exact.
-pub(crate) fn hold(
-    data: &super::data::Data,
-    terms: &mut super::model::Terms,
-    latitude_deg: f64,
-) -> Option<Held> {
+pub(crate) fn hold(data: &Data, terms: &mut Terms, latitude_deg: f64) -> Option<Held> {
     let lay = &data.layout;
     if !terms.effects.contains(&data.earth) {
         return None;
@@ -125,7 +35,7 @@ pub(crate) fn hold(
     let all: Vec<usize> = (0..data.accs.len()).collect();
     let gs = lay.first[data.earth];
     let ge = gs + 1;
-    let free = super::model::fit(data, terms, &all, &all).0;
+    let free = fit(data, terms, &all, &all).0;
     let scale = (free.theta[gs], free.u(gs));
     let reg = lay.index("earth_rate")?;
     let (h, v) = components(latitude_deg);
@@ -133,7 +43,7 @@ pub(crate) fn hold(
     terms.fixed.push((reg, vec![h, v]));
     let mut heading = None;
     for _ in 0..2 {
-        let f = super::model::fit(data, terms, &all, &all).0;
+        let f = fit(data, terms, &all, &all).0;
         if !f.estimated.contains(&ge) {
             heading = None;
             break;
@@ -181,7 +91,7 @@ impl Held {
     pub(crate) fn mimic(&self, alpha: f64) -> Option<super::Unexplained> {
         let (s, u) = self.scale;
         let z = if u > 0.0 { (s - 1.0).abs() / u } else { 0.0 };
-        let p = super::select::p_value(z * z, 1);
+        let p = p_value(z * z, 1);
         if (s - 1.0).abs() <= 0.1 || z < 5.0 || p >= alpha {
             return None;
         }
@@ -208,7 +118,7 @@ impl Held {
 }
 
 /// The final model's term names, the Earth's rate said once.
-pub(crate) fn names(data: &super::data::Data, terms: &super::model::Terms) -> Vec<String> {
+pub(crate) fn names(data: &Data, terms: &Terms) -> Vec<String> {
     let held =
         terms.effects.contains(&data.earth) && terms.skip.contains(&data.layout.first[data.earth]);
     terms
