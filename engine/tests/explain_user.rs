@@ -8,7 +8,7 @@ mod common;
 use common::explain::found;
 use common::plans::standard;
 use common::sim;
-use ratecal_engine::explain::{self, Explanation, NominalModel, Options, ParamOut, user};
+use ratecal_engine::explain::{self, Explanation, NominalModel, Options, Parameter, user};
 use ratecal_engine::recording::{self, Recording};
 
 fn record(effects: &str, seed: u64) -> Recording {
@@ -43,7 +43,7 @@ fn run(rec: &Recording, files: &[&str], without: &[&str]) -> Explanation {
 fn estimate(x: &Explanation, effect: &str, param: &str) -> (f64, f64) {
     let f = x.findings.iter().find(|f| f.effect == effect).unwrap();
     match &f.parameters[param] {
-        ParamOut::Estimate { value, u, .. } => (*value, *u),
+        Parameter::Estimate { value, u, .. } => (*value, *u),
         other => panic!("{effect}.{param}: {other:?}"),
     }
 }

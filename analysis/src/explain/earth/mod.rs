@@ -12,6 +12,7 @@ pub(crate) mod candidate;
 use super::data::Data;
 use super::model::{Terms, fit};
 use super::stats::p_value;
+use crate::results::Parameter;
 use candidate::{components, heading_deg};
 use ratecal_physics::DEG;
 
@@ -68,14 +69,9 @@ impl Held {
     pub(crate) fn parameters(
         &self,
         latitude_deg: f64,
-    ) -> std::collections::BTreeMap<String, super::ParamOut> {
-        use super::ParamOut::Estimate;
+    ) -> std::collections::BTreeMap<String, Parameter> {
         let (h, v) = components(latitude_deg);
-        let est = |value: f64, u: f64, unit: &str| Estimate {
-            value,
-            u,
-            unit: unit.into(),
-        };
+        let est = Parameter::estimate;
         let mut p = std::collections::BTreeMap::new();
         p.insert("latitude_deg".into(), est(latitude_deg, 0.0, "deg"));
         p.insert("north_dph".into(), est(h, 0.0, "deg/h"));
