@@ -12,7 +12,7 @@ mod common;
 use common::explain::{found, within};
 use common::plans::standard;
 use common::sim::{record, station};
-use ratecal_analysis::explain::{self, Explanation, NominalModel, Options, ParamOut};
+use ratecal_analysis::explain::{self, Explanation, NominalModel, Options, Parameter};
 use ratecal_drivers::Station;
 use ratecal_recording as recording;
 
@@ -39,11 +39,11 @@ fn heading(x: &Explanation) -> (f64, f64) {
         .find(|f| f.effect == "earth_rate")
         .unwrap();
     match &f.parameters["latitude_deg"] {
-        ParamOut::Estimate { value, u, .. } => assert_eq!((*value, *u), (55.7, 0.0)),
+        Parameter::Estimate { value, u, .. } => assert_eq!((*value, *u), (55.7, 0.0)),
         p => panic!("latitude not reported: {p:?}"),
     }
     match &f.parameters["heading_deg"] {
-        ParamOut::Estimate { value, u, .. } => (*value, *u),
+        Parameter::Estimate { value, u, .. } => (*value, *u),
         p => panic!("heading not determined: {p:?}"),
     }
 }

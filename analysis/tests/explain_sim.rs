@@ -10,7 +10,7 @@ mod common;
 use common::explain::{found, within};
 use common::plans::standard;
 use common::sim::{record, station};
-use ratecal_analysis::explain::{self, Explanation, NominalModel, Options, ParamOut};
+use ratecal_analysis::explain::{self, Explanation, NominalModel, Options, Parameter};
 use ratecal_drivers::Station;
 use ratecal_recording as recording;
 
@@ -37,11 +37,11 @@ fn a_defect_free_imu_shows_only_the_earth_rate() {
         assert_eq!(found(&x), ["earth_rate"], "seed {seed}: {:?}", x.rejected);
         let f = &x.findings[0];
         // Held at the manifest's latitude, not fitted (docs/explain.md).
-        let ParamOut::Estimate { value, u, .. } = &f.parameters["latitude_deg"] else {
+        let Parameter::Estimate { value, u, .. } = &f.parameters["latitude_deg"] else {
             panic!("latitude not reported");
         };
         assert_eq!((*value, *u), (55.7, 0.0));
-        let ParamOut::Estimate { value, u, .. } = &f.parameters["heading_deg"] else {
+        let Parameter::Estimate { value, u, .. } = &f.parameters["heading_deg"] else {
             panic!("heading not fitted");
         };
         assert!(value.abs() < 3.0 * u, "heading {value} ± {u}");
@@ -73,7 +73,7 @@ fn lever_arm_is_found_with_the_coordinates_the_motion_determines() {
     // Nothing rotates about Z nor about an axis between X and Y.
     assert!(matches!(
         f.parameters["rxy_mm"],
-        ParamOut::Unobservable { .. }
+        Parameter::Unobservable { .. }
     ));
     assert!(
         f.located
@@ -141,7 +141,7 @@ fn misalignments_are_found() {
         .iter()
         .find(|f| f.effect == "gyro_misalignment")
         .unwrap();
-    let ParamOut::Estimate { value, .. } = &f.parameters["yx_mrad"] else {
+    let Parameter::Estimate { value, .. } = &f.parameters["yx_mrad"] else {
         panic!("yx not determined")
     };
     assert!((value - 0.5).abs() < 0.02, "yx {value}");

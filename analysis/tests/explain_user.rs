@@ -9,7 +9,7 @@ mod common;
 use common::explain::found;
 use common::plans::standard;
 use common::sim;
-use ratecal_analysis::explain::{self, Explanation, NominalModel, Options, ParamOut, user};
+use ratecal_analysis::explain::{self, Explanation, NominalModel, Options, Parameter, user};
 use ratecal_recording::{self as recording, Recording};
 
 fn record(effects: &str, seed: u64) -> Recording {
@@ -44,7 +44,7 @@ fn run(rec: &Recording, files: &[&str], without: &[&str]) -> Explanation {
 fn estimate(x: &Explanation, effect: &str, param: &str) -> (f64, f64) {
     let f = x.findings.iter().find(|f| f.effect == effect).unwrap();
     match &f.parameters[param] {
-        ParamOut::Estimate { value, u, .. } => (*value, *u),
+        Parameter::Estimate { value, u, .. } => (*value, *u),
         other => panic!("{effect}.{param}: {other:?}"),
     }
 }

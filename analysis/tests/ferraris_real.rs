@@ -7,7 +7,7 @@
 mod shared;
 
 use nalgebra::{DMatrix, DVector};
-use ratecal_analysis::explain::{self, NominalModel, Options, ParamOut};
+use ratecal_analysis::explain::{self, NominalModel, Options, Parameter};
 use ratecal_recording as recording;
 
 /// `K` (3x3) of `a = K f + b` from the six segments' mean outputs and references
@@ -69,7 +69,7 @@ fn explain_names_the_misalignment_a_full_fit_agrees_with() {
     for i in 0..3 {
         for j in (0..3).filter(|&j| j != i) {
             let name = format!("{}{}_mrad", names[i], names[j]);
-            let ParamOut::Estimate { value, u, .. } = &f.parameters[&name] else {
+            let Parameter::Estimate { value, u, .. } = &f.parameters[&name] else {
                 panic!("{name} not determined");
             };
             let (full, uf) = (k[i][j].0 * 1e3, k[i][j].1 * 1e3);

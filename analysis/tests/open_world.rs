@@ -6,7 +6,7 @@
 #[path = "../../tests/support/shared.rs"]
 mod shared;
 
-use ratecal_analysis::explain::{self, Explanation, NominalModel, Options, ParamOut};
+use ratecal_analysis::explain::{self, Explanation, NominalModel, Options, Parameter};
 use ratecal_recording as recording;
 
 fn explain_example(name: &str) -> Option<Explanation> {
@@ -30,11 +30,11 @@ fn earth_held(x: &Explanation, latitude: f64) {
         .iter()
         .find(|f| f.effect == "earth_rate")
         .expect("the Earth's rate is always in a real recording");
-    let ParamOut::Estimate { value, u, .. } = &f.parameters["latitude_deg"] else {
+    let Parameter::Estimate { value, u, .. } = &f.parameters["latitude_deg"] else {
         panic!("latitude not reported");
     };
     assert_eq!((*value, *u), (latitude, 0.0));
-    let ParamOut::Estimate { value, .. } = &f.parameters["north_dph"] else {
+    let Parameter::Estimate { value, .. } = &f.parameters["north_dph"] else {
         panic!("north not reported");
     };
     assert!((value - 15.041 * latitude.to_radians().cos()).abs() < 0.01);
@@ -50,7 +50,7 @@ fn null_names_the_earth_rate_and_nothing_else() {
     earth_held(&x, 40.0);
     // The table is aligned: the fitted heading is zero within 3u.
     let f = &x.findings[0];
-    let ParamOut::Estimate { value, u, .. } = &f.parameters["heading_deg"] else {
+    let Parameter::Estimate { value, u, .. } = &f.parameters["heading_deg"] else {
         panic!("heading not fitted");
     };
     assert!(value.abs() < 3.0 * u && *u < 5.0, "heading {value} ± {u}");
@@ -129,7 +129,7 @@ fn accel_bias_step_is_discovered_on_the_accelerometers_at_its_instant() {
             "{c}: {v} +- {u} ug, truth {truth}"
         );
     }
-    let ParamOut::Estimate { value, .. } = &step.parameters["at_s"] else {
+    let Parameter::Estimate { value, .. } = &step.parameters["at_s"] else {
         panic!("no instant")
     };
     assert!((value - 1500.0).abs() < 20.0, "step at {value}");

@@ -116,7 +116,7 @@ fn confirm(s: &Scenario, x: &Explanation, opts: &Options) {
                 )
             });
         for t in &f.terms {
-            let Some(explain::ParamOut::Estimate { value, u, .. }) =
+            let Some(explain::Parameter::Estimate { value, u, .. }) =
                 g.parameters.get(&format!("k_{}", t.channel))
             else {
                 panic!("{}: k_{} not estimated", f.effect, t.channel);
@@ -195,7 +195,7 @@ fn a_bias_step_is_discovered_at_its_instant() {
             }
         }
         let f = discovered(&x)[0];
-        let Some(explain::ParamOut::Estimate { value, u, .. }) = f.parameters.get("at_s") else {
+        let Some(explain::Parameter::Estimate { value, u, .. }) = f.parameters.get("at_s") else {
             panic!("no instant: {:?}", f.parameters)
         };
         // The instant is located to the gap between the segments around it.
@@ -225,7 +225,7 @@ fn a_warm_up_without_temperature_is_discovered_with_its_time_constant() {
         .into_iter()
         .find(|f| f.effect.contains("decay"))
         .unwrap_or_else(|| panic!("no decay: {:?}", x.findings));
-    let Some(explain::ParamOut::Estimate { value, u, .. }) = f.parameters.get("tau_s") else {
+    let Some(explain::Parameter::Estimate { value, u, .. }) = f.parameters.get("tau_s") else {
         panic!("no time constant: {:?}", f.parameters)
     };
     within("tau", (*value, *u), tau, 3.0);

@@ -1,7 +1,7 @@
 //! The recording accumulated once for every model explain will try: every segment, every
 //! registry effect's columns, and which segments are held out.
 
-use super::earth::EARTH_HELD;
+use super::earth::candidate::EARTH_HELD;
 use super::probe::{self, Probe};
 use crate::fit::joint::{Layout, SegAcc, excitation};
 use crate::fit::{Retime, Source};

@@ -12,7 +12,8 @@
 use super::data::Data;
 use super::model::{Terms, fit, misfit};
 use super::probe::{Form, Probe};
-use super::select::{Step, p_value, wald};
+use super::select::Step;
+use super::stats::{p_value, wald};
 use crate::fit::joint::{Fit, channel};
 use ratecal_physics::effects::Sensor;
 
@@ -122,7 +123,7 @@ pub(crate) fn discover(data: &Data, terms: &mut Terms, alpha: f64) -> Vec<Discov
     let mut out: Vec<Discovery> = Vec::new();
     while out.len() < MOST {
         let (base, _) = fit(data, terms, &work, &work);
-        let short = super::probe::screen(data, terms, &work, SHORTLIST);
+        let short = super::select::screen(data, terms, &work, SHORTLIST);
         let tries: Vec<Try> = short
             .par_iter()
             .map(|&e| try_probe(data, terms, e, &base))

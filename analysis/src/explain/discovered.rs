@@ -4,11 +4,12 @@
 
 use super::data::Data;
 use super::discover::{Discovery, channel_of, local_axis, name};
-use super::output::{Finding, ParamOut, Term};
+use super::output::{Finding, Term};
 use super::probe::Form;
 use super::{locate, model::Terms, model::rms};
 use crate::fit::joint::{CHANNELS, Fit};
 use crate::recording::Manifest;
+use crate::results::Parameter;
 use std::collections::BTreeMap;
 
 /// The finding of discovery `d`, its coefficients from `last` (the final model fitted on
@@ -41,7 +42,7 @@ pub(crate) fn finding(
         let unit = form.unit(probe.sensor).to_string();
         parameters.insert(
             format!("k_{}", CHANNELS[c]),
-            ParamOut::Estimate {
+            Parameter::Estimate {
                 value,
                 u,
                 unit: unit.clone(),
@@ -60,7 +61,7 @@ pub(crate) fn finding(
         (Form::Decay { .. }, Some(r)) => {
             parameters.insert(
                 "tau_s".into(),
-                ParamOut::Estimate {
+                Parameter::Estimate {
                     value: r.tau_s,
                     u: r.u_s,
                     unit: "s".into(),
@@ -78,7 +79,7 @@ pub(crate) fn finding(
             let (before, after) = gap(m, data, at);
             parameters.insert(
                 "at_s".into(),
-                ParamOut::Estimate {
+                Parameter::Estimate {
                     value: at,
                     u: (after - before) / 12f64.sqrt(),
                     unit: "s".into(),

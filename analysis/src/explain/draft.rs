@@ -3,7 +3,8 @@
 //! unchanged and tries it like any user effect, so the engineer confirms the discovery on
 //! this recording or the next one, renames it and adopts it.
 
-use super::output::{Finding, ParamOut};
+use super::output::Finding;
+use crate::results::Parameter;
 
 /// The draft file's name for a finding.
 pub fn file_name(f: &Finding) -> String {
@@ -34,7 +35,7 @@ pub fn effect_file(f: &Finding, recording: &str) -> Option<String> {
         f.evidence.holdout_rms_after.gyro_dps,
     ));
     for (name, p) in &f.parameters {
-        if let ParamOut::Estimate { value, u, unit } = p {
+        if let Parameter::Estimate { value, u, unit } = p {
             out.push_str(&format!("#   {name} = {value:.6} +- {u:.6} {unit}\n"));
         }
     }

@@ -7,6 +7,12 @@
 //! wandering bias) and confirmed on segments held out of every fit. Candidates are the
 //! registry's effects and the user effects of `*.effect` files ([`user`]); with a
 //! procedure, [`adoption`] writes the diff that declares the findings in its fits.
+//!
+//! The modules stand in layers, each using only those below it, so that each can be read
+//! (and changed) without the ones above: [`stats`] (pure statistics), [`probe`] and the
+//! Earth's rate candidate ([`earth::candidate`]) at the bottom; [`data`] (the
+//! accumulation) over them; [`model`] over `data`; [`select`] and [`earth`] over `model`;
+//! discovery, location, timing and the output over those.
 
 // Numeric loops index the six channels of several arrays at once.
 #![allow(clippy::needless_range_loop)]
@@ -23,6 +29,7 @@ mod output;
 mod plausible;
 mod probe;
 mod select;
+mod stats;
 mod text;
 mod timing;
 mod unexplained;
@@ -30,11 +37,13 @@ mod unexplained;
 pub(crate) use timing::TIMING;
 pub mod user;
 
+/// A finding's parameters are the results' own parameter type.
+pub use crate::results::Parameter;
 pub use adopt::{AdoptTarget, Adoption, adoption, next_version};
 pub use model::NominalModel;
 pub use output::{
-    Evidence, Explanation, FORMAT, Final, Finding, Located, Nominal, ParamOut, RefusedOut, Rms,
-    SegmentRms, Signature, Term, Unexplained, UserEffectOut,
+    Evidence, Explanation, FORMAT, Final, Finding, Located, Nominal, RefusedOut, Rms, SegmentRms,
+    Signature, Term, Unexplained, UserEffectOut,
 };
 pub use text::render_text;
 pub use user::UserEffect;
@@ -345,16 +354,11 @@ fn finding(
     for g in lay.columns_of(step.effect) {
         let p = lay.param(g);
         let out = if unobservable.contains(&g) || !last.estimated.contains(&g) {
-            ParamOut::Unobservable {
-                observable: false,
-                needs: p.needs.to_string(),
-            }
+            // Always with the motion it needs, even an empty one: explain's JSON always
+            // carries `needs` (docs/explain.md).
+            Parameter::needs(p.needs)
         } else {
-            ParamOut::Estimate {
-                value: last.theta[g],
-                u: last.u(g),
-                unit: p.unit.to_string(),
-            }
+            Parameter::estimate(last.theta[g], last.u(g), p.unit)
         };
         parameters.insert(p.name.to_string(), out);
     }

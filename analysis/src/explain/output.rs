@@ -1,5 +1,6 @@
 //! What explain reports: the `ratecal-explain/1` JSON (docs/explain.md), and its text form.
 
+use crate::results::Parameter;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -65,28 +66,6 @@ pub struct SegmentRms {
     pub held_out: bool,
 }
 
-/// One parameter: an estimate, or what the motion lacked.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
-pub enum ParamOut {
-    /// Estimated.
-    Estimate {
-        /// Value in the catalogue's unit.
-        value: f64,
-        /// Standard uncertainty.
-        u: f64,
-        /// Unit.
-        unit: String,
-    },
-    /// Not determined by this recording.
-    Unobservable {
-        /// Always false.
-        observable: bool,
-        /// The motion that would determine it.
-        needs: String,
-    },
-}
-
 /// Why explain believes a finding.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Evidence {
@@ -115,8 +94,8 @@ pub struct Finding {
     pub explanation: String,
     /// Where it shows.
     pub located: Vec<Located>,
-    /// Its parameters.
-    pub parameters: BTreeMap<String, ParamOut>,
+    /// Its parameters; an unobservable one always says what motion it needs.
+    pub parameters: BTreeMap<String, Parameter>,
     /// The statistics.
     pub evidence: Evidence,
     /// RMS over every segment once this effect (and those before it) is modelled.

@@ -2,12 +2,15 @@
 //! candidate is added to the whole model, which is refitted; the most significant one
 //! (Wald test with the honest covariance) is kept when it passes the threshold and lowers
 //! the residual on the held-out segments. Selection stops when none does.
+//!
+//! Here too is the screen that ranks the probe library beside a model ([`screen`]): it
+//! fits models, so it sits above the probes and the accumulation rather than with them.
 
 use super::data::Data;
-use super::model::{Terms, fit};
+use super::model::{Terms, fit, fit_with, misfit};
+use super::stats::{p_value, score, wald};
 use crate::fit::joint::Fit;
-use nalgebra::DMatrix;
-use statrs::distribution::{ChiSquared, ContinuousCDF};
+use ratecal_physics::effects::Sensor;
 
 /// One accepted step.
 pub(crate) struct Step {
@@ -33,66 +36,11 @@ pub(crate) struct Step {
 /// degrees of freedom, p-value, held-out misfit.
 type Tried = (usize, Fit, Vec<usize>, f64, usize, f64, f64);
 
-/// Wald statistic of the estimated columns of an effect, with its degrees of freedom.
-pub(crate) fn wald(fit: &Fit, cols: &[usize]) -> (f64, usize) {
-    let est: Vec<usize> = cols
-        .iter()
-        .copied()
-        .filter(|g| fit.estimated.contains(g))
-        .collect();
-    let k = est.len();
-    if k == 0 {
-        return (0.0, 0);
-    }
-    let cov = DMatrix::from_fn(k, k, |i, j| fit.cov[(est[i], est[j])]);
-    let th = nalgebra::DVector::from_fn(k, |i, _| fit.theta[est[i]]);
-    // A non-finite covariance or value says nothing (and nalgebra's SVD of a non-finite
-    // matrix never converges).
-    if cov.iter().chain(th.iter()).any(|v| !v.is_finite()) {
-        return (0.0, 0);
-    }
-    // Pseudo-inverse by the symmetric eigen-decomposition, with a bounded number of
-    // sweeps (nalgebra's `pseudo_inverse` runs an SVD with no bound, which on an
-    // ill-conditioned matrix can run forever): a direction the covariance cannot resolve
-    // adds nothing.
-    let tol = 1e-12 * cov.norm();
-    let Some(eig) = nalgebra::SymmetricEigen::try_new(cov, f64::EPSILON, EIGEN_SWEEPS) else {
-        return (0.0, 0);
-    };
-    let proj = eig.eigenvectors.transpose() * &th;
-    let chi2 = proj
-        .iter()
-        .zip(eig.eigenvalues.iter())
-        .filter(|(_, l)| **l > tol)
-        .map(|(p, l)| p * p / l)
-        .sum();
-    (chi2, k)
-}
-
-/// Iterations allowed to an eigen-decomposition before it is given up as not converging.
-const EIGEN_SWEEPS: usize = 10_000;
-
-/// Upper-tail probability of a chi-square statistic.
-pub(crate) fn p_value(chi2: f64, dof: usize) -> f64 {
-    if dof == 0 {
-        return 1.0;
-    }
-    ChiSquared::new(dof as f64).map_or(1.0, |d| d.sf(chi2))
-}
-
-/// The drop of the Bayesian information criterion an effect brings: its statistic less
-/// `ln(n)` per parameter. Among significant candidates the one that explains most per
-/// parameter wins, so a general term (nine g-sensitivities) does not take the place of
-/// the physics it contains (the Earth's rate, two parameters).
-pub(crate) fn score(chi2: f64, dof: usize, n: usize) -> f64 {
-    chi2 - dof as f64 * (n.max(2) as f64).ln()
-}
-
 /// Held-out misfit in units of each channel's noise under `base`.
 pub(crate) fn holdout_score(data: &Data, fit: &Fit, base: &Fit) -> f64 {
     (0..6)
         .filter(|&c| base.noise[c].sigma > 0.0)
-        .map(|c| super::model::misfit(data, fit, c, &data.held, base.noise[c].sigma))
+        .map(|c| misfit(data, fit, c, &data.held, base.noise[c].sigma))
         .sum()
 }
 
@@ -134,12 +82,44 @@ struct ProbeTry {
     score: f64,
 }
 
+/// Probes most worth a full test beside `terms` over `segs`: each probe not in `terms`
+/// fitted with a white-noise covariance (cheap), its Wald statistic per sensor, the `keep`
+/// strongest of each sensor kept, strongest first.
+pub(crate) fn screen(data: &Data, terms: &Terms, segs: &[usize], keep: usize) -> Vec<usize> {
+    use rayon::prelude::*;
+    let lay = &data.layout;
+    let mut scored: Vec<(usize, Sensor, f64)> = data
+        .probes
+        .par_iter()
+        .filter(|(e, _)| !terms.effects.contains(e))
+        .map(|&(e, p)| {
+            let mut t = terms.clone();
+            t.effects.push(e);
+            let (f, _) = fit_with(data, &t, segs, segs, true);
+            let cols: Vec<usize> = lay.columns_of(e).collect();
+            (e, p.sensor, wald(&f, &cols).0)
+        })
+        .collect();
+    scored.sort_by(|a, b| b.2.total_cmp(&a.2));
+    let mut out = Vec::new();
+    for sensor in [Sensor::Accel, Sensor::Gyro] {
+        out.extend(
+            scored
+                .iter()
+                .filter(|s| s.1 == sensor)
+                .take(keep)
+                .map(|s| s.0),
+        );
+    }
+    out
+}
+
 /// Every probe added alone to `terms`, most explaining first.
 fn try_probes(data: &Data, terms: &Terms, work: &[usize], n: usize) -> Vec<ProbeTry> {
     use rayon::prelude::*;
     let lay = &data.layout;
     // A white-noise screen first: only the strongest probes get the honest covariance.
-    let short = super::probe::screen(data, terms, work, 4);
+    let short = screen(data, terms, work, 4);
     let mut out: Vec<ProbeTry> = short
         .par_iter()
         .map(|&e| {

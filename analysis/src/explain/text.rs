@@ -1,7 +1,8 @@
 //! The text form of an explanation, for the terminal.
 
-use super::output::{Explanation, ParamOut, Rms};
+use super::output::{Explanation, Rms};
 use crate::measured::format_measured;
+use crate::results::Parameter;
 use std::fmt::Write;
 
 fn rms(r: &Rms) -> String {
@@ -85,11 +86,16 @@ pub fn render_text(x: &Explanation) -> String {
         }
         for (name, p) in &f.parameters {
             match p {
-                ParamOut::Estimate { value, u, unit } => {
+                Parameter::Estimate { value, u, unit } => {
                     let _ = writeln!(s, "   {name} = {}", format_measured(*value, *u, unit));
                 }
-                ParamOut::Unobservable { needs, .. } => {
+                Parameter::Unobservable {
+                    needs: Some(needs), ..
+                } => {
                     let _ = writeln!(s, "   {name}: not determined ({needs} to observe it)");
+                }
+                Parameter::Unobservable { needs: None, .. } => {
+                    let _ = writeln!(s, "   {name}: not determined");
                 }
             }
         }

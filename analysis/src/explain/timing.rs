@@ -10,7 +10,7 @@
 //! plus what is left of it). The nominal model's figures stay the first pass's: the model
 //! as given, without the timing.
 
-use super::{Explanation, Finding, NominalModel, Options, ParamOut, accumulate, explain_fitted};
+use super::{Explanation, Finding, NominalModel, Options, Parameter, accumulate, explain_fitted};
 use crate::fit::{Retime, Source};
 
 /// The registry's timing terms, in the order of [`Retime::registry`]: `time_offset.tau_ms`
@@ -28,10 +28,7 @@ fn param(id: &str) -> &'static str {
 /// A finding's estimate of its timing parameter, if it has one.
 fn value(x: &Explanation, id: &str) -> Option<(f64, f64)> {
     let f = x.findings.iter().find(|f| f.effect == id)?;
-    match f.parameters.get(param(id))? {
-        ParamOut::Estimate { value, u, .. } => Some((*value, *u)),
-        ParamOut::Unobservable { .. } => None,
-    }
+    f.parameters.get(param(id))?.value_u()
 }
 
 /// The timing terms `x` found, added to `held`, their findings kept in `found`.
@@ -81,7 +78,7 @@ pub(super) fn exact<S: Source>(
             held[k] = Some(base + d);
             // The finding's value: the held timing plus what is left of it.
             if let Some(f) = found.iter_mut().find(|f| f.effect == id)
-                && let Some(ParamOut::Estimate { value, u: fu, .. }) =
+                && let Some(Parameter::Estimate { value, u: fu, .. }) =
                     f.parameters.get_mut(param(id))
             {
                 (*value, *fu) = (base + d, u);

@@ -12,7 +12,7 @@
 use super::data::Data;
 use super::model::{Terms, fit, misfit};
 use super::output::{Signature, Unexplained};
-use super::select::p_value;
+use super::stats::p_value;
 use crate::fit::joint::{CHANNELS, Fit, seg_rss};
 use crate::recording::Manifest;
 use ratecal_physics::effects::Sensor;
@@ -50,7 +50,7 @@ pub(crate) fn leftover(
     let all: Vec<usize> = (0..data.accs.len()).collect();
     // Screened with white noise alone; the strongest of each sensor get the honest
     // covariance. The correction still counts every probe's every column.
-    let short = super::probe::screen(data, terms, &all, SCREEN);
+    let short = super::select::screen(data, terms, &all, SCREEN);
     let fits: Vec<Fit> = short
         .par_iter()
         .map(|&e| {

@@ -1,7 +1,7 @@
 //! What explain tests check of an explanation: the effects found, and a finding's
 //! parameters against the truth.
 
-use ratecal_analysis::explain::{Explanation, ParamOut};
+use ratecal_analysis::explain::{Explanation, Parameter};
 
 /// The effects found, sorted.
 pub fn found(x: &Explanation) -> Vec<&str> {
@@ -21,7 +21,7 @@ pub fn within(x: &Explanation, effect: &str, truth: &[(&str, f64)], k: f64) {
         .find(|f| f.effect == effect)
         .unwrap_or_else(|| panic!("{effect} not found: {:?}", found(x)));
     for (name, p) in &f.parameters {
-        if let ParamOut::Estimate { value, u, .. } = p {
+        if let Parameter::Estimate { value, u, .. } = p {
             let want = truth.iter().find(|t| t.0 == name).map_or(0.0, |t| t.1);
             assert!(
                 (value - want).abs() <= k * u + 1e-3 * want.abs(),
