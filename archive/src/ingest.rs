@@ -2,10 +2,11 @@
 //! index facts (from manifest.yaml and, when present, results.json).
 
 use crate::{ArchiveError, Result};
+use ratecal_folder::RunFolder;
 use ratecal_folder::hashes::sha256_hex;
-use ratecal_folder::names::{MANIFEST, RESULTS};
+use ratecal_folder::names::MANIFEST;
 use ratecal_folder::seal::is_scratch;
-use ratecal_recording::{FileState, Manifest, hash_folder, parse_manifest, regular};
+use ratecal_recording::{FileState, Manifest, hash_folder, parse_manifest};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -96,9 +97,9 @@ pub fn read(dir: &Path) -> Result<Folder> {
         path: dir.to_path_buf(),
         why,
     };
-    let manifest_path = dir.join(MANIFEST);
-    let text = regular(&manifest_path)
-        .and_then(|()| std::fs::read_to_string(&manifest_path))
+    let run = RunFolder::new(dir);
+    let text = run
+        .read(MANIFEST)
         .map_err(|e| not_run(format!("manifest.yaml: {e}")))?;
     // The one manifest rule every command reads by (spec/recording-format.md).
     let manifest: Manifest = parse_manifest(MANIFEST, &text)
@@ -106,9 +107,7 @@ pub fn read(dir: &Path) -> Result<Folder> {
     let mut files = Vec::new();
     walk(dir, &mut files)?;
     files.sort();
-    let results = std::fs::read(dir.join(RESULTS))
-        .ok()
-        .and_then(|b| serde_json::from_slice::<Value>(&b).ok());
+    let results = run.results::<Value>().ok();
     let mut facts = facts(&manifest, results.as_ref());
     facts.id = content_id(&files);
     Ok(Folder {

@@ -100,10 +100,18 @@ impl<'a> RunFolder<'a> {
         self.dir.join(name)
     }
 
+    /// The text of its file `name`, read only when it is a regular file (symlinks followed):
+    /// a FIFO in its place would block, a device never end.
+    pub fn read(&self, name: &str) -> std::io::Result<String> {
+        let path = self.path(name);
+        ratecal_recording::regular(&path)?;
+        std::fs::read_to_string(path)
+    }
+
     /// The text of its file `name`; `help` says what to do when it cannot be read.
     pub fn text(&self, name: &str, help: &str) -> Result<String, ReadError> {
-        let path = self.path(name);
-        std::fs::read_to_string(&path).map_err(|e| ReadError::io(&path, e, help))
+        self.read(name)
+            .map_err(|e| ReadError::io(&self.path(name), e, help))
     }
 
     /// `results.json`, parsed as `T` (the typed results or plain JSON).
@@ -134,20 +142,20 @@ impl<'a> RunFolder<'a> {
 
     /// The manifest when there is one that parses; `None` otherwise (never an error).
     pub fn manifest_quiet(&self) -> Option<Manifest> {
-        let text = std::fs::read_to_string(self.path(MANIFEST)).ok()?;
+        let text = self.read(MANIFEST).ok()?;
         parse_manifest(MANIFEST, &text).ok()
     }
 
     /// The checked plan the run saved beside its results, if any (and it parses).
     pub fn plan(&self) -> Option<Plan> {
-        let text = std::fs::read_to_string(self.path(PLAN)).ok()?;
+        let text = self.read(PLAN).ok()?;
         serde_json::from_str(&text).ok()
     }
 
     /// `plan.json` when present; an error located in it when it does not parse.
     pub fn plan_checked(&self) -> Result<Option<Plan>, ReadError> {
         let path = self.path(PLAN);
-        match std::fs::read_to_string(&path) {
+        match self.read(PLAN) {
             Ok(text) => serde_json::from_str(&text).map(Some).map_err(|e| {
                 ReadError::json(&path, &text, &e, "plan.json is written by `ratecal run`")
             }),
@@ -163,13 +171,13 @@ impl<'a> RunFolder<'a> {
 
     /// The seal when the folder holds one that parses.
     pub fn seal(&self) -> Option<Seal> {
-        let text = std::fs::read_to_string(self.path(SEAL_FILE)).ok()?;
+        let text = self.read(SEAL_FILE).ok()?;
         serde_json::from_str(&text).ok()
     }
 
     /// What `ratecal explain` kept beside the run, if it parses.
     pub fn explain(&self) -> Option<serde_json::Value> {
-        let text = std::fs::read_to_string(self.path(EXPLAIN)).ok()?;
+        let text = self.read(EXPLAIN).ok()?;
         serde_json::from_str(&text).ok()
     }
 

@@ -7,6 +7,7 @@ use miette::{Diagnostic, NamedSource, SourceSpan};
 use ratecal_analysis::explain::Rms;
 use ratecal_analysis::twin::{Change, Twin};
 use ratecal_drivers::station::{self, SetValue, Station};
+use ratecal_folder::RunFolder;
 use ratecal_folder::names::STATION;
 use ratecal_recording::Manifest;
 use std::path::{Path, PathBuf};
@@ -44,12 +45,12 @@ pub struct Contradiction {
 /// Reads the twin: a station file, or a run folder's `station.yaml`. Prints the located
 /// error on failure.
 pub(crate) fn read(arg: &Path) -> Result<TwinFile, ()> {
-    let path = if arg.is_dir() {
-        arg.join(STATION)
+    let (path, text) = if arg.is_dir() {
+        (arg.join(STATION), RunFolder::new(arg).read(STATION))
     } else {
-        arg.to_path_buf()
+        (arg.to_path_buf(), std::fs::read_to_string(arg))
     };
-    let text = std::fs::read_to_string(&path).map_err(|e| {
+    let text = text.map_err(|e| {
         errln!("error: cannot read the twin {}: {e}", path.display());
     })?;
     let mut station = Station::from_yaml(&text, &path.display().to_string()).map_err(|e| {
