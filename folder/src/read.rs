@@ -90,11 +90,6 @@ impl<'a> RunFolder<'a> {
         RunFolder { dir }
     }
 
-    /// The folder.
-    pub fn dir(&self) -> &'a Path {
-        self.dir
-    }
-
     /// The path of its file `name`.
     pub fn path(&self, name: &str) -> PathBuf {
         self.dir.join(name)

@@ -2,9 +2,9 @@
 //! rename, so a crash at any moment leaves one of these, and `run --resume` knows what to do
 //! with each.
 
-use crate::names::{MANIFEST, SEAL_FILE, SEAL_HASH_FILE};
+use crate::names::{SEAL_FILE, SEAL_HASH_FILE};
+use crate::read::RunFolder;
 use ratecal_recording::commit::pending_intent;
-use ratecal_recording::parse_manifest;
 use std::path::Path;
 
 /// A run folder's state.
@@ -45,9 +45,8 @@ pub fn state_of(dir: &Path) -> State {
     if pending_intent(dir).is_some() {
         return State::Committing;
     }
-    let status = std::fs::read_to_string(dir.join(MANIFEST))
-        .ok()
-        .and_then(|t| parse_manifest(MANIFEST, &t).ok())
+    let status = RunFolder::new(dir)
+        .manifest_quiet()
         .and_then(|m| m.run.map(|r| r.status));
     // A seal's hash without the seal: the seal was removed (a commit that removes or adds
     // both is in the committing state until done), which `verify` calls altered.

@@ -5,6 +5,7 @@
 use crate::hashes::VerifyReport;
 use crate::names::{IMU, JOURNAL, MANIFEST, TABLE};
 use crate::names::{SEAL_FILE, SEAL_HASH_FILE};
+use crate::read::RunFolder;
 use crate::seal::verify_hashes;
 use crate::state::{State, state_of};
 use ed25519_dalek::VerifyingKey;
@@ -53,9 +54,8 @@ pub fn verify_folder(
 pub fn require_intact(dir: &Path, command: &str) -> Result<(), miette::Report> {
     let sealed = std::fs::symlink_metadata(dir.join(SEAL_FILE)).is_ok();
     if !sealed {
-        let ratecal_run = std::fs::read_to_string(dir.join(MANIFEST))
-            .ok()
-            .and_then(|t| ratecal_recording::parse_manifest(MANIFEST, &t).ok())
+        let ratecal_run = RunFolder::new(dir)
+            .manifest_quiet()
             .is_some_and(|m| m.run.is_some());
         if !ratecal_run {
             return Ok(());

@@ -168,13 +168,23 @@ fn explain_or_exit(args: &Request) -> Result<u8, Exit> {
         }
     }
     if let Some(dir) = &args.plots {
-        write_beside(dir, &figures, in_run && same_dir(dir, &args.run), "figure")?;
+        write_beside(
+            dir,
+            &figures,
+            in_run && same_dir(dir, &args.run),
+            ("figure", "the figures"),
+        )?;
     }
     if let Some(dir) = &args.draft_effects
         && !(in_run && same_dir(dir, &args.run))
         && !drafts.is_empty()
     {
-        write_beside(dir, &drafts, false, "draft effect")?;
+        write_beside(
+            dir,
+            &drafts,
+            false,
+            ("draft effect", "the draft effect files"),
+        )?;
     }
     let out = match args.format {
         Format::Json => json + "\n",
@@ -390,24 +400,21 @@ fn figures(
         .collect()
 }
 
-/// Writes `files` into `dir` (unless it is the run folder, which has them) and names each.
+/// Writes `files` into `dir` (unless `same`: it is the run folder, which has them) and
+/// names each; `what` is one file and all of them, in words.
 fn write_beside(
     dir: &Path,
     files: &[(String, String)],
     same: bool,
-    what: &str,
+    what: (&str, &str),
 ) -> Result<(), Exit> {
+    let (one, all) = what;
     if !same && let Err(e) = write(dir, files, false) {
-        let kind = if what == "figure" {
-            "the figures"
-        } else {
-            "the draft effect files"
-        };
-        errln!("error: cannot write {kind} into {}: {e}", dir.display());
+        errln!("error: cannot write {all} into {}: {e}", dir.display());
         return Err(2);
     }
     for (name, _) in files {
-        errln!("{what}: {}", dir.join(name).display());
+        errln!("{one}: {}", dir.join(name).display());
     }
     Ok(())
 }

@@ -6,6 +6,7 @@ use ed25519_dalek::SigningKey;
 use miette::Report;
 use ratecal_analysis::measured::{format_measured, format_value};
 use ratecal_analysis::results::RunVerdict;
+use ratecal_folder::RunFolder;
 use ratecal_folder::names::{JOURNAL, MANIFEST, PLAN, RESULTS, SEAL_FILE};
 use ratecal_plan::Plan;
 use ratecal_recording::{manifest_yaml, parse_manifest, rfc3339};
@@ -154,8 +155,7 @@ impl End<'_> {
 
 /// The failed write the manifest records, if any.
 fn write_failure(dir: &Path) -> Option<ratecal_recording::WriteFailure> {
-    let text = std::fs::read_to_string(dir.join(MANIFEST)).ok()?;
-    parse_manifest(MANIFEST, &text).ok()?.run?.write_failure
+    RunFolder::new(dir).manifest_quiet()?.run?.write_failure
 }
 
 /// A run that ended but was never sealed (a crash after its manifest said so), finished by
