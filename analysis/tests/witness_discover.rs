@@ -70,8 +70,9 @@ fn term(x: &Explanation, channel: &str, form: &str, what: &str) -> (f64, f64) {
                 .flat_map(|f| f.terms.iter().map(|t| (&t.channel, &t.expression)))
                 .collect();
             panic!(
-                "{what}: no `{form}` on {channel}; discovered {all:?}; unexplained {:?}",
-                x.unexplained
+                "{what}: no `{form}` on {channel}; discovered {all:?}; unexplained {:?}; \
+                 refused {:?}; not observable {:?}",
+                x.unexplained, x.refused, x.not_observable
             )
         })
 }

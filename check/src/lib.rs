@@ -18,6 +18,7 @@ mod accept;
 mod header;
 mod motion;
 mod observe;
+mod registry;
 mod segments;
 mod steps;
 mod values;
@@ -29,6 +30,7 @@ use ratecal_plan::{Plan, Step};
 use std::collections::{BTreeMap, HashMap};
 use values::RVal;
 
+pub use registry::EffectObservability;
 pub use steps::{DEFAULT_MAX_ACCEL_DPS2, DEFAULT_MAX_RATE_DPS};
 
 /// Largest number of actions a nest of `for` loops may expand to.
@@ -79,6 +81,9 @@ pub struct Checked {
     pub plan: Plan,
     /// Warnings (the procedure is accepted).
     pub warnings: Vec<Diagnostic>,
+    /// What the procedure's motion lets explain determine of each registry effect that
+    /// is not part of the nominal model.
+    pub observability: Vec<EffectObservability>,
 }
 
 /// Parses and checks a procedure text; `name` is how diagnostics name the file.
@@ -103,12 +108,14 @@ pub fn check(
 ) -> Result<Checked, Vec<Diagnostic>> {
     let mut ck = Ck::new(src.clone(), sources, opts);
     let plan = ck.file(file);
+    let observability = ck.registry_observability(&ck.walk.segments);
     let mut diags = std::mem::take(&mut ck.diags);
     dedup(&mut diags);
     match plan {
         Some(plan) if !diags.iter().any(Diagnostic::is_error) => Ok(Checked {
             plan,
             warnings: diags,
+            observability,
         }),
         _ => {
             if !diags.iter().any(Diagnostic::is_error) {

@@ -38,6 +38,41 @@ pub fn human_duration(s: f64) -> String {
     }
 }
 
+/// What explain could determine on a recording of this procedure: the registry effects
+/// its motion determines in full, in part, and not at all (docs/explain.md).
+fn observability_lines(obs: &[ratecal_check::EffectObservability]) -> Vec<String> {
+    let list = |v: Vec<String>| {
+        if v.is_empty() {
+            "none".to_string()
+        } else {
+            v.join(", ")
+        }
+    };
+    let full: Vec<String> = obs
+        .iter()
+        .filter(|o| o.not.is_empty())
+        .map(|o| o.effect.to_string())
+        .collect();
+    let part: Vec<String> = obs
+        .iter()
+        .filter(|o| !o.not.is_empty() && !o.determined.is_empty())
+        .map(|o| {
+            let missing: Vec<&str> = o.not.iter().map(|n| n.0).collect();
+            format!("{} (not {})", o.effect, missing.join(" "))
+        })
+        .collect();
+    let none: Vec<String> = obs
+        .iter()
+        .filter(|o| o.determined.is_empty())
+        .map(|o| o.effect.to_string())
+        .collect();
+    vec![
+        format!("  explain can determine: {}", list(full)),
+        format!("  in part: {}", list(part)),
+        format!("  not at all: {}", list(none)),
+    ]
+}
+
 /// Runs the subcommand.
 pub fn main(args: Args) -> ExitCode {
     let mut opts = CheckOptions::default();
@@ -94,10 +129,13 @@ pub fn main(args: Args) -> ExitCode {
                     p.version,
                     human_duration(p.estimated_duration_s)
                 );
+                let observes = observability_lines(&checked.observability);
                 if args.format == "json" {
                     errln!("{line}");
+                    observes.iter().for_each(|l| errln!("{l}"));
                 } else {
                     outln!("{line}");
+                    observes.iter().for_each(|l| outln!("{l}"));
                 }
                 plans.push(checked.plan);
             }

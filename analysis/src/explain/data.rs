@@ -31,6 +31,28 @@ pub(crate) struct Data {
     /// The timing error the signals were evaluated with: the timing columns
     /// (`time_offset`, `clock_rate`) measure what is left about it.
     pub retime: Retime,
+    /// Static segments left out because their attitude is unknown (`up: oblique`): ids.
+    pub left_out: Vec<String>,
+    /// Whether the table stream is a table's feedback (not synthesized from declared
+    /// attitudes by an import with `table: none`): table-side effects need it.
+    pub table_feedback: bool,
+}
+
+/// Whether a segment's attitude is unknown to the recording: a pose of a multi-position
+/// session that no body axis is near vertical in (`up: oblique`). Its specific force is
+/// not the table stream's, so no fit may use it as such.
+fn attitude_unknown(s: &crate::recording::Segment) -> bool {
+    s.up.as_deref() == Some("oblique")
+}
+
+/// Whether the manifest's table stream is a table's feedback: `ratecal import` names a
+/// synthesized one `none: ...` (docs/import.md).
+pub(crate) fn has_table_feedback(m: &crate::recording::Manifest) -> bool {
+    !m.station
+        .table
+        .model
+        .as_deref()
+        .is_some_and(|t| t.starts_with("none"))
 }
 
 /// Merged factors by (accelerometer segments, gyro segments).
@@ -63,7 +85,9 @@ impl Data {
         candidates.push(earth);
         effects.push(&EARTH_HELD);
         let t1 = segs.iter().map(|s| s.t_end).fold(t0, f64::max);
-        let sampled = probe::sampled(t0, t1 - t0);
+        let m = src.manifest();
+        let grade = super::plausible::grade_scale(m.imu.get("grade").map(String::as_str));
+        let sampled = probe::sampled(t0, t1 - t0, grade);
         let mut probes: Vec<(usize, &'static Probe)> = Vec::new();
         for p in sampled {
             probes.push((effects.len(), p));
@@ -71,12 +95,18 @@ impl Data {
         }
         let mut layout = Layout::new(effects);
         let mut accs = crate::fit::accumulate_all(src, &layout, retime)?;
+        let left_out: Vec<String> = accs
+            .iter()
+            .filter(|a| attitude_unknown(&segs[a.seg]))
+            .map(|a| segs[a.seg].id.clone())
+            .collect();
+        accs.retain(|a| !attitude_unknown(&segs[a.seg]));
         let spans: Vec<(f64, f64)> = accs
             .iter()
             .map(|a| (segs[a.seg].t_start, segs[a.seg].t_end))
             .collect();
-        let g = src.manifest().station.site.gravity_mps2;
-        probes.extend(probe::add_steps(&mut layout, &mut accs, &spans, g));
+        let g = m.station.site.gravity_mps2;
+        probes.extend(probe::add_steps(&mut layout, &mut accs, &spans, g, grade));
         let longest = accs
             .iter()
             .enumerate()
@@ -108,6 +138,8 @@ impl Data {
             earth,
             merged: Default::default(),
             retime,
+            left_out,
+            table_feedback: has_table_feedback(m),
         })
     }
 

@@ -12,7 +12,7 @@
 use super::data::Data;
 use super::model::{Terms, fit, misfit};
 use super::probe::{Form, Probe};
-use super::select::Step;
+use super::select::{Refused, Step};
 use super::stats::{p_value, wald};
 use crate::fit::joint::{Fit, channel};
 use ratecal_physics::effects::Sensor;
@@ -45,13 +45,14 @@ pub(crate) struct Refined {
     pub amplitudes: Vec<(f64, f64)>,
 }
 
-/// Columns of the library that some segment excites: the number of tests the threshold
-/// corrects for.
-pub(crate) fn live_columns(data: &Data) -> usize {
+/// Columns of the library that some segment excites and the recording determines (not
+/// skipped in `terms`): the number of tests the threshold corrects for.
+pub(crate) fn live_columns(data: &Data, terms: &Terms) -> usize {
     let lay = &data.layout;
     data.probes
         .iter()
         .flat_map(|&(e, _)| lay.columns_of(e))
+        .filter(|g| !terms.skip.contains(g))
         .filter(|&g| data.excitation.iter().any(|x| x[g] > 0.0))
         .count()
         .max(1)
@@ -101,6 +102,26 @@ fn try_probe(data: &Data, terms: &Terms, e: usize, base: &Fit) -> Try {
     Try { e, cols }
 }
 
+/// Why the kept columns' fit is not physics: the first outside its plausible range.
+fn implausible(data: &Data, e: usize, f: &Fit, keep: &[usize]) -> Option<String> {
+    keep.iter().find_map(|&g| {
+        let p = data.layout.param(g);
+        let max = super::plausible::max_abs(p)?;
+        let v = f.theta[g];
+        (v.abs() > max).then(|| {
+            format!(
+                "{} = {v:.4e} {} on {} is outside what a real part shows (|value| <= {max:.4e} {})",
+                data.probe(e)
+                    .map(|q| q.expression(local_axis(data, g)))
+                    .unwrap_or_default(),
+                p.unit,
+                crate::fit::joint::CHANNELS[channel_of(data, g)],
+                p.unit
+            )
+        })
+    })
+}
+
 /// A channel cannot tell two forms apart when the misfits they leave differ by less than
 /// this (in units of the white noise): it then takes the form the strongest channel chose.
 const TIE: f64 = 10.0;
@@ -113,11 +134,16 @@ const TIE: f64 = 10.0;
 /// it on every other channel where it is significant and removes as much as that channel's best
 /// form (within [`TIE`]), so a form the data cannot tell from another on some channel is
 /// not split across two readings.
-pub(crate) fn discover(data: &Data, terms: &mut Terms, alpha: f64) -> Vec<Discovery> {
+pub(crate) fn discover(
+    data: &Data,
+    terms: &mut Terms,
+    alpha: f64,
+    refused: &mut Vec<Refused>,
+) -> Vec<Discovery> {
     use rayon::prelude::*;
     let work = data.working();
     let n: usize = work.iter().map(|&i| 6 * data.accs[i].n).sum();
-    let m = live_columns(data) as f64;
+    let m = live_columns(data, terms) as f64;
     let a = alpha / m;
     let debug = std::env::var_os("RATECAL_EXPLAIN_DEBUG").is_some();
     let mut out: Vec<Discovery> = Vec::new();
@@ -190,6 +216,15 @@ pub(crate) fn discover(data: &Data, terms: &mut Terms, alpha: f64) -> Vec<Discov
                 );
             }
             if !data.held.is_empty() && hold >= base_hold {
+                continue;
+            }
+            if let Some(why) = implausible(data, t.e, &f, &keep) {
+                if !refused.iter().any(|r: &Refused| r.reason == why) {
+                    refused.push(Refused {
+                        effect: "discovered".into(),
+                        reason: why,
+                    });
+                }
                 continue;
             }
             lead = lead.or(Some(top));

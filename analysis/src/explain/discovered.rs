@@ -55,6 +55,7 @@ pub(crate) fn finding(
             u,
             unit,
             needs: probe.form.needs().to_string(),
+            max_abs: super::plausible::max_abs(data.layout.param(g)),
         });
     }
     match (probe.form, &d.tau) {
@@ -107,6 +108,7 @@ pub(crate) fn finding(
         station_side: false,
         discovered: true,
         terms: out_terms,
+        alternative_fits: Vec::new(),
     }
 }
 

@@ -18,6 +18,9 @@
 #![allow(clippy::needless_range_loop)]
 
 mod adopt;
+mod alternatives;
+mod change;
+mod change_out;
 pub(crate) mod data;
 mod discover;
 mod discovered;
@@ -25,6 +28,7 @@ pub mod draft;
 mod earth;
 mod locate;
 pub(crate) mod model;
+mod observe;
 mod output;
 mod plausible;
 mod probe;
@@ -42,7 +46,7 @@ pub use crate::results::Parameter;
 pub use adopt::{AdoptTarget, Adoption, adoption, next_version};
 pub use model::NominalModel;
 pub use output::{
-    Evidence, Explanation, FORMAT, Final, Finding, Located, Nominal, RefusedOut, Rms, SegmentRms,
+    AlternativeFit, Evidence, NotObservable, Explanation, FORMAT, Final, Finding, Located, Nominal, RefusedOut, Rms, SegmentRms,
     Signature, Term, Unexplained, UserEffectOut,
 };
 pub use text::render_text;
@@ -157,7 +161,7 @@ pub(crate) fn explain_fitted(
         }
     }
     let index = |id: &str| lay.index(id).expect("a registry id");
-    let start = Terms {
+    let mut start = Terms {
         effects: nominal.effects.iter().map(|id| index(id)).collect(),
         fixed: nominal
             .fixed
@@ -166,6 +170,18 @@ pub(crate) fn explain_fitted(
             .collect(),
         skip: Vec::new(),
     };
+    if !data.left_out.is_empty() {
+        warnings.push(format!(
+            "{} static segments with no body axis near vertical (up: oblique) are left out: \
+             explain needs each segment's attitude ({})",
+            data.left_out.len(),
+            data.left_out.join(", ")
+        ));
+    }
+    // What this recording cannot determine is not fitted: its columns are skipped in
+    // every model grown from `start`.
+    let observed = observe::observe(data, &start);
+    start.skip.extend(observed.skip.iter().copied());
     let all: Vec<usize> = (0..data.accs.len()).collect();
     let (sa, sg) = seed_segments(m, data);
     if sa.is_empty() || sg.is_empty() {
@@ -204,7 +220,8 @@ pub(crate) fn explain_fitted(
     let mut held = earth::hold(data, &mut terms, latitude);
     // What the registry left: forms of the probe library, found one at a time.
     let registry_terms = terms.clone();
-    let mut discoveries = discover::discover(data, &mut terms, opts.alpha);
+    let mut lib_refused = Vec::new();
+    let mut discoveries = discover::discover(data, &mut terms, opts.alpha, &mut lib_refused);
     if !discoveries.is_empty() {
         // The registry's selection again beside what was found: a strong unlisted form can
         // hide the Earth's rate (or a registry effect) from the held-out segments, and a
@@ -228,9 +245,15 @@ pub(crate) fn explain_fitted(
             again.effects.push(step.effect);
         }
         held = earth::hold(data, &mut again, latitude);
-        discoveries.extend(discover::discover(data, &mut again, opts.alpha));
+        discoveries.extend(discover::discover(
+            data,
+            &mut again,
+            opts.alpha,
+            &mut lib_refused,
+        ));
         terms = again;
     }
+    refused.extend(lib_refused);
     let last = fit(data, &terms, &work, &work).0;
     if debug {
         eprintln!("discovered in {:?}", clock.elapsed());
@@ -252,6 +275,7 @@ pub(crate) fn explain_fitted(
         .iter()
         .map(|step| {
             let mut f = finding(m, data, step, &terms, &whole);
+            refused.extend(alternatives::attach(data, &mut f, step.effect, &terms));
             f.defined_in = opts
                 .user
                 .iter()
@@ -270,6 +294,7 @@ pub(crate) fn explain_fitted(
             .iter()
             .map(|d| discovered::finding(m, data, d, &registry_terms, &whole.0)),
     );
+    refused.extend(change_points(m, data, &terms, &whole.0, opts.alpha, &mut findings));
     let mut unexplained = unexplained::leftover(m, data, &terms, &whole.0, opts.alpha);
     if debug {
         eprintln!("leftover tested in {:?}", clock.elapsed());
@@ -303,6 +328,7 @@ pub(crate) fn explain_fitted(
             .map(|&i| m.segments[data.accs[i].seg].id.clone())
             .collect(),
         rejected,
+        not_observable: observed.entries,
         refused: refused
             .into_iter()
             .map(|r| RefusedOut {
@@ -325,6 +351,54 @@ pub(crate) fn explain_fitted(
         warnings,
     };
     (x, timing_left)
+}
+
+/// The change points the final model `whole` leaves inside segments, as discovered
+/// findings; a library step discovered at a gap next to a change point on the same channel
+/// was that change point, put at the nearest gap, and gives way to it. Returns the change
+/// points refused as implausible.
+fn change_points(
+    m: &Manifest,
+    data: &Data,
+    terms: &Terms,
+    whole: &Fit,
+    alpha: f64,
+    findings: &mut Vec<Finding>,
+) -> Vec<select::Refused> {
+    let grade = plausible::grade_scale(m.imu.get("grade").map(String::as_str));
+    let library = discover::live_columns(data, terms);
+    let all: Vec<usize> = (0..data.accs.len()).collect();
+    let now = rms(data, whole, &all);
+    let mut refused = Vec::new();
+    for cp in change::scan(data, whole, alpha, library) {
+        let (sensor, _) = crate::fit::joint::channel(cp.channel);
+        let form = probe::Form::Step { at: cp.at_s };
+        let max = grade * probe::range::max_abs(form, sensor, 0.0);
+        match change_out::finding(m, data, &cp, alpha, max, now) {
+            Ok(f) => {
+                let seg = &m.segments[data.accs[cp.acc].seg];
+                findings.retain(|d| !gap_step_beside(d, &f.terms[0].channel, seg));
+                findings.push(f);
+            }
+            Err(reason) => refused.push(select::Refused {
+                effect: "discovered".into(),
+                reason,
+            }),
+        }
+    }
+    refused
+}
+
+/// Whether `d` is a library step on `channel` whose instant lies in a gap that borders
+/// `seg` (within the gap's own span of the segment's ends).
+fn gap_step_beside(d: &Finding, channel: &str, seg: &crate::recording::Segment) -> bool {
+    let Some(Parameter::Estimate { value: at, u, .. }) = d.parameters.get("at_s") else {
+        return false;
+    };
+    let reach = 12f64.sqrt() * u / 2.0 + 1.0;
+    d.discovered
+        && d.terms.iter().any(|t| t.channel == channel)
+        && ((at - seg.t_end).abs() <= reach || (seg.t_start - at).abs() <= reach)
 }
 
 /// How to adopt the findings (`with lever_arm, time_offset`): only the registry's effects
@@ -383,15 +457,8 @@ fn finding(
         station_side: fx.station_side(),
         discovered: false,
         terms: Vec::new(),
-        separate_by: (!step.alternatives.is_empty()).then(|| {
-            step.alternatives
-                .iter()
-                .filter_map(|&e| lay.effects[e].params().first())
-                .map(|p| p.needs)
-                .chain(fx.params().first().map(|p| p.needs))
-                .collect::<Vec<_>>()
-                .join("; ")
-        }),
+        alternative_fits: Vec::new(),
+        separate_by: None,
     }
 }
 

@@ -123,6 +123,32 @@ pub struct Finding {
     /// A discovered finding's terms, one per channel, in the user-effect language.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub terms: Vec<Term>,
+    /// Each alternative's own fit in this finding's place (the same model otherwise), so
+    /// that an engineer sees both answers; an alternative whose fit lies outside its
+    /// plausible range is in `refused` instead.
+    #[serde(default)]
+    pub alternative_fits: Vec<AlternativeFit>,
+}
+
+/// An alternative's own fit: its parameters as a finding's.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AlternativeFit {
+    /// Its id.
+    pub effect: String,
+    /// Its parameters.
+    pub parameters: BTreeMap<String, Parameter>,
+}
+
+/// A candidate this recording cannot determine, so explain did not fit it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct NotObservable {
+    /// The registry or user effect's id (`effect.parameter` when only some of its
+    /// parameters fail), or a library form (`form_accel_fy_fz`, `.ax` for one channel).
+    pub candidate: String,
+    /// Why, in words.
+    pub reason: String,
+    /// The motion that would determine it.
+    pub observed_by: String,
 }
 
 /// One term of a discovered finding: `channel += value * expression`.
@@ -140,6 +166,9 @@ pub struct Term {
     pub unit: String,
     /// The motion that excites it.
     pub needs: String,
+    /// Its plausible range for the IMU's grade (`|value| <= max_abs`, docs/effects.md).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_abs: Option<f64>,
 }
 
 /// One form a leftover follows.
@@ -227,6 +256,9 @@ pub struct Explanation {
     pub held_out: Vec<String>,
     /// Candidates tried and not reported, with their last p-value.
     pub rejected: BTreeMap<String, f64>,
+    /// Candidates this recording cannot determine: not fitted (always present).
+    #[serde(default)]
+    pub not_observable: Vec<NotObservable>,
     /// Significant candidates not reported: outside the plausible range, or a form
     /// outside the registry explains their residual better.
     #[serde(default)]

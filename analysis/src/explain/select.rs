@@ -91,7 +91,7 @@ pub(crate) fn screen(data: &Data, terms: &Terms, segs: &[usize], keep: usize) ->
     let mut scored: Vec<(usize, Sensor, f64)> = data
         .probes
         .par_iter()
-        .filter(|(e, _)| !terms.effects.contains(e))
+        .filter(|(e, _)| !terms.effects.contains(e) && !terms.skips_all(lay, *e))
         .map(|&(e, p)| {
             let mut t = terms.clone();
             t.effects.push(e);
@@ -251,6 +251,7 @@ pub(crate) fn forward(data: &Data, start: &Terms, alpha: f64, without: &[String]
         .filter(|e| {
             !without.iter().any(|w| w == lay.effects[*e].id())
                 && !terms.effects.contains(e)
+                && !terms.skips_all(lay, *e)
                 && !terms
                     .fixed
                     .iter()

@@ -205,6 +205,25 @@ impl Form {
         }
     }
 
+    /// A short name of the form on every axis of its sensor (`f2` for `f_i^2`, `fx_fz` for a
+    /// product, `step_42s`): a candidate's name in `not_observable`.
+    pub(crate) fn family(self) -> String {
+        match self {
+            Form::ForceSquare => "f2".into(),
+            Form::ForceProduct(j, k) => format!("f{}_f{}", AXES[j], AXES[k]),
+            Form::ForceAbs => "abs_f".into(),
+            Form::ForceCube => "f3".into(),
+            Form::ForceRateSquare => "f_w2".into(),
+            Form::RateAbs => "abs_w".into(),
+            Form::RateSquare => "w2".into(),
+            Form::RateCube => "w3".into(),
+            Form::ScaleDrift { .. } => "scale_drift".into(),
+            Form::ThermalScale => "scale_dtemp".into(),
+            // Functions of time alone: the same on every axis.
+            _ => self.slug(Sensor::Accel, 0),
+        }
+    }
+
     /// The motion that excites a term of this form (a draft effect file's `needs`).
     pub(crate) fn needs(self) -> &'static str {
         match self {

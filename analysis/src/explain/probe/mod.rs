@@ -13,6 +13,7 @@
 //!   candidate instant without a second pass over the samples ([`add_steps`]).
 
 mod form;
+pub(crate) mod range;
 
 pub(crate) use form::{AXES, Form};
 
@@ -29,7 +30,8 @@ pub(crate) struct Probe {
 }
 
 impl Probe {
-    fn new(sensor: Sensor, form: Form) -> &'static Probe {
+    /// The probe of `form` on `sensor`, its plausible range `max_abs` (the form's unit).
+    fn new(sensor: Sensor, form: Form, max_abs: f64) -> &'static Probe {
         let id: &'static str = Box::leak(
             format!("probe:{}:{}", sensor.name(), form.expression(sensor, 0)).into_boxed_str(),
         );
@@ -38,9 +40,8 @@ impl Probe {
                 name: AXES[i],
                 unit: form.unit(sensor),
                 channel: Some((sensor, i)),
-                needs: "",
-                // A probe is a form, not physics: no range.
-                max_abs: f64::INFINITY,
+                needs: form.needs(),
+                max_abs,
             })
             .collect();
         Box::leak(Box::new(Probe {
@@ -113,8 +114,9 @@ pub(crate) fn decay_grid(span_s: f64) -> Vec<f64> {
     out
 }
 
-/// The sampled probes for a recording that begins at `t0` and spans `span_s` seconds.
-pub(crate) fn sampled(t0: f64, span_s: f64) -> Vec<&'static Probe> {
+/// The sampled probes for a recording that begins at `t0` and spans `span_s` seconds, with
+/// their plausible ranges times `grade` (`plausible::grade_scale`).
+pub(crate) fn sampled(t0: f64, span_s: f64, grade: f64) -> Vec<&'static Probe> {
     let mut out: Vec<&'static Probe> = Vec::new();
     for sensor in [Sensor::Accel, Sensor::Gyro] {
         let mut forms = vec![
@@ -138,12 +140,18 @@ pub(crate) fn sampled(t0: f64, span_s: f64) -> Vec<&'static Probe> {
                 .into_iter()
                 .map(|tau| Form::Decay { t0, tau }),
         );
-        out.extend(forms.into_iter().map(|f| Probe::new(sensor, f)));
+        let span_h = span_s / 3600.0;
+        out.extend(
+            forms
+                .into_iter()
+                .map(|f| Probe::new(sensor, f, grade * range::max_abs(f, sensor, span_h))),
+        );
     }
     out
 }
 
-/// Adds a derived step probe per sensor (`g` the site's gravity, for its scale) at every gap between consecutive segments (its
+/// Adds a derived step probe per sensor (`g` the site's gravity, for its scale; `grade` the
+/// range's factor) at every gap between consecutive segments (its
 /// instant the middle of the gap) to the layout and every segment's factor and blocks.
 /// Returns the new effects' layout indices with their probes.
 pub(crate) fn add_steps(
@@ -151,6 +159,7 @@ pub(crate) fn add_steps(
     accs: &mut [SegAcc],
     starts: &[(f64, f64)],
     g: f64,
+    grade: f64,
 ) -> Vec<(usize, &'static Probe)> {
     let mut order: Vec<usize> = (0..accs.len()).collect();
     order.sort_by(|&a, &b| starts[a].0.total_cmp(&starts[b].0));
@@ -175,7 +184,8 @@ pub(crate) fn add_steps(
     let mut effects = layout.effects.clone();
     for &at in &instants {
         for sensor in [Sensor::Accel, Sensor::Gyro] {
-            let p = Probe::new(sensor, Form::Step { at });
+            let form = Form::Step { at };
+            let p = Probe::new(sensor, form, grade * range::max_abs(form, sensor, 0.0));
             added.push((effects.len(), p));
             effects.push(p as &dyn Effect);
         }

@@ -17,6 +17,12 @@ pub(crate) struct Terms {
 }
 
 impl Terms {
+    /// Whether every column of layout effect `e` is skipped: a candidate the recording
+    /// cannot determine, never fitted.
+    pub(crate) fn skips_all(&self, layout: &Layout, e: usize) -> bool {
+        layout.columns_of(e).all(|g| self.skip.contains(&g))
+    }
+
     /// The ids, fitted then fixed (`earth_rate (fixed)`).
     pub(crate) fn names(&self, layout: &Layout) -> Vec<String> {
         self.effects
