@@ -6,8 +6,10 @@ use std::fmt;
 use serde::Serialize;
 use serde_json::{Value, json};
 
+use crate::motion::AxesState;
 use crate::rot::{M3, V3};
-use crate::station::Instant;
+use crate::station::{Instant, Station};
+use crate::table;
 
 /// A closed form of the instant: what it adds to the accelerometer (m/s^2) and gyro (deg/s)
 /// outputs.
@@ -82,6 +84,26 @@ pub enum Hidden {
         /// `r_mm[i][j]`: j-component of `R_i`, mm.
         r_mm: M3,
     },
+    /// The table's encoders are eccentric (docs/effects.md): axis k (`[outer, inner]`)
+    /// reads `theta_enc = theta + e_k sin(theta + phi_k)`, `theta` the true angle. The table
+    /// reports `theta_enc` and servoes on it: the plan's motion is the encoders', the IMU
+    /// turns by the true `theta`. Registry `table_encoder_eccentricity` (station side),
+    /// `<axis>_sin_arcsec = e cos(phi)`, `<axis>_cos_arcsec = e sin(phi)`.
+    TableEncoderEccentricity {
+        /// `e` per axis, `[outer, inner]`, arcsec.
+        e_arcsec: [f64; 2],
+        /// `phi` per axis, `[outer, inner]`, deg.
+        phi_deg: [f64; 2],
+    },
+    /// The outer bearing wobbles: the whole gimbal tilts about the lab axis
+    /// `u = unit(a_o x up)` by `delta = w sin(2 th_o + phi)` (twice per outer revolution);
+    /// the encoders read the angles exactly. A table error in no registry.
+    TableWobble {
+        /// `w`, arcsec.
+        w_arcsec: f64,
+        /// `phi`, deg.
+        phi_deg: f64,
+    },
     /// Anything else: `(da, dw)` added to the outputs.
     Custom {
         /// Short name (the truth's `id`).
@@ -130,6 +152,17 @@ fn per_pair(m: &M3, prefix: &str, suffix: &str, diagonal: bool) -> Value {
     Value::Object(out)
 }
 
+/// The registry's linear components of `e sin(theta + phi)`:
+/// `e sin(theta) cos(phi) + e cos(theta) sin(phi)`.
+fn eccentricity_components(e: [f64; 2], phi_deg: [f64; 2]) -> Value {
+    let (so, co) = phi_deg[0].to_radians().sin_cos();
+    let (si, ci) = phi_deg[1].to_radians().sin_cos();
+    json!({
+        "outer_sin_arcsec": e[0] * co, "outer_cos_arcsec": e[0] * so,
+        "inner_sin_arcsec": e[1] * ci, "inner_cos_arcsec": e[1] * si,
+    })
+}
+
 impl Hidden {
     /// A custom effect named `name`, with `truth` for `truth.json`.
     pub fn custom(
@@ -158,6 +191,8 @@ impl Hidden {
             Hidden::GyroWarmUp { .. } => "gyro_warm_up",
             Hidden::GSensitivity { .. } => "g_sensitivity",
             Hidden::LeverArm { .. } => "lever_arm",
+            Hidden::TableEncoderEccentricity { .. } => "table_encoder_eccentricity",
+            Hidden::TableWobble { .. } => "table_wobble",
             Hidden::Custom { name, .. } => name,
         }
     }
@@ -252,6 +287,24 @@ impl Hidden {
                 "mm",
                 "lever_arm with r<i><j>_mm (those this plan can determine)",
             ),
+            Hidden::TableEncoderEccentricity { e_arcsec, phi_deg } => (
+                true,
+                "theta_enc = theta + e * sin(theta + phi) per axis; the table reports and \
+                 servoes on theta_enc, the IMU turns by theta",
+                eccentricity_components(*e_arcsec, *phi_deg),
+                "arcsec",
+                "table_encoder_eccentricity (station side) with <axis>_sin_arcsec = \
+                 e cos(phi), <axis>_cos_arcsec = e sin(phi); nothing credited to the IMU",
+            ),
+            Hidden::TableWobble { w_arcsec, phi_deg } => (
+                false,
+                "C_LB = R(u, w * sin(2 th_o + phi)) * C_LB, u = unit(a_o x up); angles \
+                 reported exactly",
+                json!({ "w_arcsec": w_arcsec, "phi_deg": phi_deg }),
+                "arcsec (phi: deg)",
+                "unexplained where the outer axis turns or stands at several angles; no \
+                 IMU-side effect",
+            ),
             Hidden::Custom { truth, .. } => (
                 false,
                 "custom closed form",
@@ -268,6 +321,23 @@ impl Hidden {
             unit: unit.into(),
             right: right.into(),
         }
+    }
+
+    /// The true motion of the axes (`[outer, inner]` of angle deg, rate deg/s, acceleration
+    /// deg/s^2) when the table's encoders follow `plan`.
+    pub(crate) fn true_axes(&self, plan: AxesState) -> AxesState {
+        let Hidden::TableEncoderEccentricity { e_arcsec, phi_deg } = self else {
+            return plan;
+        };
+        [0, 1].map(|k| table::true_axis(e_arcsec[k], phi_deg[k], plan[k]))
+    }
+
+    /// What the IMU senses once the table's own tilt is added (`axes` the true motion).
+    pub(crate) fn tilt(&self, st: &Station, inst: Instant, axes: &AxesState) -> Instant {
+        let Hidden::TableWobble { w_arcsec, phi_deg } = self else {
+            return inst;
+        };
+        table::wobble(st, &inst, *w_arcsec, *phi_deg, axes[0])
     }
 
     /// What it adds to the specific force each accelerometer senses, before `K_a`, m/s^2.
@@ -315,9 +385,11 @@ impl Hidden {
                 std::array::from_fn(|i| (0..3).map(|j| dps_per_g[i][j] * f[j] / g).sum()),
             ),
             Hidden::Custom { f: custom, .. } => custom(inst),
-            Hidden::ClockRate { .. } | Hidden::TimeOffset { .. } | Hidden::LeverArm { .. } => {
-                (zero, zero)
-            }
+            Hidden::ClockRate { .. }
+            | Hidden::TimeOffset { .. }
+            | Hidden::LeverArm { .. }
+            | Hidden::TableEncoderEccentricity { .. }
+            | Hidden::TableWobble { .. } => (zero, zero),
         }
     }
 }

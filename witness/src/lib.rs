@@ -28,6 +28,7 @@ mod motion;
 mod rot;
 mod scenario;
 mod station;
+mod table;
 mod write;
 
 pub use hidden::{CustomFn, Hidden, HiddenTruth};
@@ -36,4 +37,5 @@ pub use motion::{AxesState, Axis, Plan, SegmentSpec, Step, Timeline};
 pub use rot::{M3, V3};
 pub use scenario::{Scenario, Thermal};
 pub use station::{Instant, OMEGA_E, Station};
+pub use table::{ARCSEC, true_axis};
 pub use write::{Noise, Nominal, Truth, write};

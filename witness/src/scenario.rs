@@ -115,11 +115,14 @@ impl Scenario {
         th.start_c + th.rise_c * (1.0 - (-t / th.tau_s).exp())
     }
 
-    /// What an ideal IMU senses for the sample stamped `t_stamp`.
+    /// What an ideal IMU senses for the sample stamped `t_stamp`: the plan is what the
+    /// table reports; the table's own errors ([`Hidden::TableEncoderEccentricity`],
+    /// [`Hidden::TableWobble`]) make the IMU's motion differ from it.
     pub fn instant(&self, timeline: &Timeline, t_stamp: f64) -> Instant {
         let t = self.table_time(t_stamp);
-        self.station
-            .instant(t, t_stamp, self.temp_c(t), timeline.state(t))
+        let axes = (self.hidden.iter()).fold(timeline.state(t), |a, h| h.true_axes(a));
+        let inst = self.station.instant(t, t_stamp, self.temp_c(t), axes);
+        (self.hidden.iter()).fold(inst, |i, h| h.tilt(&self.station, i, &axes))
     }
 
     /// The outputs without noise and without the wandering bias: (accel m/s^2, gyro deg/s),

@@ -330,3 +330,163 @@ fn the_hidden_forms() {
         close(got_w, dw, 1e-12);
     }
 }
+
+/// One arc second, rad.
+const ARCSEC: f64 = std::f64::consts::PI / 648_000.0;
+
+/// docs/effects.md's encoder: the inner encoder reads `theta + e sin(theta + phi)` and the
+/// table servoes on it, so at the plan's roll 90 deg the true roll is `90 deg - e cos(phi)`
+/// to first order (`sin(90 deg + phi) = cos(phi)`): gravity reads
+/// `g [0, cos(e cos phi), sin(e cos phi)]`; at roll 0 the true roll is `-e sin(phi)`. The
+/// second order (`e^2`, 4e-8 rad here) bounds the difference.
+#[test]
+fn an_eccentric_encoder_turns_the_imu_by_the_true_angle() {
+    let (e, phi) = (40.0, 30f64);
+    let s = ideal().with(Hidden::TableEncoderEccentricity {
+        e_arcsec: [0.0, e],
+        phi_deg: [0.0, phi],
+    });
+    let tl = s.timeline();
+    let d = e * ARCSEC * phi.to_radians().cos();
+    let at_90 = s.instant(&tl, mid(segment(&tl, "accel_static/5")));
+    let second = G * (e * ARCSEC).powi(2);
+    close(at_90.f_b, [0.0, G * d.cos(), G * d.sin()], second);
+    let d0 = e * ARCSEC * phi.to_radians().sin();
+    let at_0 = s.instant(&tl, mid(segment(&tl, "accel_static/1")));
+    close(at_0.f_b, [0.0, -G * d0.sin(), G * d0.cos()], second);
+    // The encoder reads the plan (roll 90 deg modulo turns): theta + e sin(theta + phi).
+    let th = at_90.angles_deg[1].to_radians();
+    let enc = th + e * ARCSEC * (th + phi.to_radians()).sin();
+    let plan = tl.state(at_90.t)[1][0];
+    assert!(
+        (enc - plan.to_radians()).abs() < 1e-14,
+        "{enc} vs {plan} deg"
+    );
+    assert_eq!(plan.rem_euclid(360.0), 90.0);
+    // The outer axis is exact.
+    assert_eq!(at_90.angles_deg[0], tl.state(at_90.t)[0][0]);
+}
+
+/// In a rate segment the encoder's rate is the commanded one: the true rate `r` satisfies
+/// `r (1 + e cos(theta + phi)) = 100 deg/s` (docs/effects.md's rate feedback), and the X gyro
+/// reads it; the angle, rate and acceleration stay derivatives of each other.
+#[test]
+fn an_eccentric_encoder_makes_the_true_rate_ripple() {
+    let (e, phi) = (80.0, -45f64);
+    let s = ideal().with(Hidden::TableEncoderEccentricity {
+        e_arcsec: [0.0, e],
+        phi_deg: [0.0, phi],
+    });
+    let tl = s.timeline();
+    let seg = segment(&tl, "gyro_scale/inner/+100");
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for k in 0..200 {
+        let t = seg.t_start + 0.05 * f64::from(k);
+        let inst = s.instant(&tl, t);
+        let th = inst.angles_deg[1].to_radians() + phi.to_radians();
+        let r = inst.rates_dps[1];
+        assert!(
+            (r * (1.0 + e * ARCSEC * th.cos()) - 100.0).abs() < 1e-10,
+            "{r}"
+        );
+        let earth = ideal_earth(&inst);
+        assert!((inst.w_ib_dps[0] - earth[0] - r).abs() < 1e-10);
+        lo = lo.min(r);
+        hi = hi.max(r);
+        let h = 1e-4;
+        let (a1, a0) = (s.instant(&tl, t + h), s.instant(&tl, t - h));
+        let rate = (a1.angles_deg[1] - a0.angles_deg[1]) / (2.0 * h);
+        assert!((rate - r).abs() < 1e-6, "rate {rate} vs {r}");
+        let accel = (a1.rates_dps[1] - a0.rates_dps[1]) / (2.0 * h);
+        let dw = (a1.w_b_rps[0] - a0.w_b_rps[0]) / (2.0 * h);
+        assert!((dw - inst.dw_b_rps2[0]).abs() < 1e-6, "dw {dw} at {t}");
+        assert!((accel.to_radians() - inst.dw_b_rps2[0]).abs() < 1e-6);
+    }
+    // The ripple: 100 deg/s times e, both ways.
+    let ripple = 100.0 * e * ARCSEC;
+    assert!((hi - 100.0 - ripple).abs() < 0.01 * ripple, "{hi}");
+    assert!((100.0 - lo - ripple).abs() < 0.01 * ripple, "{lo}");
+}
+
+/// truth.json gives the registry's components: `sin = e cos(phi)`, `cos = e sin(phi)`.
+#[test]
+fn the_eccentricity_truth_holds_the_registry_components() {
+    let h = Hidden::TableEncoderEccentricity {
+        e_arcsec: [50.0, 40.0],
+        phi_deg: [-60.0, 30.0],
+    };
+    let t = h.truth();
+    assert_eq!(t.id, "table_encoder_eccentricity");
+    assert!(t.registry);
+    let p = |k: &str| t.parameters[k].as_f64().unwrap();
+    assert!((p("outer_sin_arcsec") - 25.0).abs() < 1e-12);
+    assert!((p("outer_cos_arcsec") + 25.0 * 3f64.sqrt()).abs() < 1e-12);
+    assert!((p("inner_sin_arcsec") - 20.0 * 3f64.sqrt()).abs() < 1e-12);
+    assert!((p("inner_cos_arcsec") - 20.0).abs() < 1e-12);
+}
+
+/// The outer bearing's wobble tilts the gimbal about `u = a_o x up = -East` by
+/// `delta = w sin(2 th_o + phi)`. At rest Z up (`th_o = 0`, phi 90: `delta = w`) gravity
+/// reads `R(-x, delta)^T [0, 0, g] = g [0, -sin(delta), cos(delta)]`; at pitch 90 (X up,
+/// `delta = -w`) it reads `g [cos(w), sin(w), 0]`.
+#[test]
+fn the_wobble_tilts_gravity_by_hand() {
+    let w = 60.0;
+    let s = ideal().with(Hidden::TableWobble {
+        w_arcsec: w,
+        phi_deg: 90.0,
+    });
+    let tl = s.timeline();
+    let d = w * ARCSEC;
+    let z_up = s.instant(&tl, mid(segment(&tl, "accel_static/1")));
+    close(z_up.f_b, [0.0, -G * d.sin(), G * d.cos()], 1e-12);
+    let x_up = s.instant(&tl, mid(segment(&tl, "accel_static/3")));
+    close(x_up.f_b, [G * d.cos(), G * d.sin(), 0.0], 1e-12);
+    // The encoders are exact: the angles are the plan's.
+    assert_eq!(x_up.angles_deg, tl.state(x_up.t).map(|a| a[0]));
+}
+
+/// Under the wobble the body rate and its derivative still agree with `C_LB`'s change, and
+/// an outer spin at 100 deg/s adds `2 w 100 deg/s` at most to the rate.
+#[test]
+fn the_wobble_kinematics_are_consistent() {
+    let w = 60.0;
+    let s = ideal().with(Hidden::TableWobble {
+        w_arcsec: w,
+        phi_deg: 20.0,
+    });
+    let base = ideal();
+    let tl = s.timeline();
+    let seg = segment(&tl, "gyro_scale/outer/+100");
+    let h = 1e-4;
+    let mut most: f64 = 0.0;
+    for k in 0..100 {
+        let t = seg.t_start + 0.1 * f64::from(k);
+        let (a, a1, a0) = (
+            s.instant(&tl, t),
+            s.instant(&tl, t + h),
+            s.instant(&tl, t - h),
+        );
+        let d = |r: usize, c: usize| -> f64 {
+            (0..3)
+                .map(|k| a.c_lb[k][r] * (a1.c_lb[k][c] - a0.c_lb[k][c]) / (2.0 * h))
+                .sum()
+        };
+        close([d(2, 1), d(0, 2), d(1, 0)], a.w_b_rps, 1e-7);
+        for j in 0..3 {
+            let dw = (a1.w_b_rps[j] - a0.w_b_rps[j]) / (2.0 * h);
+            assert!((dw - a.dw_b_rps2[j]).abs() < 1e-6, "dw_b at {t}");
+        }
+        let plain = base.instant(&tl, t);
+        let extra: f64 = (0..3)
+            .map(|j| (a.w_b_rps[j] - plain.w_b_rps[j]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        most = most.max(extra);
+    }
+    let peak = 2.0 * w * ARCSEC * 100f64.to_radians();
+    assert!(
+        most <= peak * (1.0 + 1e-9) && most > 0.9 * peak,
+        "{most} vs {peak}"
+    );
+}
