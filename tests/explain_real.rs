@@ -49,7 +49,9 @@ fn estimate(p: &Value) -> Option<(f64, f64)> {
 
 /// What every explanation of a real recording must hold.
 fn sound(x: &Value, what: &str) {
-    let not_obs = x["not_observable"].as_array().expect("not_observable always present");
+    let not_obs = x["not_observable"]
+        .as_array()
+        .expect("not_observable always present");
     let excluded = |effect: &str, param: &str| {
         not_obs.iter().any(|n| {
             let c = n["candidate"].as_str().unwrap();
@@ -75,7 +77,10 @@ fn sound(x: &Value, what: &str) {
             );
             if let Some(max) = registry_max(effect, name) {
                 assert!(v.abs() <= max, "{what}: {effect}.{name} = {v} beyond {max}");
-                assert!(3.0 * u <= max, "{what}: {effect}.{name} ± {u} not determined");
+                assert!(
+                    3.0 * u <= max,
+                    "{what}: {effect}.{name} ± {u} not determined"
+                );
             }
         }
         for alt in f["alternative_fits"].as_array().unwrap() {
@@ -100,11 +105,17 @@ fn lists_what_a_table_would_show(x: &Value, what: &str) {
     };
     let ecc = entry("table_encoder_eccentricity");
     assert!(
-        ecc["reason"].as_str().unwrap().contains("no table feedback"),
+        ecc["reason"]
+            .as_str()
+            .unwrap()
+            .contains("no table feedback"),
         "{ecc}"
     );
     let lever = entry("lever_arm");
-    assert!(!lever["observed_by"].as_str().unwrap().is_empty(), "{lever}");
+    assert!(
+        !lever["observed_by"].as_str().unwrap().is_empty(),
+        "{lever}"
+    );
 }
 
 #[test]

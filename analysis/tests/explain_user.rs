@@ -155,23 +155,23 @@ fn physics_the_registry_lacks_is_found_from_its_file() {
             top.rms_after < 1.1 * x.final_.noise_floor.accel_mps2,
             "{top:?}"
         );
-        // Without the file the cross-coupling is discovered by its form, with the file's
-        // values (and no registry effect is named for it: the test below).
+        // Without the file the cross-coupling is not named: on this plan only the outer
+        // turns excite f_x f_z, where an error of the table's motion has the same shape
+        // (docs/explain.md), so the form is a lead of `unexplained` and refused as a
+        // finding. The engineer's file is what names it.
         let bare = run(&rec, &[], &[]);
-        let d = bare
-            .findings
-            .iter()
-            .find(|f| f.discovered)
-            .unwrap_or_else(|| panic!("seed {seed}: not discovered: {:?}", found(&bare)));
-        for (c, p) in [("ax", "xz"), ("az", "zx")] {
-            let t = d.terms.iter().find(|t| t.channel == c).unwrap();
-            assert!(t.expression.contains("f_b.x * f_b.z"), "{t:?}");
-            let (v, u) = estimate(&x, "accel_cross_xz", p);
-            assert!(
-                (t.value - v).abs() < u.max(t.u),
-                "seed {seed}: {t:?} vs {v} ± {u}"
-            );
-        }
+        assert!(
+            bare.findings.iter().all(|f| !f.discovered),
+            "seed {seed}: {:?}",
+            found(&bare)
+        );
+        let leads: Vec<&str> = (bare.unexplained.iter())
+            .flat_map(|u| u.signature.iter().map(|g| g.expression.as_str()))
+            .collect();
+        assert!(
+            leads.iter().any(|e| e.contains("f_b.x * f_b.z")),
+            "seed {seed}: leads {leads:?}"
+        );
     }
 }
 

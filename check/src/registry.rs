@@ -119,11 +119,7 @@ fn nominal_columns(signals: &[Signals]) -> Vec<Vec<f64>> {
         let mut scale = vec![0.0; 6 * n];
         for (i, s) in signals.iter().enumerate() {
             bias[6 * i + c] = 1.0;
-            scale[6 * i + c] = if c < 3 {
-                s.f_b[c]
-            } else {
-                s.w_ib_dps()[c - 3]
-            };
+            scale[6 * i + c] = if c < 3 { s.f_b[c] } else { s.w_ib_dps()[c - 3] };
         }
         cols.push(bias);
         cols.push(scale);
@@ -133,7 +129,11 @@ fn nominal_columns(signals: &[Signals]) -> Vec<Vec<f64>> {
 
 /// One effect's parameters, each projected out of the nominal columns and the effect's
 /// earlier ones.
-fn observe_effect(e: &dyn Effect, signals: &[Signals], nominal: &[Vec<f64>]) -> EffectObservability {
+fn observe_effect(
+    e: &dyn Effect,
+    signals: &[Signals],
+    nominal: &[Vec<f64>],
+) -> EffectObservability {
     let params = e.params();
     let n = signals.len();
     let mut cols: Vec<Vec<f64>> = vec![vec![0.0; 6 * n]; params.len()];
@@ -156,7 +156,11 @@ fn observe_effect(e: &dyn Effect, signals: &[Signals], nominal: &[Vec<f64>]) -> 
     };
     for (k, p) in params.iter().enumerate() {
         let left = residual_rms(&held, &cols[k]);
-        let max = if p.max_abs.is_finite() { p.max_abs } else { 1.0 };
+        let max = if p.max_abs.is_finite() {
+            p.max_abs
+        } else {
+            1.0
+        };
         if left * max >= SIGNAL_FLOOR {
             res.determined.push(p.name);
             held.push(cols[k].clone());

@@ -1,7 +1,7 @@
 //! `Checked::observability`: which registry effects a procedure's motion lets explain
 //! determine, asked of the plan with the analysis's own regressors. Derived by hand: six
 //! static faces turn gravity through every axis but never rotate, so nothing that needs a
-//! rate (lever arm, timing) or a temperature change is determined, while the standard
+//! rate (lever arm, timing) is determined, while the standard
 //! procedure's rate points determine the lever arm's diagonal (the centripetal terms along
 //! each axis) and not its cross terms.
 
@@ -40,7 +40,12 @@ fn of<'a>(obs: &'a [EffectObservability], id: &str) -> &'a EffectObservability {
 #[test]
 fn six_static_faces_determine_no_rotation_physics() {
     let obs = observability(SIX_FACES);
-    for id in ["lever_arm", "time_offset", "clock_rate", "gyro_scale_asymmetry"] {
+    for id in [
+        "lever_arm",
+        "time_offset",
+        "clock_rate",
+        "gyro_scale_asymmetry",
+    ] {
         let o = of(&obs, id);
         assert!(o.determined.is_empty(), "{id}: {:?}", o.determined);
         assert!(o.not.iter().all(|n| !n.1.is_empty()), "{id}: needs said");
@@ -49,7 +54,11 @@ fn six_static_faces_determine_no_rotation_physics() {
     // each axis sees three levels (-g, 0, +g), so f_i^2 is separable from a bias and a
     // scale factor (the second order and the asymmetry are, each beside the nominal model;
     // from each other they are not, which is explain's `not_separable_from`).
-    for id in ["accel_misalignment", "accel_second_order", "accel_scale_asymmetry"] {
+    for id in [
+        "accel_misalignment",
+        "accel_second_order",
+        "accel_scale_asymmetry",
+    ] {
         let o = of(&obs, id);
         assert!(o.not.is_empty(), "{id}: {:?}", o.not);
     }
@@ -65,5 +74,8 @@ fn the_standard_procedure_determines_the_lever_arm_diagonal_only() {
     for id in ["gyro_thermal_drift", "accel_scale_thermal"] {
         assert!(of(&obs, id).determined.is_empty(), "{id}");
     }
-    assert!(of(&obs, "time_offset").not.is_empty(), "rate points time the IMU");
+    assert!(
+        of(&obs, "time_offset").not.is_empty(),
+        "rate points time the IMU"
+    );
 }

@@ -27,6 +27,28 @@ pub struct Imu {
     /// Gyro bias random walk: the bias's standard deviation grows by this times sqrt(t s),
     /// deg/s per sqrt(s).
     pub gyro_bias_walk_dps_per_sqrt_s: f64,
+    /// Gyro bias instability as a first-order Gauss-Markov process (deg/s), on each axis.
+    pub gyro_bias_gm: Option<GaussMarkov>,
+    /// Accelerometer bias instability as a first-order Gauss-Markov process (m/s^2).
+    pub accel_bias_gm: Option<GaussMarkov>,
+}
+
+/// A first-order Gauss-Markov process: stationary standard deviation `sigma`, correlation
+/// time `tau_s`; `x(t + dt) = exp(-dt/tau) x(t) + sigma sqrt(1 - exp(-2 dt/tau)) n`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct GaussMarkov {
+    /// Stationary standard deviation (the output's unit).
+    pub sigma: f64,
+    /// Correlation time, s.
+    pub tau_s: f64,
+}
+
+impl GaussMarkov {
+    /// The factors `(exp(-dt/tau), sigma sqrt(1 - exp(-2 dt/tau)))` of one step of `dt`.
+    pub fn step(&self, dt: f64) -> (f64, f64) {
+        let a = (-dt / self.tau_s).exp();
+        (a, self.sigma * (1.0 - a * a).sqrt())
+    }
 }
 
 impl Imu {
@@ -42,6 +64,8 @@ impl Imu {
             accel_noise_mps2: 0.0,
             gyro_noise_dps: 0.0,
             gyro_bias_walk_dps_per_sqrt_s: 0.0,
+            gyro_bias_gm: None,
+            accel_bias_gm: None,
         }
     }
 

@@ -32,7 +32,7 @@ mod table;
 mod write;
 
 pub use hidden::{CustomFn, Hidden, HiddenTruth};
-pub use imu::Imu;
+pub use imu::{GaussMarkov, Imu};
 pub use motion::{AxesState, Axis, Plan, SegmentSpec, Step, Timeline};
 pub use rot::{M3, V3};
 pub use scenario::{Scenario, Thermal};

@@ -184,6 +184,15 @@ fn write_imu(path: &Path, s: &Scenario, timeline: &Timeline) -> io::Result<BTree
     let dt = 1.0 / s.imu_rate_hz;
     let walk_step = s.imu.gyro_bias_walk_dps_per_sqrt_s * dt.sqrt();
     let mut walk = [0.0; 3];
+    // Bias instability (Gauss-Markov), started from its stationary distribution; drawn
+    // only when the scenario asks, so that other scenarios' samples stay as they were.
+    let gm = [s.imu.accel_bias_gm, s.imu.gyro_bias_gm];
+    let mut gm_x = [[0.0f64; 3]; 2];
+    for (x, p) in gm_x.iter_mut().zip(&gm) {
+        if let Some(p) = p {
+            *x = std::array::from_fn(|_| p.sigma * normal(&mut rng));
+        }
+    }
     for k in 0u64.. {
         let t_stamp = s.imu_t0_s + k as f64 * dt;
         if t_stamp > timeline.duration_s {
@@ -201,6 +210,18 @@ fn write_imu(path: &Path, s: &Scenario, timeline: &Timeline) -> io::Result<BTree
             a[i] += s.imu.accel_noise_mps2 * normal(&mut rng);
             w[i] += walk[i] + s.imu.gyro_noise_dps * normal(&mut rng);
             walk[i] += walk_step * normal(&mut rng);
+        }
+        for (j, p) in gm.iter().enumerate() {
+            let Some(p) = p else { continue };
+            let (decay, kick) = p.step(dt);
+            for i in 0..3 {
+                if j == 0 {
+                    a[i] += gm_x[j][i];
+                } else {
+                    w[i] += gm_x[j][i];
+                }
+                gm_x[j][i] = decay * gm_x[j][i] + kick * normal(&mut rng);
+            }
         }
         writeln!(
             f,

@@ -53,10 +53,7 @@ pub(crate) fn finding(
         "at_s".to_string(),
         Parameter::estimate(cp.at_s, cp.u_at_s, "s"),
     );
-    parameters.insert(
-        format!("k_{name}"),
-        Parameter::estimate(value, u, &unit),
-    );
+    parameters.insert(format!("k_{name}"), Parameter::estimate(value, u, &unit));
     Ok(Finding {
         effect: format!("discovered_{name}_step_{:.0}s", cp.at_s),
         explanation: format!(

@@ -33,6 +33,9 @@ pub(crate) struct Data {
     pub retime: Retime,
     /// Static segments left out because their attitude is unknown (`up: oblique`): ids.
     pub left_out: Vec<String>,
+    /// Per accumulation: whether its segment is static (the table at rest at a known
+    /// attitude).
+    pub at_rest: Vec<bool>,
     /// Whether the table stream is a table's feedback (not synthesized from declared
     /// attitudes by an import with `table: none`): table-side effects need it.
     pub table_feedback: bool,
@@ -106,7 +109,18 @@ impl Data {
             .map(|a| (segs[a.seg].t_start, segs[a.seg].t_end))
             .collect();
         let g = m.station.site.gravity_mps2;
-        probes.extend(probe::add_steps(&mut layout, &mut accs, &spans, g, grade));
+        let turning: Vec<bool> = accs
+            .iter()
+            .map(|a| segs[a.seg].kind != SegmentKind::Static)
+            .collect();
+        probes.extend(probe::add_steps(
+            &mut layout,
+            &mut accs,
+            &spans,
+            &turning,
+            g,
+            grade,
+        ));
         let longest = accs
             .iter()
             .enumerate()
@@ -128,7 +142,12 @@ impl Data {
         }
         held.sort_unstable();
         let excitation: Vec<Vec<f64>> = accs.iter().map(|a| excitation(&layout, a)).collect();
+        let at_rest: Vec<bool> = accs
+            .iter()
+            .map(|a| segs[a.seg].kind == SegmentKind::Static)
+            .collect();
         Ok(Data {
+            at_rest,
             layout,
             accs,
             held,

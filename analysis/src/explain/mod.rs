@@ -46,8 +46,8 @@ pub use crate::results::Parameter;
 pub use adopt::{AdoptTarget, Adoption, adoption, next_version};
 pub use model::NominalModel;
 pub use output::{
-    AlternativeFit, Evidence, NotObservable, Explanation, FORMAT, Final, Finding, Located, Nominal, RefusedOut, Rms, SegmentRms,
-    Signature, Term, Unexplained, UserEffectOut,
+    AlternativeFit, Evidence, Explanation, FORMAT, Final, Finding, Located, Nominal, NotObservable,
+    RefusedOut, Rms, SegmentRms, Signature, Term, Unexplained, UserEffectOut,
 };
 pub use text::render_text;
 pub use user::UserEffect;
@@ -294,7 +294,14 @@ pub(crate) fn explain_fitted(
             .iter()
             .map(|d| discovered::finding(m, data, d, &registry_terms, &whole.0)),
     );
-    refused.extend(change_points(m, data, &terms, &whole.0, opts.alpha, &mut findings));
+    refused.extend(change_points(
+        m,
+        data,
+        &terms,
+        &whole.0,
+        opts.alpha,
+        &mut findings,
+    ));
     let mut unexplained = unexplained::leftover(m, data, &terms, &whole.0, opts.alpha);
     if debug {
         eprintln!("leftover tested in {:?}", clock.elapsed());

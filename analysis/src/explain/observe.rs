@@ -19,6 +19,7 @@ use super::data::Data;
 use super::model::{Terms, fit_with};
 use super::output::NotObservable;
 use super::plausible::max_abs;
+use super::probe::Form;
 use crate::fit::joint::CHANNELS;
 use rayon::prelude::*;
 
@@ -43,7 +44,15 @@ enum Why {
 /// segments.
 pub(crate) fn observe(data: &Data, start: &Terms) -> Observability {
     let mut cands: Vec<usize> = data.candidates.clone();
-    cands.extend(data.probes.iter().map(|p| p.0));
+    // Steps are columns of the bias or scale copied after an instant between segments:
+    // excited by construction, and many; the solver's rank test drops one a fit cannot
+    // separate.
+    cands.extend(
+        data.probes
+            .iter()
+            .filter(|p| !matches!(p.1.form, Form::Step { .. } | Form::ScaleStep { .. }))
+            .map(|p| p.0),
+    );
     cands.retain(|e| !start.effects.contains(e) && !start.fixed.iter().any(|f| f.0 == *e));
     let per: Vec<(usize, Vec<(usize, Why)>)> = cands
         .par_iter()
@@ -81,11 +90,20 @@ fn check(data: &Data, start: &Terms, e: usize) -> Vec<(usize, Why)> {
         .filter_map(|g| {
             if !f.estimated.contains(&g) {
                 let excited = work.iter().any(|&i| data.excitation[i][g] > 0.0);
-                return Some((g, if excited { Why::Dependent } else { Why::NotExcited }));
+                return Some((
+                    g,
+                    if excited {
+                        Why::Dependent
+                    } else {
+                        Why::NotExcited
+                    },
+                ));
             }
             let max = max_abs(lay.param(g))?;
             let u = f.u(g);
-            (!(3.0 * u <= max)).then_some((g, Why::Unresolved { u, max }))
+            // A NaN u is not determined either.
+            let determined = 3.0 * u <= max;
+            (!determined).then_some((g, Why::Unresolved { u, max }))
         })
         .collect()
 }
@@ -120,10 +138,9 @@ fn entries(data: &Data, e: usize, cols: &[(usize, Why)]) -> Vec<NotObservable> {
 
 /// A candidate's name: the registry or user effect's id, or for a library form
 /// `form_<sensor>_<form>` (`form_accel_fy_fz`).
-fn candidate_name(data: &Data, e: usize) -> String {
+pub(crate) fn candidate_name(data: &Data, e: usize) -> String {
     match data.probe(e) {
-        Some(p) => format!("form_{}_{}", p.sensor.name(), p.form.family())
-            .replace(['.', '-'], "_"),
+        Some(p) => format!("form_{}_{}", p.sensor.name(), p.form.family()).replace(['.', '-'], "_"),
         None => data.layout.effects[e].id().to_string(),
     }
 }
@@ -167,9 +184,9 @@ fn reason(why: &Why, unit: &str, plural: bool) -> String {
         ("it", "it", "is")
     };
     match why {
-        Why::NoTable => format!(
-            "a table-side error, and the recording has no table feedback: {it} cannot show"
-        ),
+        Why::NoTable => {
+            format!("a table-side error, and the recording has no table feedback: {it} cannot show")
+        }
         Why::NotExcited => format!("no segment of the recording excites {them}"),
         Why::Dependent => format!(
             "on this recording's segments {it} {is} not separable from the nominal model's terms"

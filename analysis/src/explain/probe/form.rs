@@ -39,6 +39,9 @@ pub(crate) enum Form {
     Decay { t0: f64, tau: f64 },
     /// `1` after the instant, `0` before: a bias step (derived from the bias column).
     Step { at: f64 },
+    /// `s_i` after the instant, `0` before: a scale-factor step (derived from the scale
+    /// column).
+    ScaleStep { at: f64 },
     /// `s_i (t - t0)`: a scale factor that drifts.
     ScaleDrift { t0: f64 },
     /// `s_i dtemp`: a scale factor that follows the temperature.
@@ -46,6 +49,15 @@ pub(crate) enum Form {
 }
 
 impl Form {
+    /// Whether the form is a function of the specific force alone (what a static attitude
+    /// excites as well as a turn).
+    pub(crate) fn of_force_alone(self) -> bool {
+        matches!(
+            self,
+            Form::ForceSquare | Form::ForceProduct(..) | Form::ForceAbs | Form::ForceCube
+        )
+    }
+
     /// Whether the form is a function of time alone (a drift, decay or step of the bias).
     pub(crate) fn in_time(self) -> bool {
         matches!(
@@ -93,6 +105,7 @@ impl Form {
             Form::Drift2 { t0 } => bias(format!("((t_s - {t0}) / 3600)^2")),
             Form::Decay { t0, tau } => bias(format!("exp(-(t_s - {t0}) / {tau})")),
             Form::Step { at } => bias(format!("(sign(t_s - {at}) + 1) / 2")),
+            Form::ScaleStep { at } => format!("1e-6 * {input} * (sign(t_s - {at}) + 1) / 2"),
             Form::ScaleDrift { t0 } => format!("1e-6 * {input} * (t_s - {t0}) / 3600"),
             Form::ThermalScale => format!("1e-6 * {input} * dtemp_c"),
         }
@@ -136,6 +149,10 @@ impl Form {
             Form::Drift2 { t0 } => bias(hours(t0).powi(2)),
             Form::Decay { t0, tau } => bias((-(s.t_s - t0) / tau).exp()),
             Form::Step { at } => bias(if s.t_s > at { 1.0 } else { 0.0 }),
+            Form::ScaleStep { at } => {
+                let (x, on) = (input(), if s.t_s > at { 1e-6 } else { 0.0 });
+                each(&|i| x[i] * on)
+            }
             Form::ScaleDrift { t0 } => {
                 let (x, h) = (input(), hours(t0));
                 each(&|i| 1e-6 * x[i] * h)
@@ -155,6 +172,7 @@ impl Form {
                 | Form::Drift2 { .. }
                 | Form::Decay { .. }
                 | Form::Step { .. }
+                | Form::ScaleStep { .. }
                 | Form::ScaleDrift { .. }
                 | Form::ThermalScale
         )
@@ -179,6 +197,7 @@ impl Form {
             Form::Decay { .. } | Form::Step { .. } if gyro => "deg/h",
             Form::Decay { .. } | Form::Step { .. } => "ug",
             Form::ScaleDrift { .. } => "ppm/h",
+            Form::ScaleStep { .. } => "ppm",
             Form::ThermalScale => "ppm/degC",
         }
     }
@@ -201,6 +220,7 @@ impl Form {
             Form::Decay { tau, .. } => format!("decay_{tau:.0}s"),
             Form::Step { at } => format!("step_{at:.0}s"),
             Form::ScaleDrift { .. } => format!("{s}{a}_drift"),
+            Form::ScaleStep { at } => format!("{s}{a}_step_{at:.0}s"),
             Form::ThermalScale => format!("{s}{a}_dtemp"),
         }
     }
@@ -218,6 +238,7 @@ impl Form {
             Form::RateSquare => "w2".into(),
             Form::RateCube => "w3".into(),
             Form::ScaleDrift { .. } => "scale_drift".into(),
+            Form::ScaleStep { at } => format!("scale_step_{at:.0}s"),
             Form::ThermalScale => "scale_dtemp".into(),
             // Functions of time alone: the same on every axis.
             _ => self.slug(Sensor::Accel, 0),
@@ -231,7 +252,7 @@ impl Form {
                 "attitudes with gravity along the axis, up and down, and oblique ones"
             }
             Form::ForceProduct(..) => {
-                "oblique attitudes with gravity along both axes of the product together"
+                "compound static attitudes with both axes of the product off vertical"
             }
             Form::ForceRateSquare => "rotation at several rates with gravity along the axis",
             Form::RateAbs | Form::RateSquare | Form::RateCube => {
@@ -241,6 +262,7 @@ impl Form {
                 "repeated attitudes spread over the recording's duration"
             }
             Form::ScaleDrift { .. } => "the same input repeated early and late in the recording",
+            Form::ScaleStep { .. } => "the same input repeated before and after the instant",
             Form::ThermalScale => "the same input repeated at different temperatures",
         }
     }
@@ -285,6 +307,9 @@ impl Form {
             Form::Decay { .. } => "the bias decays with time since power-on: warm-up",
             Form::Step { .. } => "the bias jumps between two segments: a bias step",
             Form::ScaleDrift { .. } => "the scale factor drifts with time",
+            Form::ScaleStep { .. } => {
+                "the scale factor jumps between two segments: a scale-factor step"
+            }
             Form::ThermalScale => {
                 "the scale factor follows the temperature: a thermal scale coefficient"
             }

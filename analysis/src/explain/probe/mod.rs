@@ -150,44 +150,49 @@ pub(crate) fn sampled(t0: f64, span_s: f64, grade: f64) -> Vec<&'static Probe> {
     out
 }
 
-/// Adds a derived step probe per sensor (`g` the site's gravity, for its scale; `grade` the
-/// range's factor) at every gap between consecutive segments (its
-/// instant the middle of the gap) to the layout and every segment's factor and blocks.
+/// Adds derived step probes per sensor, a bias step and a scale-factor step (`g` the
+/// site's gravity, for the bias step's scale; `grade` the ranges' factor), at every gap
+/// between consecutive segments (the instant the middle of the gap), to the layout and
+/// every segment's factor and blocks.
 /// Returns the new effects' layout indices with their probes.
 pub(crate) fn add_steps(
     layout: &mut Layout,
     accs: &mut [SegAcc],
     starts: &[(f64, f64)],
+    turning: &[bool],
     g: f64,
     grade: f64,
 ) -> Vec<(usize, &'static Probe)> {
     let mut order: Vec<usize> = (0..accs.len()).collect();
     order.sort_by(|&a, &b| starts[a].0.total_cmp(&starts[b].0));
-    let mut instants = Vec::new();
+    // (instant, whether a gyro scale step is tried there: between two turning segments,
+    // where the rate tests' passes meet; elsewhere it is a copy of one of these on the
+    // gyros' inputs).
+    let mut instants: Vec<(f64, bool)> = Vec::new();
     for w in order.windows(2) {
         let (end, next) = (starts[w[0]].1, starts[w[1]].0);
         if next > end {
-            instants.push(0.5 * (end + next));
+            instants.push((0.5 * (end + next), turning[w[0]] && turning[w[1]]));
         }
     }
-    let bias = |s: Sensor| {
-        let id = match s {
-            Sensor::Accel => "accel_bias",
-            Sensor::Gyro => "gyro_bias",
-        };
-        layout.index(id).map(|e| layout.first[e])
-    };
-    let (Some(ba), Some(bg)) = (bias(Sensor::Accel), bias(Sensor::Gyro)) else {
+    let first = |id: &str| layout.index(id).map(|e| layout.first[e]);
+    let (Some(ba), Some(bg), Some(sg)) =
+        (first("accel_bias"), first("gyro_bias"), first("gyro_scale"))
+    else {
         return Vec::new();
     };
     let mut added = Vec::new();
     let mut effects = layout.effects.clone();
-    for &at in &instants {
-        for sensor in [Sensor::Accel, Sensor::Gyro] {
-            let form = Form::Step { at };
-            let p = Probe::new(sensor, form, grade * range::max_abs(form, sensor, 0.0));
-            added.push((effects.len(), p));
-            effects.push(p as &dyn Effect);
+    let mut push = |sensor: Sensor, form: Form, effects: &mut Vec<&'static dyn Effect>| {
+        let p = Probe::new(sensor, form, grade * range::max_abs(form, sensor, 0.0));
+        added.push((effects.len(), p));
+        effects.push(p as &dyn Effect);
+    };
+    for &(at, scale) in &instants {
+        push(Sensor::Accel, Form::Step { at }, &mut effects);
+        push(Sensor::Gyro, Form::Step { at }, &mut effects);
+        if scale {
+            push(Sensor::Gyro, Form::ScaleStep { at }, &mut effects);
         }
     }
     let old = layout.clone();
@@ -195,43 +200,70 @@ pub(crate) fn add_steps(
     for (i, acc) in accs.iter_mut().enumerate() {
         let t = starts[i].0;
         for c in 0..6 {
-            // Every sensor has a step at each instant, in order: the channel's new columns.
-            // The bias column of this channel's own axis.
-            let base = if c < 3 { ba + c } else { bg + c - 3 };
-            // The step's scale (Form::value): ug for the accelerometers, deg/h for the gyros.
-            let scale = if c < 3 { 1e-6 * g } else { 1.0 / 3600.0 };
-            let k_old = old.by_channel[c].len();
-            let local_bias = old.by_channel[c].iter().position(|&g| g == base);
-            let k_new = layout.by_channel[c].len();
-            let r = &acc.r[c];
-            let mut m = nalgebra::DMatrix::zeros(k_new + 1, k_new + 1);
-            let rows = r.nrows().min(k_old + 1);
-            for row in 0..rows {
-                for col in 0..k_old {
-                    m[(row, col)] = r[(row, col)];
-                }
-                m[(row, k_new)] = r[(row, k_old)];
-            }
-            for (j, at) in instants.iter().enumerate() {
-                if t > *at
-                    && let Some(lb) = local_bias
-                {
-                    for row in 0..rows {
-                        m[(row, k_old + j)] = scale * r[(row, lb)];
-                    }
+            // The channel's new columns in layout order: per instant the step (a copy of
+            // the bias column of this channel's axis, in ug or deg/h), and on the gyros the
+            // scale step where one is tried (a copy of the scale column, in ppm like it).
+            let local = |gcol: usize| old.by_channel[c].iter().position(|&x| x == gcol);
+            let (bias, unit) = if c < 3 {
+                (local(ba + c), 1e-6 * g)
+            } else {
+                (local(bg + c - 3), 1.0 / 3600.0)
+            };
+            let mut cols = Vec::new();
+            for &(at, scale) in &instants {
+                cols.push((bias, unit, t > at));
+                if scale && c >= 3 {
+                    cols.push((local(sg + c - 3), 1.0, t > at));
                 }
             }
-            // Still upper triangular: the copies sit above the diagonal (the bias column's
-            // rows), their own diagonal is zero, and `m^T m` is the Gram matrix of
-            // `[X steps y]`, which is all a factor has to be.
-            acc.r[c] = m;
-            for b in &mut acc.blocks {
-                let bias_sum = local_bias.map_or(0.0, |lb| scale * b.sx[c][lb]);
-                for at in &instants {
-                    b.sx[c].push(if t > *at { bias_sum } else { 0.0 });
-                }
-            }
+            extend(acc, c, &old, layout, &cols);
         }
     }
     added
+}
+
+/// Extends segment `acc`'s factor and block sums on channel `c` (laid out as `old`) by the
+/// new columns of `layout`, in order: each a copy of a source column (its local index in
+/// the old factor) times a scale where the segment is after the column's instant, zero
+/// before.
+///
+/// The result is not triangular: the copies sit above the diagonal (the source column's
+/// rows) with a zero diagonal of their own, and `m^T m` is the Gram matrix of
+/// `[X copies y]`, which is all a factor has to be.
+fn extend(
+    acc: &mut SegAcc,
+    c: usize,
+    old: &Layout,
+    layout: &Layout,
+    cols: &[(Option<usize>, f64, bool)],
+) {
+    let k_old = old.by_channel[c].len();
+    let k_new = layout.by_channel[c].len();
+    let r = &acc.r[c];
+    let mut m = nalgebra::DMatrix::zeros(k_new + 1, k_new + 1);
+    let rows = r.nrows().min(k_old + 1);
+    for row in 0..rows {
+        for col in 0..k_old {
+            m[(row, col)] = r[(row, col)];
+        }
+        m[(row, k_new)] = r[(row, k_old)];
+    }
+    for (j, &(src, scale, on)) in cols.iter().enumerate() {
+        if let (true, Some(l)) = (on, src) {
+            for row in 0..rows {
+                m[(row, k_old + j)] = scale * r[(row, l)];
+            }
+        }
+    }
+    acc.r[c] = m;
+    for b in &mut acc.blocks {
+        for j in 0..cols.len() {
+            let (src, scale, on) = cols[j];
+            let v = match (on, src) {
+                (true, Some(l)) => scale * b.sx[c][l],
+                _ => 0.0,
+            };
+            b.sx[c].push(v);
+        }
+    }
 }

@@ -45,6 +45,7 @@ pub(crate) fn max_abs(form: Form, sensor: Sensor, span_h: f64) -> f64 {
         Form::Drift2 { .. } => bias / (span_h * span_h),
         Form::Decay { .. } | Form::Step { .. } => bias,
         Form::ScaleDrift { .. } => SCALE_CHANGE_PPM / span_h,
+        Form::ScaleStep { .. } => SCALE_CHANGE_PPM,
         // The registry's scale thermal coefficient.
         Form::ThermalScale => 500.0,
     }
