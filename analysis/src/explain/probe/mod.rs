@@ -103,7 +103,7 @@ impl Effect for Probe {
 
 /// The decays' time constants: a geometric grid (ratio 1.5) from 30 s to half the
 /// recording's span, so that a warm-up's time constant is located to a grid step and refined
-/// between the neighbours (`discover::refine_tau`).
+/// by the profile of the misfit (`discover::tau`).
 pub(crate) fn decay_grid(span_s: f64) -> Vec<f64> {
     let mut out = Vec::new();
     let mut tau: f64 = 30.0;

@@ -9,6 +9,8 @@
 //! held-out segments, which no fit saw. The winner (the highest information-criterion
 //! score) joins the model, which is refitted jointly with everything found before.
 
+mod tau;
+
 use super::data::Data;
 use super::model::{Terms, fit, misfit};
 use super::probe::{Form, Probe};
@@ -30,18 +32,18 @@ pub(crate) struct Discovery {
     pub probe: &'static Probe,
     /// Global columns kept (one per channel).
     pub columns: Vec<usize>,
-    /// For a decay: the time constant refined between the grid's neighbours, with its
-    /// standard uncertainty, and the amplitude of each kept column there (value, u).
+    /// For a decay: the time constant from the profile of the misfit, with its standard
+    /// uncertainty, and the amplitude of each kept column there (value, u).
     pub tau: Option<Refined>,
 }
 
-/// A decay's time constant between the grid points.
+/// A decay's time constant from the profile of the misfit ([`tau::refine`]).
 pub(crate) struct Refined {
     /// Time constant, s.
     pub tau_s: f64,
     /// Its standard uncertainty, s.
     pub u_s: f64,
-    /// Per kept column: the amplitude at `tau_s` and its u, interpolated in `ln tau`.
+    /// Per kept column: the amplitude at `tau_s` and its u (the time constant's included).
     pub amplitudes: Vec<(f64, f64)>,
 }
 
@@ -60,9 +62,6 @@ pub(crate) fn live_columns(data: &Data, terms: &Terms) -> usize {
 
 /// A round's winner: probe, kept and dropped columns, the fit with it, its Wald statistic.
 type Accepted = (usize, Vec<usize>, Vec<usize>, Fit, f64);
-
-/// A decay grid point: `ln tau`, the negated misfit, the amplitudes (value, u).
-type GridPoint = (f64, f64, Vec<(f64, f64)>);
 
 /// A probe tried beside the model: each channel column's Wald statistic (is it there?)
 /// and the misfit it removes (how well does it explain?).
@@ -277,7 +276,7 @@ pub(crate) fn discover(
         terms.effects.push(e);
         terms.skip.extend(drop.iter().copied());
         let tau = match probe.form {
-            Form::Decay { .. } => refine_tau(data, terms, e, &keep, probe),
+            Form::Decay { .. } => tau::refine(data, terms, e, &keep, probe),
             _ => None,
         };
         let dof = keep.len();
@@ -299,113 +298,6 @@ pub(crate) fn discover(
         });
     }
     out
-}
-
-/// A decay found at a grid time constant: the same channels tried with its neighbours on
-/// the grid in place of it; the misfit's parabola in `ln tau` through the three gives the
-/// time constant (its vertex) and its uncertainty (where the misfit has risen by one,
-/// scaled from white noise to the honest noise model).
-fn refine_tau(
-    data: &Data,
-    terms: &Terms,
-    best: usize,
-    keep: &[usize],
-    probe: &Probe,
-) -> Option<Refined> {
-    let work = data.working();
-    let lay = &data.layout;
-    let mut grid: Vec<(f64, usize)> = data
-        .probes
-        .iter()
-        .filter(|(_, p)| p.sensor == probe.sensor)
-        .filter_map(|&(e, p)| match p.form {
-            Form::Decay { tau, .. } => Some((tau, e)),
-            _ => None,
-        })
-        .collect();
-    grid.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let k = grid.iter().position(|g| g.1 == best)?;
-    if k == 0 || k + 1 >= grid.len() {
-        return None;
-    }
-    let axes: Vec<usize> = keep.iter().map(|&g| local_axis(data, g)).collect();
-    // The misfit of the kept channels (in units of their white noise, negated: a peak)
-    // and the amplitudes with decay `e` in place of the best one.
-    let swap = |e: usize| -> (Terms, Vec<usize>) {
-        let mut t = terms.clone();
-        t.effects.retain(|&x| x != best);
-        t.skip.retain(|g| !lay.columns_of(best).contains(g));
-        t.effects.push(e);
-        let keep: Vec<usize> = lay
-            .columns_of(e)
-            .filter(|&g| axes.contains(&local_axis(data, g)))
-            .collect();
-        t.skip
-            .extend(lay.columns_of(e).filter(|g| !keep.contains(g)));
-        (t, keep)
-    };
-    // One noise scale for the three fits: the model's with the best decay.
-    let (center, _) = fit(data, terms, &work, &work);
-    let with = |e: usize| -> (f64, Vec<(f64, f64)>) {
-        let (t, keep) = swap(e);
-        let (f, _) = fit(data, &t, &work, &work);
-        let total: f64 = keep
-            .iter()
-            .map(|&g| {
-                let c = channel_of(data, g);
-                misfit(data, &f, c, &work, center.noise[c].sigma)
-            })
-            .sum();
-        let amps = keep.iter().map(|&g| (f.theta[g], f.u(g))).collect();
-        (-total, amps)
-    };
-    // The white curvature understates the uncertainty where the bias wanders: scaled by
-    // the amplitude's honest-to-white ratio at the best grid point.
-    let inflation = {
-        let (t, keep) = swap(best);
-        let (honest, _) = fit(data, &t, &work, &work);
-        let (white, _) = super::model::fit_with(data, &t, &work, &work, true);
-        let g = keep[0];
-        if white.u(g) > 0.0 {
-            (honest.u(g) / white.u(g)).max(1.0)
-        } else {
-            1.0
-        }
-    };
-    let pts: Vec<GridPoint> = [grid[k - 1], grid[k], grid[k + 1]]
-        .iter()
-        .map(|&(tau, e)| {
-            let (c, a) = with(e);
-            (tau.ln(), c, a)
-        })
-        .collect();
-    // Parabola through three points: c(x) = p2 x^2 + p1 x + p0.
-    let (x0, x1, x2) = (pts[0].0, pts[1].0, pts[2].0);
-    let (y0, y1, y2) = (pts[0].1, pts[1].1, pts[2].1);
-    let d = (x0 - x1) * (x0 - x2) * (x1 - x2);
-    let p2 = (x2 * (y1 - y0) + x1 * (y0 - y2) + x0 * (y2 - y1)) / d;
-    let p1 = (x2 * x2 * (y0 - y1) + x1 * x1 * (y2 - y0) + x0 * x0 * (y1 - y2)) / d;
-    if p2 >= 0.0 {
-        return None;
-    }
-    let xv = (-p1 / (2.0 * p2)).clamp(x0, x2);
-    let sx = (-1.0 / p2).sqrt() * inflation;
-    // Amplitudes interpolated linearly in ln tau between the two grid points around xv.
-    let (lo, hi) = if xv <= x1 { (0, 1) } else { (1, 2) };
-    let w = (xv - pts[lo].0) / (pts[hi].0 - pts[lo].0);
-    let amplitudes = (0..axes.len())
-        .map(|j| {
-            let (a0, u0) = pts[lo].2[j];
-            let (a1, u1) = pts[hi].2[j];
-            (a0 + w * (a1 - a0), u0 + w * (u1 - u0))
-        })
-        .collect();
-    let tau_s = xv.exp();
-    Some(Refined {
-        tau_s,
-        u_s: tau_s * sx,
-        amplitudes,
-    })
 }
 
 /// The axis (0..3) of a probe column's channel.
