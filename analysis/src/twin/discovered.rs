@@ -24,8 +24,28 @@ pub(super) struct DiscoveredTerm {
     pub unit: String,
 }
 
+/// The time constant of a decay's expression (`... exp(-(t_s - t0) / tau)`).
+fn decay_tau(expr: &str) -> Option<f64> {
+    let rest = &expr[expr.find("exp(-(t_s - ")?..];
+    let after = &rest[rest.find(") / ")? + 4..];
+    after[..after.find(')')?].trim().parse().ok()
+}
+
+/// The library decay on `sensor` nearest in `ln tau` to the decay written in `expr`: a
+/// time constant refined between the grid's (docs/explain.md) is held in the twin by the
+/// grid's column nearest to it.
+fn nearest_decay(data: &Data, sensor: Sensor, expr: &str) -> Option<usize> {
+    let tau = decay_tau(expr)?;
+    data.probes
+        .iter()
+        .filter(|(_, p)| p.sensor == sensor)
+        .filter_map(|q| Some((q.0, decay_tau(&q.1.expression(0))?)))
+        .min_by(|a, b| (a.1 / tau).ln().abs().total_cmp(&(b.1 / tau).ln().abs()))
+        .map(|(e, _)| e)
+}
+
 /// Every term of the discovered findings that a probe column of the layout holds (a decay
-/// whose time constant was refined between the grid's has none: it is left out).
+/// whose time constant was refined between the grid's takes the nearest grid decay's).
 pub(super) fn terms(data: &Data, x: &Explanation) -> Vec<DiscoveredTerm> {
     let lay = &data.layout;
     let mut out = Vec::new();
@@ -42,8 +62,10 @@ pub(super) fn terms(data: &Data, x: &Explanation) -> Vec<DiscoveredTerm> {
             let hit = data
                 .probes
                 .iter()
-                .find(|(_, p)| p.sensor == sensor && p.expression(ax) == t.expression);
-            if let Some(&(e, _)) = hit {
+                .find(|(_, p)| p.sensor == sensor && p.expression(ax) == t.expression)
+                .map(|q| q.0)
+                .or_else(|| nearest_decay(data, sensor, &t.expression));
+            if let Some(e) = hit {
                 out.push(DiscoveredTerm {
                     effect: f.effect.clone(),
                     channel: t.channel.clone(),
