@@ -15,18 +15,16 @@ use ratecal_physics::REGISTRY;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
-fn map(name: &str) -> String {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("docs/examples/import")
-        .join(name);
-    p.to_str().unwrap().to_string()
-}
-
 /// Imports `sources` with `map_name` into `dir/run` and explains it; the JSON.
 fn import_and_explain(dir: &Path, sources: &[PathBuf], map_name: &str) -> Value {
     let mut args: Vec<String> = vec!["import".into()];
     args.extend(sources.iter().map(|s| s.to_str().unwrap().to_string()));
-    args.extend(["--map".into(), map(map_name), "--out".into(), "run".into()]);
+    args.extend([
+        "--map".into(),
+        import_map(map_name),
+        "--out".into(),
+        "run".into(),
+    ]);
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let o = ratecal(&args, dir);
     assert_eq!(code(&o), 0, "{}", text(&o));

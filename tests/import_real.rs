@@ -9,13 +9,6 @@ use support::*;
 
 use std::path::Path;
 
-fn map(name: &str) -> String {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("docs/examples/import")
-        .join(name);
-    p.to_str().unwrap().to_string()
-}
-
 /// Whitespace- or comma-separated numbers, after `skip` lines.
 fn numbers(path: &Path, skip: usize) -> Vec<Vec<f64>> {
     std::fs::read_to_string(path)
@@ -68,7 +61,7 @@ fn imu_tk_xsens_poses_are_found_and_static_by_the_factory_calibration() {
             acc.to_str().unwrap(),
             gyr.to_str().unwrap(),
             "--map",
-            &map("imu_tk-xsens.yaml"),
+            &import_map("imu_tk-xsens.yaml"),
             "--out",
             "run",
         ],
@@ -193,7 +186,7 @@ fn mpu6050_start_up_rest_and_poses_are_found() {
             "import",
             src.to_str().unwrap(),
             "--map",
-            &map("mpu6050.yaml"),
+            &import_map("mpu6050.yaml"),
             "--out",
             "run",
         ],

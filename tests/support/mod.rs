@@ -142,3 +142,11 @@ pub fn twin_changes(v: &serde_json::Value) -> Vec<(String, f64, f64, f64, bool)>
         })
         .collect()
 }
+
+/// The path of an import map of `docs/examples/import/` (`ferraris.yaml`).
+pub fn import_map(name: &str) -> String {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("docs/examples/import")
+        .join(name);
+    p.to_str().unwrap().to_string()
+}

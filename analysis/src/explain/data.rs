@@ -36,6 +36,9 @@ pub(crate) struct Data {
     /// Per accumulation: whether its segment is static (the table at rest at a known
     /// attitude).
     pub at_rest: Vec<bool>,
+    /// The factor on the library forms' consumer ranges for the IMU's grade
+    /// (`plausible::grade_scale`).
+    pub grade: f64,
     /// Whether the table stream is a table's feedback (not synthesized from declared
     /// attitudes by an import with `table: none`): table-side effects need it.
     pub table_feedback: bool,
@@ -159,6 +162,7 @@ impl Data {
             retime,
             left_out,
             table_feedback: has_table_feedback(m),
+            grade,
         })
     }
 

@@ -372,7 +372,6 @@ fn change_points(
     alpha: f64,
     findings: &mut Vec<Finding>,
 ) -> Vec<select::Refused> {
-    let grade = plausible::grade_scale(m.imu.get("grade").map(String::as_str));
     let library = discover::live_columns(data, terms);
     let all: Vec<usize> = (0..data.accs.len()).collect();
     let now = rms(data, whole, &all);
@@ -380,7 +379,7 @@ fn change_points(
     for cp in change::scan(data, whole, alpha, library) {
         let (sensor, _) = crate::fit::joint::channel(cp.channel);
         let form = probe::Form::Step { at: cp.at_s };
-        let max = grade * probe::range::max_abs(form, sensor, 0.0);
+        let max = data.grade * probe::range::max_abs(form, sensor, 0.0);
         match change_out::finding(m, data, &cp, alpha, max, now) {
             Ok(f) => {
                 let seg = &m.segments[data.accs[cp.acc].seg];
