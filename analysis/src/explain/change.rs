@@ -15,8 +15,10 @@
 use super::data::Data;
 use crate::fit::joint::Fit;
 
-/// Blocks (s) each side of a boundary in the window test.
-const WINDOW: usize = 60;
+/// Blocks (s) each side of a boundary in the window tests: a long window sees a small
+/// step through white noise, a short one sees a step through a wander that the step itself
+/// inflated (the fit's `q` counts the jump as wander).
+const WINDOWS: [usize; 3] = [5, 20, 60];
 /// Fewest blocks each side of a boundary.
 const LEAST: usize = 5;
 /// Most change points reported in one recording.
@@ -67,8 +69,8 @@ fn residuals(data: &Data, fit: &Fit, i: usize, c: usize) -> Vec<Res> {
 
 /// The windows at boundary `k` of `r` (between blocks k-1 and k): the jump of the mean,
 /// the samples before and after, and the span after (s).
-fn window(r: &[Res], k: usize) -> (f64, f64, f64, f64) {
-    let l = WINDOW.min(k).min(r.len() - k);
+fn window(r: &[Res], k: usize, width: usize) -> (f64, f64, f64, f64) {
+    let l = width.min(k).min(r.len() - k);
     let mean = |s: &[Res]| {
         let n: f64 = s.iter().map(|x| x.1).sum();
         (s.iter().map(|x| x.1 * x.2).sum::<f64>() / n, n)
@@ -79,16 +81,52 @@ fn window(r: &[Res], k: usize) -> (f64, f64, f64, f64) {
     (m2 - m1, n1, n2, span)
 }
 
-/// The window statistic at boundary `k`: (z, jump), white noise `white` per sample and
-/// wander `q` per second.
-fn window_z(r: &[Res], k: usize, white: f64, q: f64) -> (f64, f64) {
-    let (d, n1, n2, span) = window(r, k);
-    let var = white * (1.0 / n1 + 1.0 / n2) + q * 2.0 * span / 3.0;
-    (if var > 0.0 { d / var.sqrt() } else { 0.0 }, d)
+/// The wandering bias's intensity per second as estimated, with the degrees of freedom of
+/// that estimate (infinite when it is taken as known).
+#[derive(Debug, Clone, Copy)]
+struct Wander {
+    q: f64,
+    dof: f64,
 }
 
-/// Two-sided normal tail probability of `z` standard errors (chi-square of one degree).
-fn tail(z: f64) -> f64 {
+/// The window statistic at boundary `k`: (z, its degrees of freedom), white noise `white`
+/// per sample and the wander `w`. The white share of the variance is known (the fit has
+/// hundreds of thousands of samples behind it); the wander's share is estimated from a few
+/// dozen group differences, so the statistic is Student's t with the Satterthwaite degrees
+/// of freedom of the sum: a large wander estimated from little data does not make a
+/// Gauss-Markov excursion a step.
+fn window_z(r: &[Res], k: usize, width: usize, white: f64, w: Wander) -> (f64, f64) {
+    let (d, n1, n2, span) = window(r, k, width);
+    let var_white = white * (1.0 / n1 + 1.0 / n2);
+    let var_q = w.q * 2.0 * span / 3.0;
+    let var = var_white + var_q;
+    if var <= 0.0 {
+        return (0.0, f64::INFINITY);
+    }
+    let dof = if var_q > 0.0 && w.dof.is_finite() {
+        var * var / (var_q * var_q / w.dof)
+    } else {
+        f64::INFINITY
+    };
+    (d / var.sqrt(), dof)
+}
+
+/// The two-sided normal quantile of `alpha`: the fewest standard errors a single test at
+/// `alpha` needs.
+fn normal_quantile(alpha: f64) -> f64 {
+    use statrs::distribution::{ContinuousCDF, Normal};
+    Normal::standard().inverse_cdf(1.0 - (alpha / 2.0).clamp(1e-300, 0.5))
+}
+
+/// Two-sided tail probability of `z` standard errors: Student's t of `dof` degrees (the
+/// normal beyond a thousand).
+fn tail(z: f64, dof: f64) -> f64 {
+    use statrs::distribution::{ContinuousCDF, StudentsT};
+    if dof < 1e3
+        && let Ok(t) = StudentsT::new(0.0, 1.0, dof.max(1.0))
+    {
+        return (2.0 * t.sf(z.abs())).min(1.0);
+    }
     super::stats::p_value(z * z, 1)
 }
 
@@ -147,7 +185,11 @@ const GROUP: usize = 10;
 /// fit's estimate `q`, which a step inflates, is the fallback where the recording has too
 /// few pairs). For a random walk two group means `l` apart differ with variance
 /// `q (l - G/3)` beyond the white noise's share.
-fn wander(rs: &[Vec<Res>], white: f64, q: f64) -> f64 {
+///
+/// Its degrees of freedom: differences at the shortest lag two groups apart that share no
+/// group are independent, a third of the groups' count, and the median of a chi-square of
+/// one degree keeps about half of the mean's efficiency.
+fn wander(rs: &[Vec<Res>], white: f64, q: f64) -> Wander {
     let groups: Vec<Vec<Res>> = rs
         .iter()
         .map(|r| {
@@ -181,44 +223,85 @@ fn wander(rs: &[Vec<Res>], white: f64, q: f64) -> f64 {
         per_lag.push((excess / (factor / n)).max(0.0));
     }
     if per_lag.is_empty() {
-        return q;
+        return Wander {
+            q,
+            dof: f64::INFINITY,
+        };
     }
     per_lag.sort_by(f64::total_cmp);
-    per_lag[per_lag.len() / 2]
+    let groups: usize = groups.iter().map(|g| g.len().saturating_sub(2)).sum();
+    Wander {
+        q: per_lag[per_lag.len() / 2],
+        dof: (groups as f64 / 6.0).max(1.0),
+    }
 }
 
 /// Every change point the final model `fit` leaves, strongest first; `library` is the
 /// number of library columns the discovery tested (they share the threshold).
 pub(crate) fn scan(data: &Data, fit: &Fit, alpha: f64, library: usize) -> Vec<ChangePoint> {
-    let mut tried: Vec<(usize, usize, Vec<Res>, usize, f64)> = Vec::new();
+    // (segment, channel, residuals, z and p at the boundary of least p).
+    let mut tried: Vec<(usize, usize, Vec<Res>, f64, f64)> = Vec::new();
     let mut positions = 0usize;
+    let least_z = normal_quantile(alpha);
+    let debug = std::env::var_os("RATECAL_EXPLAIN_DEBUG").is_some();
     for c in 0..6 {
         let nz = &fit.noise[c];
         let white = nz.sigma * nz.sigma * nz.phi;
         let rs: Vec<Vec<Res>> = (0..data.accs.len())
             .map(|i| residuals(data, fit, i, c))
             .collect();
-        let q = wander(&rs, white, nz.q);
+        // The fit's wander (every lag, mean squares) unless the robust estimate says more:
+        // a step inflates the fit's, which the short windows see through; the robust one,
+        // from few pairs with white noise dominating, can fall far below the truth.
+        let robust = wander(&rs, white, nz.q);
+        let q = if nz.q >= robust.q {
+            Wander {
+                q: nz.q,
+                dof: f64::INFINITY,
+            }
+        } else {
+            robust
+        };
         for (i, r) in rs.into_iter().enumerate() {
             if r.len() < 2 * LEAST {
                 continue;
             }
-            let (mut best_k, mut best_z) = (0, 0.0f64);
+            let (mut best_z, mut best_p) = (0.0f64, 1.0f64);
             for k in LEAST..=r.len() - LEAST {
-                positions += 1;
-                let (z, _) = window_z(&r, k, white, q);
-                if z.abs() > best_z.abs() {
-                    (best_k, best_z) = (k, z);
+                let room = k.min(r.len() - k);
+                for (j, &width) in WINDOWS.iter().enumerate() {
+                    // A wider window that the segment's edge cuts to the last one's width
+                    // is the same test again.
+                    if j > 0 && room <= WINDOWS[j - 1] {
+                        break;
+                    }
+                    positions += 1;
+                    let (z, dof) = window_z(&r, k, width, white, q);
+                    // Where even the normal tail exceeds alpha before any correction, the
+                    // position cannot be a change point: not worth the t's cost.
+                    if z.abs() < least_z {
+                        continue;
+                    }
+                    let p = tail(z, dof);
+                    if p < best_p {
+                        (best_z, best_p) = (z, p);
+                    }
                 }
             }
-            tried.push((i, c, r, best_k, best_z));
+            if debug && best_p < 1e-3 {
+                eprintln!(
+                    "change: ch {c} seg {i} q {:.3e} (fit {:.3e}) dof {:.1} white {white:.3e} z {best_z:.2} p {best_p:.2e}",
+                    q.q, nz.q, q.dof
+                );
+            }
+            tried.push((i, c, r, best_z, best_p));
         }
     }
     let m = (positions + library).max(1) as f64;
     let mut out: Vec<ChangePoint> = tried
         .into_iter()
-        .filter(|t| tail(t.4) * m < alpha)
-        .map(|(i, c, r, _, z)| {
+        .filter(|t| t.4 * m < alpha)
+        .map(|(i, c, r, z, p)| {
             let nz = &fit.noise[c];
             let (at_s, u_at_s, size, u_size) = locate(&r, nz.sigma * nz.sigma * nz.phi);
             ChangePoint {
@@ -229,7 +312,7 @@ pub(crate) fn scan(data: &Data, fit: &Fit, alpha: f64, library: usize) -> Vec<Ch
                 size,
                 u_size,
                 z,
-                p: (tail(z) * m).min(1.0),
+                p: (p * m).min(1.0),
             }
         })
         .collect();

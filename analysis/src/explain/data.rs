@@ -189,7 +189,7 @@ impl Data {
             accel: accel.iter().map(|&i| &self.accs[i]).collect(),
             gyro: gyro.iter().map(|&i| &self.accs[i]).collect(),
             merged: None,
-            white_only: false,
+            wander: crate::fit::joint::WanderRule::Estimated,
         };
         let m = std::sync::Arc::new(crate::fit::joint::merge(&req));
         let mut cache = self.merged.lock().expect("not poisoned");

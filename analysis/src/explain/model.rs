@@ -3,7 +3,7 @@
 
 use super::data::Data;
 pub(crate) use crate::fit::joint::Terms;
-use crate::fit::joint::{Fit, fit_terms_merged, rss_on, seg_rss};
+use crate::fit::joint::{Fit, WanderRule, fit_terms_merged, rss_on, seg_rss};
 use crate::plan::Plan;
 use crate::recording::{Manifest, SegmentKind};
 use ratecal_physics::effects::EarthRate;
@@ -81,16 +81,17 @@ pub(crate) fn fit(
     accel: &[usize],
     gyro: &[usize],
 ) -> (Fit, Vec<usize>) {
-    fit_with(data, terms, accel, gyro, false)
+    fit_with(data, terms, accel, gyro, WanderRule::Estimated)
 }
 
-/// [`fit`] with a white-noise covariance only (`white_only`): to rank many models cheaply.
+/// [`fit`] with the wandering bias taken as `wander` says (white noise only ranks many
+/// models cheaply).
 pub(crate) fn fit_with(
     data: &Data,
     terms: &Terms,
     accel: &[usize],
     gyro: &[usize],
-    white_only: bool,
+    wander: WanderRule,
 ) -> (Fit, Vec<usize>) {
     let merged = data.merged(accel, gyro);
     fit_terms_merged(
@@ -101,7 +102,7 @@ pub(crate) fn fit_with(
         accel,
         gyro,
         Some(&merged),
-        white_only,
+        wander,
     )
 }
 

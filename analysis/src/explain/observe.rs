@@ -20,7 +20,7 @@ use super::model::{Terms, fit_with};
 use super::output::NotObservable;
 use super::plausible::max_abs;
 use super::probe::Form;
-use crate::fit::joint::CHANNELS;
+use crate::fit::joint::{CHANNELS, WanderRule};
 use rayon::prelude::*;
 
 /// What the recording cannot determine: columns to leave out and the entries to report.
@@ -85,7 +85,7 @@ fn check(data: &Data, start: &Terms, e: usize) -> Vec<(usize, Why)> {
     let work = data.working();
     let mut t = start.clone();
     t.effects.push(e);
-    let (f, _) = fit_with(data, &t, &work, &work, true);
+    let (f, _) = fit_with(data, &t, &work, &work, WanderRule::WhiteOnly);
     cols.into_iter()
         .filter_map(|g| {
             if !f.estimated.contains(&g) {

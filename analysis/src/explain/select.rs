@@ -9,7 +9,7 @@
 use super::data::Data;
 use super::model::{Terms, fit, fit_with, misfit};
 use super::stats::{p_value, score, wald};
-use crate::fit::joint::Fit;
+use crate::fit::joint::{Fit, WanderRule};
 use ratecal_physics::effects::Sensor;
 
 /// One accepted step.
@@ -95,7 +95,7 @@ pub(crate) fn screen(data: &Data, terms: &Terms, segs: &[usize], keep: usize) ->
         .map(|&(e, p)| {
             let mut t = terms.clone();
             t.effects.push(e);
-            let (f, _) = fit_with(data, &t, segs, segs, true);
+            let (f, _) = fit_with(data, &t, segs, segs, WanderRule::WhiteOnly);
             let cols: Vec<usize> = lay.columns_of(e).collect();
             (e, p.sensor, wald(&f, &cols).0)
         })

@@ -29,8 +29,15 @@ fn block_mean(b: &Block, c: usize, nonzero: &[(usize, f64)]) -> f64 {
     s / b.n as f64
 }
 
-/// Estimates the noise of channel `c` over the fitted segments.
-pub(crate) fn estimate(accs: &[&SegAcc], c: usize, theta_c: &[f64], sigma: f64) -> ChannelNoise {
+/// Estimates the noise of channel `c` over the fitted segments; the wander only when
+/// `wander` (a white-noise covariance has no use for it).
+pub(crate) fn estimate(
+    accs: &[&SegAcc],
+    c: usize,
+    theta_c: &[f64],
+    sigma: f64,
+    wander: bool,
+) -> ChannelNoise {
     // White-equivalent variance of a sample from adjacent one-second blocks.
     let (mut num, mut den) = (0.0, 0.0);
     // Random walk from ten-second groups.
@@ -52,6 +59,9 @@ pub(crate) fn estimate(accs: &[&SegAcc], c: usize, theta_c: &[f64], sigma: f64) 
             let (n1, n2) = (w[0].1 as f64, w[1].1 as f64);
             num += (w[1].2 - w[0].2).powi(2);
             den += 1.0 / n1 + 1.0 / n2;
+        }
+        if !wander {
+            continue;
         }
         groups.clear();
         for chunk in means.chunks(10) {

@@ -25,9 +25,18 @@ pub(crate) struct FitRequest<'a> {
     /// The channels' factors over exactly these segments, when the caller keeps them
     /// ([`merge`]): many models over the same segments then share one merge.
     pub merged: Option<&'a [DMatrix<f64>]>,
-    /// Whether the covariance may omit the wandering bias (white noise only): a cheap
-    /// screen of many models, never a reported uncertainty.
-    pub white_only: bool,
+    /// How the covariance takes the wandering bias.
+    pub wander: WanderRule,
+}
+
+/// How a fit's covariance takes the wandering bias.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum WanderRule {
+    /// As the residuals estimate it (pooled per sensor).
+    Estimated,
+    /// Left out (white noise only): a cheap screen of many models, never a reported
+    /// uncertainty.
+    WhiteOnly,
 }
 
 /// A solved model.
@@ -166,8 +175,12 @@ pub(crate) fn solve(req: &FitRequest) -> Fit {
                 .count();
             let dof = n[c].saturating_sub(pc).max(1) as f64;
             let sigma = (rss[c] / dof).sqrt();
-            let theta_c: Vec<f64> = lay.by_channel[c].iter().map(|&g| full[g]).collect();
-            noise[c] = noise::estimate(req.segs(c), c, &theta_c, sigma);
+            // The first pass only weighs the channels: their noise is the second's.
+            if pass == 1 {
+                let theta_c: Vec<f64> = lay.by_channel[c].iter().map(|&g| full[g]).collect();
+                let wander = req.wander != WanderRule::WhiteOnly;
+                noise[c] = noise::estimate(req.segs(c), c, &theta_c, sigma, wander);
+            }
             if pass == 0 {
                 w[c] = if sigma > 0.0 {
                     1.0 / (sigma * sigma)
@@ -210,7 +223,7 @@ pub(crate) fn solve(req: &FitRequest) -> Fit {
         let nz = &noise[c];
         let white = nz.sigma * nz.sigma * nz.phi;
         meat += (xl.transpose() * &xl) * (w[c] * w[c] * white);
-        if nz.q > 0.0 && !req.white_only {
+        if nz.q > 0.0 && req.wander != WanderRule::WhiteOnly {
             let m = noise::random_walk_gram(req.segs(c), c, &local, p);
             meat += m * (w[c] * w[c] * nz.q);
         }

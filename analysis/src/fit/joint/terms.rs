@@ -1,7 +1,7 @@
 //! A model under test: registry effects fitted, some held at known values, over a set of
 //! segments per sensor; and how much each segment excites each column.
 
-use super::{Fit, FitRequest, Layout, SegAcc, solve};
+use super::{Fit, FitRequest, Layout, SegAcc, WanderRule, solve};
 use ratecal_physics::effects::{EarthRate, Sensor};
 
 /// Effects (layout indices) and fixed values of a model.
@@ -70,11 +70,20 @@ pub(crate) fn fit_terms(
     accel: &[usize],
     gyro: &[usize],
 ) -> (Fit, Vec<usize>) {
-    fit_terms_merged(layout, accs, excitation, terms, accel, gyro, None, false)
+    fit_terms_merged(
+        layout,
+        accs,
+        excitation,
+        terms,
+        accel,
+        gyro,
+        None,
+        WanderRule::Estimated,
+    )
 }
 
 /// [`fit_terms`] with the channels' factors over these segments already merged
-/// ([`super::solve::merge`]); `white_only` leaves the wandering bias out of the covariance.
+/// ([`super::solve::merge`]); `wander` says how the covariance takes the wandering bias.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn fit_terms_merged(
     layout: &Layout,
@@ -84,7 +93,7 @@ pub(crate) fn fit_terms_merged(
     accel: &[usize],
     gyro: &[usize],
     merged: Option<&[nalgebra::DMatrix<f64>]>,
-    white_only: bool,
+    wander: WanderRule,
 ) -> (Fit, Vec<usize>) {
     let mut cols = Vec::new();
     let mut weak = Vec::new();
@@ -130,7 +139,7 @@ pub(crate) fn fit_terms_merged(
         accel: accel.iter().map(|&i| &accs[i]).collect(),
         gyro: gyro.iter().map(|&i| &accs[i]).collect(),
         merged,
-        white_only,
+        wander,
     };
     let f = solve(&req);
     let mut unobs = f.unobservable.clone();
