@@ -48,7 +48,7 @@ pub(crate) struct Data {
 /// session that no body axis is near vertical in (`up: oblique`). Its specific force is
 /// not the table stream's, so no fit may use it as such.
 fn attitude_unknown(s: &crate::recording::Segment) -> bool {
-    s.up.as_deref() == Some("oblique")
+    s.is_oblique()
 }
 
 /// Whether the manifest's table stream is a table's feedback: `ratecal import` names a

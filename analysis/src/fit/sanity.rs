@@ -85,7 +85,7 @@ pub(crate) fn recording_checks(
     ]
 }
 
-fn time_increasing(imu: &CadenceReport, table: &CadenceReport) -> SanityCheck {
+pub(crate) fn time_increasing(imu: &CadenceReport, table: &CadenceReport) -> SanityCheck {
     let name = "time_increasing";
     for (file, c) in [("imu.csv", imu), ("table.csv", table)] {
         if let Some((prev, t)) = c.backwards {
@@ -103,7 +103,7 @@ fn time_increasing(imu: &CadenceReport, table: &CadenceReport) -> SanityCheck {
     )
 }
 
-fn clocks_overlap(imu: (f64, f64), table: &TableStream) -> SanityCheck {
+pub(crate) fn clocks_overlap(imu: (f64, f64), table: &TableStream) -> SanityCheck {
     let name = "clocks_overlap";
     let (Some(&t0), Some(&t1)) = (table.t.first(), table.t.last()) else {
         return SanityCheck::new(name, SanityStatus::Fail, "table.csv holds no samples");
@@ -129,7 +129,7 @@ fn clocks_overlap(imu: (f64, f64), table: &TableStream) -> SanityCheck {
 }
 
 /// Gaps and jitter are counted and located in a warning; they never refuse a recording.
-fn sampling(imu: &CadenceReport, table: &CadenceReport, warnings: &mut Vec<String>) -> SanityCheck {
+pub(crate) fn sampling(imu: &CadenceReport, table: &CadenceReport, warnings: &mut Vec<String>) -> SanityCheck {
     let mut parts = Vec::new();
     for (file, c) in [("imu.csv", imu), ("table.csv", table)] {
         let hz = 1.0 / c.nominal_step_s;
@@ -319,7 +319,7 @@ fn gyro_follows_table(moving: &[(&RawSums, &str)], rest: &[(&RawSums, &str)]) ->
 
 /// The entry of a check judged segment by segment: `fail` when the worst segment exceeds
 /// its tolerance (with `hint`), `pass` with the worst one's figures, or `not_evaluated`.
-fn verdict(name: &str, worst: Option<(f64, String)>, none: &str, hint: &str) -> SanityCheck {
+pub(crate) fn verdict(name: &str, worst: Option<(f64, String)>, none: &str, hint: &str) -> SanityCheck {
     match worst {
         None => SanityCheck::new(name, SanityStatus::NotEvaluated, none),
         Some((excess, detail)) if excess > 0.0 || excess.is_nan() => {
