@@ -333,12 +333,25 @@ pub(crate) fn verdict(name: &str, worst: Option<(f64, String)>, none: &str, hint
 /// and size-effect coordinates inside the ranges an IMU of any grade and a table have (a scale factor of -90 % is a units error, not a
 /// calibration).
 pub(crate) fn plausible(params: &BTreeMap<String, Parameter>) -> SanityCheck {
+    plausible_with(params, ACCEL_BIAS_MAX)
+}
+
+/// Largest plausible accelerometer offset of a part calibrated without a table, m/s^2:
+/// consumer parts' raw offsets reach hundreds of mg (the MPU-6050 session: 115 mg), and
+/// a manual calibration is the first one they get.
+pub const ACCEL_OFFSET_MAX_MANUAL: f64 = 5.0;
+
+/// [`plausible`] with the accelerometer bias allowed up to `accel_bias_max`, m/s^2.
+pub(crate) fn plausible_with(
+    params: &BTreeMap<String, Parameter>,
+    accel_bias_max: f64,
+) -> SanityCheck {
     let name = "fitted_values_plausible";
     let rule = |n: &str, unit: &str| -> Option<f64> {
         let kind = n.split('.').nth(1)?;
         match (n.split('.').next()?, kind, unit) {
             ("accel" | "gyro", "scale", "ppm") => Some(SCALE_MAX * 1e6),
-            ("accel", "bias", "m/s^2") => Some(ACCEL_BIAS_MAX),
+            ("accel", "bias", "m/s^2") => Some(accel_bias_max),
             ("gyro", "bias", "deg/s") => Some(GYRO_BIAS_MAX),
             ("accel" | "gyro", "misalignment", "mrad") => Some(MISALIGNMENT_MAX),
             ("size_effect", _, "mm") => Some(SIZE_EFFECT_MAX_MM),
@@ -374,7 +387,7 @@ pub(crate) fn plausible(params: &BTreeMap<String, Parameter>) -> SanityCheck {
             name,
             SanityStatus::Pass,
             format!(
-                "{checked} fitted values within +-{:.0} % scale, +-{ACCEL_BIAS_MAX} m/s^2 and +-{GYRO_BIAS_MAX} deg/s bias, +-{MISALIGNMENT_MAX} mrad misalignment, +-{LEVER_ARM_MAX_MM} mm lever arm, +-{SIZE_EFFECT_MAX_MM} mm size effect",
+                "{checked} fitted values within +-{:.0} % scale, +-{accel_bias_max} m/s^2 and +-{GYRO_BIAS_MAX} deg/s bias, +-{MISALIGNMENT_MAX} mrad misalignment, +-{LEVER_ARM_MAX_MM} mm lever arm, +-{SIZE_EFFECT_MAX_MM} mm size effect",
                 SCALE_MAX * 100.0
             ),
         )

@@ -117,7 +117,7 @@ pub(crate) fn analyze<S: Source>(src: &S, plan: Option<&Plan>, opts: &Options) -
     }
     let manual = summary(&data, &fitted, g, &params);
     let mut sanity = checks::checks(m, src, &data, fitted.accel.as_ref().map(|a| &a.triad), g, &mut warnings);
-    sanity.push(sanity::plausible(&params));
+    sanity.push(sanity::plausible_with(&params, sanity::ACCEL_OFFSET_MAX_MANUAL));
     let (rows, extent) = (src.imu_rows(), src.imu_extent());
     let step = if rows > 1 { (extent.1 - extent.0) / (rows - 1) as f64 } else { f64::NAN };
     let mut res = Results {
