@@ -165,9 +165,9 @@ fn mpu6050_hand_held_session_reports_nothing_implausible() {
     let x = import_and_explain(tmp.path(), &[csv], "mpu6050.yaml");
     sound(&x, "mpu6050");
     lists_what_a_table_would_show(&x, "mpu6050");
-    // Its oblique poses have no known attitude: left out, and said so.
+    // Its hand-held poses have no known attitude: left out, and said so.
     let w = x["warnings"].to_string();
-    assert!(w.contains("up: oblique"), "{w}");
+    assert!(w.contains("attitude: unknown"), "{w}");
 }
 
 #[test]

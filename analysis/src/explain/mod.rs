@@ -172,8 +172,9 @@ pub(crate) fn explain_fitted(
     };
     if !data.left_out.is_empty() {
         warnings.push(format!(
-            "{} static segments with no body axis near vertical (up: oblique) are left out: \
-             explain needs each segment's attitude ({})",
+            "{} static segments of unknown attitude (attitude: unknown, or an old recording's \
+             up: oblique) are left out: explain needs each segment's attitude, and a hand-held \
+             pose has none to tilt ({})",
             data.left_out.len(),
             data.left_out.join(", ")
         ));
