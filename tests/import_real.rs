@@ -156,7 +156,11 @@ fn imu_tk_xsens_poses_are_found_and_static_by_the_factory_calibration() {
     let r = json(&tmp.path().join("results.json"));
     for s in r["segments"].as_array().unwrap() {
         let used = s["used_for"].as_array().unwrap();
-        let want = if s["kind"] == "static" { "accel" } else { "gyro_full" };
+        let want = if s["kind"] == "static" {
+            "accel"
+        } else {
+            "gyro_full"
+        };
         assert!(used.iter().any(|u| u == want), "{}: {used:?}", s["id"]);
     }
 }

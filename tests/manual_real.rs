@@ -14,7 +14,12 @@ use std::path::{Path, PathBuf};
 fn calibrate(dir: &Path, sources: &[PathBuf], map: &str) -> Value {
     let mut args = vec!["import".to_string()];
     args.extend(sources.iter().map(|p| p.display().to_string()));
-    args.extend(["--map".into(), import_map(map), "--out".into(), "run".into()]);
+    args.extend([
+        "--map".into(),
+        import_map(map),
+        "--out".into(),
+        "run".into(),
+    ]);
     let a: Vec<&str> = args.iter().map(String::as_str).collect();
     let o = ratecal(&a, dir);
     assert_eq!(code(&o), 0, "{}", text(&o));
@@ -86,11 +91,17 @@ fn imu_tk_xsens_poses_read_the_authors_gravity_and_turns_carry_it() {
     let m_acc = [[1.00, 0.00, -0.01], [0.01, 1.00, 0.01], [0.02, 0.01, 1.00]];
     let km: [[f64; 3]; 3] = std::array::from_fn(|i| m_acc[i].map(|v| v * kf[i]));
     let mut sq = 0.0;
-    for s in r["segments"].as_array().unwrap().iter().filter(|s| s["kind"] == "static") {
+    for s in r["segments"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|s| s["kind"] == "static")
+    {
         let (t0, t1) = (s["t_start"].as_f64().unwrap(), s["t_end"].as_f64().unwrap());
         let w: Vec<&Vec<f64>> = rows.iter().filter(|x| x[0] >= t0 && x[0] <= t1).collect();
-        let raw: [f64; 3] =
-            std::array::from_fn(|j| w.iter().map(|x| x[j + 1]).sum::<f64>() / w.len() as f64 - offset[j]);
+        let raw: [f64; 3] = std::array::from_fn(|j| {
+            w.iter().map(|x| x[j + 1]).sum::<f64>() / w.len() as f64 - offset[j]
+        });
         // x = inv(K M) raw, by Jacobi sweeps (K M is near diagonal).
         let mut x = [0.0; 3];
         for _ in 0..30 {
@@ -102,7 +113,11 @@ fn imu_tk_xsens_poses_read_the_authors_gravity_and_turns_carry_it() {
         sq += ((x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt() - 9.81744).powi(2);
     }
     let factory = (sq / poses.len() as f64).sqrt();
-    println!("xsens: |a| - 9.81744 RMS over {} poses: {after:.5} m/s^2 calibrated, {factory:.5} with the factory calibration, {:.4} raw", poses.len(), man["gravity_rms_raw_mps2"]);
+    println!(
+        "xsens: |a| - 9.81744 RMS over {} poses: {after:.5} m/s^2 calibrated, {factory:.5} with the factory calibration, {:.4} raw",
+        poses.len(),
+        man["gravity_rms_raw_mps2"]
+    );
     assert!(after <= 0.005, "{after}");
     assert!(factory > 2.0 * after, "factory {factory}, ours {after}");
 
@@ -112,7 +127,11 @@ fn imu_tk_xsens_poses_read_the_authors_gravity_and_turns_carry_it() {
         man["turn_rms_nominal_deg"].as_f64().unwrap(),
         man["turn_rms_calibrated_deg"].as_f64().unwrap(),
     );
-    println!("xsens: turns {}: RMS miss {nom:.3} deg nominal, {cal:.3} deg calibrated ({:.1} x)", man["turns"].as_array().unwrap().len(), nom / cal);
+    println!(
+        "xsens: turns {}: RMS miss {nom:.3} deg nominal, {cal:.3} deg calibrated ({:.1} x)",
+        man["turns"].as_array().unwrap().len(),
+        nom / cal
+    );
     assert!(man["turns"].as_array().unwrap().len() + 1 >= poses.len());
     assert!(nom >= 3.0 * cal, "{nom} vs {cal}");
     factory_comparison(&r);
@@ -131,7 +150,13 @@ fn factory_comparison(r: &Value) {
     for i in 0..3 {
         let (b, u) = est(r, &format!("accel.bias.{}", AX[i])).unwrap();
         let counts = 32768.0 + b * 414.0;
-        println!("xsens: accel offset {}: {counts:.1} counts, factory {} ({:+.1} counts, {:+.1} u)", AX[i], offset[i], counts - offset[i], (counts - offset[i]) / (u * 414.0));
+        println!(
+            "xsens: accel offset {}: {counts:.1} counts, factory {} ({:+.1} counts, {:+.1} u)",
+            AX[i],
+            offset[i],
+            counts - offset[i],
+            (counts - offset[i]) / (u * 414.0)
+        );
         assert!((counts - offset[i]).abs() <= 10.0);
     }
     let ka = [415.0, 413.0, 415.0];
@@ -139,7 +164,11 @@ fn factory_comparison(r: &Value) {
     let f: [[f64; 3]; 3] = std::array::from_fn(|i| m_acc[i].map(|v| v * ka[i] / 414.0));
     let (u_f, q) = rq(f);
     let kg = [4778.0, 4758.0, 4766.0];
-    let m_g = [[1.00, -0.01, -0.02], [0.00, 1.00, 0.04], [-0.01, 0.01, 1.00]];
+    let m_g = [
+        [1.00, -0.01, -0.02],
+        [0.00, 1.00, 0.04],
+        [-0.01, 0.01, 1.00],
+    ];
     let g: [[f64; 3]; 3] = std::array::from_fn(|i| m_g[i].map(|v| v * kg[i] / 4767.0));
     let qt: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| q[j][i]));
     let g_ours = mat_mul(g, qt);
@@ -149,11 +178,20 @@ fn factory_comparison(r: &Value) {
                 let (key, want) = if i == j {
                     (format!("{sensor}.scale.{}", AX[i]), (fac[i][i] - 1.0) * 1e6)
                 } else {
-                    (format!("{sensor}.misalignment.{}{}", AX[i], AX[j]), fac[i][j] * 1e3)
+                    (
+                        format!("{sensor}.misalignment.{}{}", AX[i], AX[j]),
+                        fac[i][j] * 1e3,
+                    )
                 };
                 match est(r, &key) {
-                    Some((v, u)) => println!("xsens: {key}: {v:.1} +- {u:.1}, factory {want:.1} ({:+.1} u)", (v - want) / u),
-                    None => assert!(fac[i][j].abs() < 1e-12, "{key}: the convention fixes it at 0"),
+                    Some((v, u)) => println!(
+                        "xsens: {key}: {v:.1} +- {u:.1}, factory {want:.1} ({:+.1} u)",
+                        (v - want) / u
+                    ),
+                    None => assert!(
+                        fac[i][j].abs() < 1e-12,
+                        "{key}: the convention fixes it at 0"
+                    ),
                 }
             }
         }
@@ -162,7 +200,13 @@ fn factory_comparison(r: &Value) {
     for i in 0..3 {
         let (b, u) = est(r, &format!("gyro.bias.{}", AX[i])).unwrap();
         let counts = 32768.0 + b.to_radians() * 4767.0;
-        println!("xsens: gyro offset {}: {counts:.1} counts, factory {} ({:+.1} counts, {:+.1} u)", AX[i], off_g[i], counts - off_g[i], (counts - off_g[i]) / (u.to_radians() * 4767.0));
+        println!(
+            "xsens: gyro offset {}: {counts:.1} counts, factory {} ({:+.1} counts, {:+.1} u)",
+            AX[i],
+            off_g[i],
+            counts - off_g[i],
+            (counts - off_g[i]) / (u.to_radians() * 4767.0)
+        );
     }
 }
 
@@ -184,13 +228,23 @@ fn imucal_ferraris_session_recovers_imucals_calibration() {
         for i in 0..3 {
             let (v, u) = est(&r, &format!("{sensor}.scale.{}", AX[i])).unwrap();
             let want = (m(k, i, i) - 1.0) * 1e6;
-            println!("imucal: {sensor}.scale.{}: {v:.0} +- {u:.0} ppm, imucal {want:.0} ({:+.3} %)", AX[i], (v - want) * 1e-4);
-            assert!((v - want).abs() <= 5000.0 && (v - want).abs() <= u, "{sensor} scale {i}");
+            println!(
+                "imucal: {sensor}.scale.{}: {v:.0} +- {u:.0} ppm, imucal {want:.0} ({:+.3} %)",
+                AX[i],
+                (v - want) * 1e-4
+            );
+            assert!(
+                (v - want).abs() <= 5000.0 && (v - want).abs() <= u,
+                "{sensor} scale {i}"
+            );
             for j in (0..3).filter(|&j| j != i) {
                 let key = format!("{sensor}.misalignment.{}{}", AX[i], AX[j]);
                 let (v, u) = est(&r, &key).unwrap();
                 let want = 1e3 * m(k, i, i) * m(rm, i, j);
-                println!("imucal: {key}: {v:.2} +- {u:.2} mrad, imucal {want:.2} ({:+.2} mrad)", v - want);
+                println!(
+                    "imucal: {key}: {v:.2} +- {u:.2} mrad, imucal {want:.2} ({:+.2} mrad)",
+                    v - want
+                );
                 assert!((v - want).abs() <= 1.5 && (v - want).abs() <= u, "{key}");
             }
         }
@@ -219,7 +273,11 @@ fn mpu6050_eight_poses_determine_bias_and_scale_only() {
     let g = man["gravity_mps2"].as_f64().unwrap();
     let before = man["gravity_rms_raw_mps2"].as_f64().unwrap() / g;
     let after = man["gravity_rms_calibrated_mps2"].as_f64().unwrap() / g;
-    println!("mpu6050: |a| - 1 g RMS over 8 poses: {:.2} % raw, {:.3} % calibrated", 100.0 * before, 100.0 * after);
+    println!(
+        "mpu6050: |a| - 1 g RMS over 8 poses: {:.2} % raw, {:.3} % calibrated",
+        100.0 * before,
+        100.0 * after
+    );
     assert!((0.055..0.075).contains(&before), "{before}");
     assert!(after <= 0.005, "{after}");
 }

@@ -96,7 +96,11 @@ fn print_summary(map: &ImportMap, s: &Summary) {
             (SegmentKind::Static, Some(u), _) => u.name(),
             (_, _, Some((a, r))) => format!("{} {r} deg/s", a.name()),
             (SegmentKind::Turn, _, _) => match f.turn.and_then(|t| t.axis.zip(t.angle_deg)) {
-                Some(((k, s), a)) => format!("{}{} {a} deg", if s < 0.0 { "-" } else { "" }, ["x", "y", "z"][k]),
+                Some(((k, s), a)) => format!(
+                    "{}{} {a} deg",
+                    if s < 0.0 { "-" } else { "" },
+                    ["x", "y", "z"][k]
+                ),
                 None => "free".into(),
             },
             _ => String::new(),

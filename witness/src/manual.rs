@@ -87,7 +87,8 @@ fn profile(s: f64, uneven: f64) -> f64 {
 fn profile_rate(s: f64, uneven: f64) -> f64 {
     let pi = std::f64::consts::PI;
     let base = 1.0 - (2.0 * pi * s).cos();
-    let dg = 4.0 * pi * (4.0 * pi * s).sin() * s * (1.0 - s) + (1.0 - (4.0 * pi * s).cos()) * (1.0 - 2.0 * s);
+    let dg = 4.0 * pi * (4.0 * pi * s).sin() * s * (1.0 - s)
+        + (1.0 - (4.0 * pi * s).cos()) * (1.0 - 2.0 * s);
     base + uneven * dg
 }
 
@@ -131,22 +132,54 @@ fn plan(s: &ManualSession, rng: &mut ChaCha8Rng) -> (Vec<Piece>, String) {
                 for sign in [1.0, -1.0] {
                     let tilt = rot::rodrigues(
                         unit([gauss(rng), gauss(rng), 0.0]),
-                        s.tilt_deg.to_radians() * (gauss(rng).powi(2) + gauss(rng).powi(2)).sqrt() / 2f64.sqrt(),
+                        s.tilt_deg.to_radians() * (gauss(rng).powi(2) + gauss(rng).powi(2)).sqrt()
+                            / 2f64.sqrt(),
                     );
                     let target = rot::mul(&tilt, &face(j, sign));
                     move_to(&mut pieces, &mut c, target, 3.0);
-                    let id = format!("{}_{}", ["x", "y", "z"][j], if sign > 0.0 { "up" } else { "down" });
-                    let _ = writeln!(segs, "  - {{ id: {id}, kind: static, up: {}{}, attitude: nominal, tolerance_deg: {tol}, T }}", if sign > 0.0 { "+" } else { "-" }, ["x", "y", "z"][j]);
-                    pieces.push(Piece { c0: c, axis: [0.0, 0.0, 1.0], angle: 0.0, dur: 6.0, seg: Some(id.clone()) });
+                    let id = format!(
+                        "{}_{}",
+                        ["x", "y", "z"][j],
+                        if sign > 0.0 { "up" } else { "down" }
+                    );
+                    let _ = writeln!(
+                        segs,
+                        "  - {{ id: {id}, kind: static, up: {}{}, attitude: nominal, tolerance_deg: {tol}, T }}",
+                        if sign > 0.0 { "+" } else { "-" },
+                        ["x", "y", "z"][j]
+                    );
+                    pieces.push(Piece {
+                        c0: c,
+                        axis: [0.0, 0.0, 1.0],
+                        angle: 0.0,
+                        dur: 6.0,
+                        seg: Some(id.clone()),
+                    });
                     if sign > 0.0 {
                         // A turn about the lab's vertical, the face's axis within its tilt.
                         let axis = rot::mul_tv(&c, [0.0, 0.0, 1.0]);
                         let angle = (-360.0 + tol * gauss(rng)).to_radians();
                         let rid = format!("{}_rot", ["x", "y", "z"][j]);
-                        let _ = writeln!(segs, "  - {{ id: {rid}, kind: turn, axis: {}, angle_deg: -360, T }}", ["x", "y", "z"][j]);
-                        pieces.push(Piece { c0: c, axis, angle, dur: 4.0, seg: Some(rid) });
+                        let _ = writeln!(
+                            segs,
+                            "  - {{ id: {rid}, kind: turn, axis: {}, angle_deg: -360, T }}",
+                            ["x", "y", "z"][j]
+                        );
+                        pieces.push(Piece {
+                            c0: c,
+                            axis,
+                            angle,
+                            dur: 4.0,
+                            seg: Some(rid),
+                        });
                         c = rot::mul(&c, &rot::rodrigues(axis, angle));
-                        pieces.push(Piece { c0: c, axis: [0.0, 0.0, 1.0], angle: 0.0, dur: 1.0, seg: None });
+                        pieces.push(Piece {
+                            c0: c,
+                            axis: [0.0, 0.0, 1.0],
+                            angle: 0.0,
+                            dur: 1.0,
+                            seg: None,
+                        });
                     }
                 }
             }
@@ -155,14 +188,34 @@ fn plan(s: &ManualSession, rng: &mut ChaCha8Rng) -> (Vec<Piece>, String) {
             let mut c = rot::rodrigues(random_axis(rng), rng.random::<f64>() * 3.0);
             for k in 0..=poses {
                 let id = format!("pose/{k:02}");
-                let dur = if k == 0 { 30.0 } else { 4.0 + 2.0 * rng.random::<f64>() };
-                let _ = writeln!(segs, "  - {{ id: {id}, kind: static, attitude: unknown, T }}");
-                pieces.push(Piece { c0: c, axis: [0.0, 0.0, 1.0], angle: 0.0, dur, seg: Some(id) });
+                let dur = if k == 0 {
+                    30.0
+                } else {
+                    4.0 + 2.0 * rng.random::<f64>()
+                };
+                let _ = writeln!(
+                    segs,
+                    "  - {{ id: {id}, kind: static, attitude: unknown, T }}"
+                );
+                pieces.push(Piece {
+                    c0: c,
+                    axis: [0.0, 0.0, 1.0],
+                    angle: 0.0,
+                    dur,
+                    seg: Some(id),
+                });
                 if k < poses {
                     let axis = random_axis(rng);
-                    let angle = (50.0 + 100.0 * rng.random::<f64>()).to_radians() * if rng.random::<bool>() { 1.0 } else { -1.0 };
+                    let angle = (50.0 + 100.0 * rng.random::<f64>()).to_radians()
+                        * if rng.random::<bool>() { 1.0 } else { -1.0 };
                     let _ = writeln!(segs, "  - {{ id: turn/{:02}, kind: turn, T }}", k + 1);
-                    pieces.push(Piece { c0: c, axis, angle, dur: 2.0 + 2.0 * rng.random::<f64>(), seg: Some(format!("turn/{:02}", k + 1)) });
+                    pieces.push(Piece {
+                        c0: c,
+                        axis,
+                        angle,
+                        dur: 2.0 + 2.0 * rng.random::<f64>(),
+                        seg: Some(format!("turn/{:02}", k + 1)),
+                    });
                     c = rot::mul(&c, &rot::rodrigues(axis, angle));
                 }
             }
@@ -181,12 +234,26 @@ fn move_to(pieces: &mut Vec<Piece>, c: &mut M3, target: M3, dur: f64) {
     }
     let axis = if angle > std::f64::consts::PI - 1e-6 {
         // Half a turn: the axis is the column of rel + I with the largest norm.
-        let k = (0..3).max_by(|a, b| rel[*a][*a].total_cmp(&rel[*b][*b])).unwrap_or(0);
-        unit(std::array::from_fn(|i| rel[i][k] + if i == k { 1.0 } else { 0.0 }))
+        let k = (0..3)
+            .max_by(|a, b| rel[*a][*a].total_cmp(&rel[*b][*b]))
+            .unwrap_or(0);
+        unit(std::array::from_fn(|i| {
+            rel[i][k] + if i == k { 1.0 } else { 0.0 }
+        }))
     } else {
-        unit([rel[2][1] - rel[1][2], rel[0][2] - rel[2][0], rel[1][0] - rel[0][1]])
+        unit([
+            rel[2][1] - rel[1][2],
+            rel[0][2] - rel[2][0],
+            rel[1][0] - rel[0][1],
+        ])
     };
-    pieces.push(Piece { c0: *c, axis, angle, dur, seg: None });
+    pieces.push(Piece {
+        c0: *c,
+        axis,
+        angle,
+        dur,
+        seg: None,
+    });
     *c = target;
 }
 
@@ -195,15 +262,17 @@ fn move_to(pieces: &mut Vec<Piece>, c: &mut M3, target: M3, dur: f64) {
 /// convention of an unknown attitude).
 fn imu(rng: &mut ChaCha8Rng, upper: bool) -> (M3, V3, M3, V3) {
     let mut k = |scale: f64, mis: f64, upper: bool| -> M3 {
-        std::array::from_fn(|i| std::array::from_fn(|j| {
-            if i == j {
-                1.0 + scale * gauss(rng)
-            } else if upper && i > j {
-                0.0
-            } else {
-                mis * gauss(rng)
-            }
-        }))
+        std::array::from_fn(|i| {
+            std::array::from_fn(|j| {
+                if i == j {
+                    1.0 + scale * gauss(rng)
+                } else if upper && i > j {
+                    0.0
+                } else {
+                    mis * gauss(rng)
+                }
+            })
+        })
     };
     let k_a = k(0.01, 0.01, upper);
     let k_g = k(0.01, 0.01, false);
@@ -218,7 +287,10 @@ pub fn write_manual(dir: &Path, s: &ManualSession) -> io::Result<ManualTruth> {
     let (k_a, b_a, k_g, b_g) = imu(&mut rng, matches!(s.kind, ManualKind::MultiPose { .. }));
     let (pieces, segs) = plan(s, &mut rng);
     let (g, lat) = s.site;
-    let omega_l = rot::scale([0.0, lat.to_radians().cos(), lat.to_radians().sin()], OMEGA_E);
+    let omega_l = rot::scale(
+        [0.0, lat.to_radians().cos(), lat.to_radians().sin()],
+        OMEGA_E,
+    );
     let dt = 1.0 / s.rate_hz;
     let mut imu_csv = String::from("t,ax,ay,az,gx,gy,gz\n");
     let mut times: Vec<(String, f64, f64)> = Vec::new();
@@ -236,7 +308,10 @@ pub fn write_manual(dir: &Path, s: &ManualSession) -> io::Result<ManualTruth> {
             let f_b = rot::mul_tv(&c, [0.0, 0.0, g]);
             let w_ib = rot::add(rot::scale(p.axis, rate), rot::mul_tv(&c, omega_l));
             let a = rot::add(rot::mul_v(&k_a, f_b), b_a);
-            let w = rot::add(rot::mul_v(&k_g, rot::scale(w_ib, 180.0 / std::f64::consts::PI)), b_g);
+            let w = rot::add(
+                rot::mul_v(&k_g, rot::scale(w_ib, 180.0 / std::f64::consts::PI)),
+                b_g,
+            );
             let _ = writeln!(
                 imu_csv,
                 "{t:.4},{},{},{},{},{},{}",
@@ -277,7 +352,10 @@ pub fn write_manual(dir: &Path, s: &ManualSession) -> io::Result<ManualTruth> {
     std::fs::write(dir.join("table.csv"), table)?;
     std::fs::write(dir.join("manifest.yaml"), manifest(&segs, &times, s))?;
     let truth = truth(&k_a, b_a, &k_g, b_g);
-    std::fs::write(dir.join("truth.json"), serde_json::to_string_pretty(&truth).unwrap_or_default())?;
+    std::fs::write(
+        dir.join("truth.json"),
+        serde_json::to_string_pretty(&truth).unwrap_or_default(),
+    )?;
     Ok(truth)
 }
 
@@ -289,7 +367,11 @@ fn manifest(segs: &str, times: &[(String, f64, f64)], s: &ManualSession) -> Stri
         s.site.1, s.site.0, s.seed
     );
     for (line, (_, a, b)) in segs.lines().zip(times) {
-        let _ = writeln!(out, "{}", line.replace(" T }", &format!(" t_start: {a:.4}, t_end: {b:.4} }}")));
+        let _ = writeln!(
+            out,
+            "{}",
+            line.replace(" T }", &format!(" t_start: {a:.4}, t_end: {b:.4} }}"))
+        );
     }
     out
 }
@@ -304,7 +386,10 @@ fn truth(k_a: &M3, b_a: V3, k_g: &M3, b_g: V3) -> ManualTruth {
                 if i == j {
                     p.insert(format!("{sensor}.scale.{}", ax[i]), (k[i][i] - 1.0) * 1e6);
                 } else {
-                    p.insert(format!("{sensor}.misalignment.{}{}", ax[i], ax[j]), k[i][j] * 1e3);
+                    p.insert(
+                        format!("{sensor}.misalignment.{}{}", ax[i], ax[j]),
+                        k[i][j] * 1e3,
+                    );
                 }
             }
         }

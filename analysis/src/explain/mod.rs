@@ -179,9 +179,11 @@ pub(crate) fn explain_fitted(
             data.left_out.join(", ")
         ));
     }
+    let tilt = observe::tilt_in_start(data, &mut start);
     // What this recording cannot determine is not fitted: its columns are skipped in
     // every model grown from `start`.
-    let observed = observe::observe(data, &start);
+    let mut observed = observe::observe(data, &start);
+    observed.entries.extend(tilt);
     start.skip.extend(observed.skip.iter().copied());
     let all: Vec<usize> = (0..data.accs.len()).collect();
     let (sa, sg) = seed_segments(m, data);

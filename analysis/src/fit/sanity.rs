@@ -129,7 +129,11 @@ pub(crate) fn clocks_overlap(imu: (f64, f64), table: &TableStream) -> SanityChec
 }
 
 /// Gaps and jitter are counted and located in a warning; they never refuse a recording.
-pub(crate) fn sampling(imu: &CadenceReport, table: &CadenceReport, warnings: &mut Vec<String>) -> SanityCheck {
+pub(crate) fn sampling(
+    imu: &CadenceReport,
+    table: &CadenceReport,
+    warnings: &mut Vec<String>,
+) -> SanityCheck {
     let mut parts = Vec::new();
     for (file, c) in [("imu.csv", imu), ("table.csv", table)] {
         let hz = 1.0 / c.nominal_step_s;
@@ -319,7 +323,12 @@ fn gyro_follows_table(moving: &[(&RawSums, &str)], rest: &[(&RawSums, &str)]) ->
 
 /// The entry of a check judged segment by segment: `fail` when the worst segment exceeds
 /// its tolerance (with `hint`), `pass` with the worst one's figures, or `not_evaluated`.
-pub(crate) fn verdict(name: &str, worst: Option<(f64, String)>, none: &str, hint: &str) -> SanityCheck {
+pub(crate) fn verdict(
+    name: &str,
+    worst: Option<(f64, String)>,
+    none: &str,
+    hint: &str,
+) -> SanityCheck {
     match worst {
         None => SanityCheck::new(name, SanityStatus::NotEvaluated, none),
         Some((excess, detail)) if excess > 0.0 || excess.is_nan() => {

@@ -66,11 +66,7 @@ impl Resolver<'_> {
                 }
                 Ok(Some(Attitude::Nominal(t.value)))
             }
-            other => Err(self.err(
-                at,
-                &format!("`{other}` is not an attitude"),
-                ATTITUDE_HELP,
-            )),
+            other => Err(self.err(at, &format!("`{other}` is not an attitude"), ATTITUDE_HELP)),
         }
     }
 

@@ -123,7 +123,10 @@ impl Resolver<'_> {
                 {
                     return Err(self.err(
                         at,
-                        &format!("nominal static segment `{}` needs `up` (a body axis)", v.id.value),
+                        &format!(
+                            "nominal static segment `{}` needs `up` (a body axis)",
+                            v.id.value
+                        ),
                         "a nominal attitude is a face: `up: +x`, `up: -z`...",
                     ));
                 }
@@ -174,7 +177,11 @@ impl Resolver<'_> {
             id: v.id.value.clone(),
             kind,
             range,
-            up: if unknown && up.is_none() { Some(Up::Oblique) } else { up },
+            up: if unknown && up.is_none() {
+                Some(Up::Oblique)
+            } else {
+                up
+            },
             rate,
             turn,
             attitude,

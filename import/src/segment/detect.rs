@@ -112,7 +112,10 @@ impl Blocks {
 fn with_turns(poses: Vec<Found>) -> Vec<Found> {
     let mut out = Vec::with_capacity(2 * poses.len());
     for p in poses {
-        if let Some(prev) = out.last().filter(|f: &&Found| f.kind == SegmentKind::Static) {
+        if let Some(prev) = out
+            .last()
+            .filter(|f: &&Found| f.kind == SegmentKind::Static)
+        {
             let (a, b) = (&prev.stretch, &p.stretch);
             if b.samples.0 > a.samples.1 + 1 {
                 let stretch = Stretch {
@@ -236,12 +239,19 @@ mod tests {
             at: 0..0,
         };
         let found = b.detect(&d);
-        let ups: Vec<_> = found.iter().filter_map(|f| f.up).map(|u| u.name()).collect();
+        let ups: Vec<_> = found
+            .iter()
+            .filter_map(|f| f.up)
+            .map(|u| u.name())
+            .collect();
         assert_eq!(ups, ["+z", "+x"]);
         assert!(found[0].stretch.t.1 < 10.0 && found[0].stretch.t.1 > 9.0);
         assert!(found[2].stretch.t.0 >= 12.0 && found[2].stretch.t.0 < 12.6);
         // The motion between the two poses is a turn from the first's end to the second's start.
         assert_eq!(found[1].kind, SegmentKind::Turn);
-        assert_eq!(found[1].stretch.t, (found[0].stretch.t.1, found[2].stretch.t.0));
+        assert_eq!(
+            found[1].stretch.t,
+            (found[0].stretch.t.1, found[2].stretch.t.0)
+        );
     }
 }

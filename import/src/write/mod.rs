@@ -15,8 +15,8 @@ use crate::read::Rows;
 use crate::segment::table::{Pose, synthesize};
 use crate::segment::{Found, Stretch, Tracker, face_up, turn};
 use ratecal_recording::{
-    Attitude, Columns, FORMAT, ImuSample, Manifest, ManifestStation, RecordingWriter, Segment, SegmentKind,
-    TableAxes, WrittenFile,
+    Attitude, Columns, FORMAT, ImuSample, Manifest, ManifestStation, RecordingWriter, Segment,
+    SegmentKind, TableAxes, WrittenFile,
 };
 use std::path::{Path, PathBuf};
 

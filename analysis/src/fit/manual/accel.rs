@@ -7,9 +7,9 @@
 //! deviation is the face's tolerance: the values are those of exact faces, the tilts widen
 //! the uncertainties.
 
+use super::Triad;
 use super::data::Pose;
 use super::lsq;
-use super::Triad;
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 /// The convention that fixes three misalignments when the attitude is unknown.
@@ -58,8 +58,10 @@ pub(crate) fn from_magnitude(poses: &[&Pose], g: f64) -> Option<Triad> {
         x0.extend([0.0; 3]);
     }
     let f = |x: &DVector<f64>| magnitude_residuals(poses, g, x);
-    let fit = lsq::solve(&f, DVector::from_vec(x0.clone()), 1.0)
-        .or_else(|| full.then(|| lsq::solve(&f, DVector::from_vec(x0[..6].to_vec()), 1.0)).flatten())?;
+    let fit = lsq::solve(&f, DVector::from_vec(x0.clone()), 1.0).or_else(|| {
+        full.then(|| lsq::solve(&f, DVector::from_vec(x0[..6].to_vec()), 1.0))
+            .flatten()
+    })?;
     let (k, b) = model(&fit.x);
     let mut t = Triad::new("accel", k, b, "m/s^2");
     for i in 0..3 {
@@ -111,7 +113,11 @@ pub(crate) fn from_faces(poses: &[&Pose], g: f64) -> Option<Triad> {
     let b = Vector3::new(x[0], x[1], x[2]);
     let resid = &y - &a * &x;
     let dof = m.saturating_sub(12);
-    let s2 = if dof > 0 { resid.norm_squared() / dof as f64 } else { 0.0 };
+    let s2 = if dof > 0 {
+        resid.norm_squared() / dof as f64
+    } else {
+        0.0
+    };
     let sigma = face_covariance(&faces, &k, g, s2);
     let cov = &gain * sigma * gain.transpose();
     let mut t = Triad::new("accel", k, b, "m/s^2");
@@ -133,7 +139,12 @@ pub(crate) fn from_faces(poses: &[&Pose], g: f64) -> Option<Triad> {
 /// The covariance of the faces' means: their noise and the misfit (`s2`), plus each
 /// face's tilt (two angles of standard deviation `tol` about the axes across the face,
 /// first order; the loss of the component along the face, second order).
-fn face_covariance(faces: &[(&Pose, usize, f64)], k: &Matrix3<f64>, g: f64, s2: f64) -> DMatrix<f64> {
+fn face_covariance(
+    faces: &[(&Pose, usize, f64)],
+    k: &Matrix3<f64>,
+    g: f64,
+    s2: f64,
+) -> DMatrix<f64> {
     let m = 3 * faces.len();
     let mut sigma = DMatrix::zeros(m, m);
     for (r, (p, j, _)) in faces.iter().enumerate() {

@@ -49,7 +49,11 @@ pub(crate) fn checks<S: Source>(
 fn magnitude(d: &Data, accel: Option<&Triad>, g: f64) -> SanityCheck {
     let name = "gravity_magnitude_at_rest";
     let Some(a) = accel else {
-        return SanityCheck::new(name, SanityStatus::NotEvaluated, "no accelerometer calibration to check the poses through");
+        return SanityCheck::new(
+            name,
+            SanityStatus::NotEvaluated,
+            "no accelerometer calibration to check the poses through",
+        );
     };
     let tol = CALIBRATED_GRAVITY_REL * g;
     let worst = d
@@ -63,7 +67,12 @@ fn magnitude(d: &Data, accel: Option<&Triad>, g: f64) -> SanityCheck {
             )
         })
         .max_by(|x, y| x.0.total_cmp(&y.0));
-    sanity::verdict(name, worst, "no static pose", " (a pose that was not at rest, or poses too few or too alike for the calibration)")
+    sanity::verdict(
+        name,
+        worst,
+        "no static pose",
+        " (a pose that was not at rest, or poses too few or too alike for the calibration)",
+    )
 }
 
 fn direction(d: &Data, accel: Option<&Triad>) -> SanityCheck {
@@ -75,7 +84,11 @@ fn direction(d: &Data, accel: Option<&Triad>) -> SanityCheck {
         .filter_map(|p| p.face.map(|f| (p, f)))
         .collect();
     let (Some(a), false) = (accel, faces.is_empty()) else {
-        return SanityCheck::new(name, SanityStatus::NotEvaluated, "attitudes unknown: only gravity's magnitude is known at the poses");
+        return SanityCheck::new(
+            name,
+            SanityStatus::NotEvaluated,
+            "attitudes unknown: only gravity's magnitude is known at the poses",
+        );
     };
     let worst = faces
         .iter()
@@ -87,7 +100,12 @@ fn direction(d: &Data, accel: Option<&Triad>) -> SanityCheck {
             (deg - tol, format!("segment {}: the calibrated specific force is {deg:.2} deg from its face (tolerance {tol:.1} deg)", p.id))
         })
         .max_by(|x, y| x.0.total_cmp(&y.0));
-    sanity::verdict(name, worst, "no nominal face", " (a pose on another face than the one declared?)")
+    sanity::verdict(
+        name,
+        worst,
+        "no nominal face",
+        " (a pose on another face than the one declared?)",
+    )
 }
 
 fn at_rest(d: &Data) -> SanityCheck {
@@ -100,7 +118,12 @@ fn at_rest(d: &Data) -> SanityCheck {
             (w - limit, format!("segment {}: |angular rate| {w:.4} deg/s at rest (limit {limit:.3} deg/s: a plausible bias)", p.id))
         })
         .max_by(|x, y| x.0.total_cmp(&y.0));
-    sanity::verdict("gyro_at_rest", worst, "no static pose", " (gyros in mdeg/s or raw counts read as deg/s?)")
+    sanity::verdict(
+        "gyro_at_rest",
+        worst,
+        "no static pose",
+        " (gyros in mdeg/s or raw counts read as deg/s?)",
+    )
 }
 
 /// Each pose's calibrated specific force less gravity along it (the model at an unknown

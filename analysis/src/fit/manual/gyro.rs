@@ -6,9 +6,9 @@
 //! column of `K_g` of each turn about a stated body axis: the integrated rate over its
 //! nominal angle (Ferraris).
 
+use super::Triad;
 use super::data::{Pose, Turn};
 use super::lsq;
-use super::Triad;
 use nalgebra::{DVector, Matrix3, Rotation3, Vector3};
 
 /// The Earth's rate, deg/s: an unknown attitude leaves its projection in the bias.
@@ -122,9 +122,16 @@ pub(crate) fn from_turns(turns: &[Prepared], bias: (Vector3<f64>, [f64; 3])) -> 
 /// The bias of nominal faces: the mean of their means, u from their spread.
 pub(crate) fn faces_bias(faces: &[&Pose]) -> (Vector3<f64>, [f64; 3]) {
     let n = faces.len().max(1) as f64;
-    let mean = faces.iter().fold(Vector3::zeros(), |a, p| a + Vector3::from(p.w)) / n;
+    let mean = faces
+        .iter()
+        .fold(Vector3::zeros(), |a, p| a + Vector3::from(p.w))
+        / n;
     let u = std::array::from_fn(|k| {
-        let var = faces.iter().map(|p| (p.w[k] - mean[k]).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+        let var = faces
+            .iter()
+            .map(|p| (p.w[k] - mean[k]).powi(2))
+            .sum::<f64>()
+            / (n - 1.0).max(1.0);
         (var / n).sqrt()
     });
     (mean, u)
@@ -157,7 +164,11 @@ pub(crate) fn from_axis_turns(
         for i in 0..3 {
             let from_bias = bias.1[i] * dur / theta.abs();
             // The angle is known within the tolerance (scale), the axis too (cross terms).
-            let from_tol = if i == j { tol_rad.to_degrees() / theta.abs() } else { tol_rad };
+            let from_tol = if i == j {
+                tol_rad.to_degrees() / theta.abs()
+            } else {
+                tol_rad
+            };
             u[(i, j)] = (from_bias.powi(2) + from_tol.powi(2)).sqrt() * k[(j, j)].abs();
         }
         seen[j] = true;

@@ -81,7 +81,12 @@ pub(crate) fn solve(
 }
 
 /// The covariance `s^2 (J^T J)^-1` at the solution, or `None` when `J^T J` is singular.
-fn covariance(j: &DMatrix<f64>, r: &DVector<f64>, x: DVector<f64>, dof_per_row: f64) -> Option<Fitted> {
+fn covariance(
+    j: &DMatrix<f64>,
+    r: &DVector<f64>,
+    x: DVector<f64>,
+    dof_per_row: f64,
+) -> Option<Fitted> {
     let n = x.len();
     let eq = (r.len() as f64 * dof_per_row).round() as usize;
     let dof = eq.saturating_sub(n);
@@ -118,7 +123,9 @@ pub(crate) fn normal_inverse(j: &DMatrix<f64>) -> Option<DMatrix<f64>> {
         return None;
     }
     let inv = scaled.try_inverse()?;
-    Some(DMatrix::from_fn(inv.nrows(), inv.ncols(), |a, b| inv[(a, b)] / (d[a] * d[b])))
+    Some(DMatrix::from_fn(inv.nrows(), inv.ncols(), |a, b| {
+        inv[(a, b)] / (d[a] * d[b])
+    }))
 }
 
 #[cfg(test)]
@@ -129,7 +136,11 @@ mod tests {
     fn fits_a_line_with_its_covariance() {
         // y = 2 + 3 t with alternating +-0.1: the covariance is that of ordinary least squares.
         let t: Vec<f64> = (0..10).map(|k| k as f64).collect();
-        let y: Vec<f64> = t.iter().enumerate().map(|(k, t)| 2.0 + 3.0 * t + if k % 2 == 0 { 0.1 } else { -0.1 }).collect();
+        let y: Vec<f64> = t
+            .iter()
+            .enumerate()
+            .map(|(k, t)| 2.0 + 3.0 * t + if k % 2 == 0 { 0.1 } else { -0.1 })
+            .collect();
         let f = |x: &DVector<f64>| DVector::from_fn(10, |k, _| x[0] + x[1] * t[k] - y[k]);
         let fit = solve(&f, DVector::from_vec(vec![0.0, 0.0]), 1.0).unwrap();
         assert!((fit.x[1] - 3.0).abs() < 0.05, "{}", fit.x);

@@ -35,7 +35,12 @@ pub(crate) struct Triad {
 }
 
 impl Triad {
-    fn new(sensor: &'static str, k: Matrix3<f64>, b: Vector3<f64>, bias_unit: &'static str) -> Self {
+    fn new(
+        sensor: &'static str,
+        k: Matrix3<f64>,
+        b: Vector3<f64>,
+        bias_unit: &'static str,
+    ) -> Self {
         Triad {
             sensor,
             bias_unit,
@@ -49,18 +54,21 @@ impl Triad {
 
     fn bias(&mut self, i: usize, v: f64, u: f64) {
         let key = format!("{}.bias.{}", self.sensor, AXES[i]);
-        self.params.insert(key, Parameter::estimate(v, u, self.bias_unit));
+        self.params
+            .insert(key, Parameter::estimate(v, u, self.bias_unit));
     }
 
     /// `k_ii` is the diagonal term (reported as `K_ii - 1` in ppm).
     fn scale(&mut self, i: usize, k_ii: f64, u: f64) {
         let key = format!("{}.scale.{}", self.sensor, AXES[i]);
-        self.params.insert(key, Parameter::estimate((k_ii - 1.0) * 1e6, u * 1e6, "ppm"));
+        self.params
+            .insert(key, Parameter::estimate((k_ii - 1.0) * 1e6, u * 1e6, "ppm"));
     }
 
     fn misalignment(&mut self, i: usize, j: usize, v: f64, u: f64) {
         let key = format!("{}.misalignment.{}{}", self.sensor, AXES[i], AXES[j]);
-        self.params.insert(key, Parameter::estimate(v * 1e3, u * 1e3, "mrad"));
+        self.params
+            .insert(key, Parameter::estimate(v * 1e3, u * 1e3, "mrad"));
     }
 
     fn unobservable(&mut self, i: usize, j: usize, why: &str) {
@@ -88,7 +96,11 @@ mod accel_fit {
 }
 
 /// Analyses a manual recording.
-pub(crate) fn analyze<S: Source>(src: &S, plan: Option<&Plan>, opts: &Options) -> Result<Results, S::Error> {
+pub(crate) fn analyze<S: Source>(
+    src: &S,
+    plan: Option<&Plan>,
+    opts: &Options,
+) -> Result<Results, S::Error> {
     let m = src.manifest();
     let g = m.station.site.gravity_mps2;
     let data = data::read(src)?;
@@ -96,14 +108,19 @@ pub(crate) fn analyze<S: Source>(src: &S, plan: Option<&Plan>, opts: &Options) -
     let mut params = BTreeMap::new();
     let mut observability = BTreeMap::new();
     let mut warnings = fitted.warnings.clone();
-    for (sensor, t) in [("accel", fitted.accel.as_ref().map(|a| &a.triad)), ("gyro", fitted.gyro.as_ref())] {
+    for (sensor, t) in [
+        ("accel", fitted.accel.as_ref().map(|a| &a.triad)),
+        ("gyro", fitted.gyro.as_ref()),
+    ] {
         match t {
             Some(t) => {
                 params.extend(t.params.clone());
                 observability.extend(t.why.clone());
             }
             None => {
-                let why = format!("the poses and turns of this recording do not determine the {sensor} model");
+                let why = format!(
+                    "the poses and turns of this recording do not determine the {sensor} model"
+                );
                 warnings.push(format!("{why}: see `manual` and `observability`"));
                 for what in ["bias", "scale"] {
                     for ax in AXES {
@@ -116,10 +133,24 @@ pub(crate) fn analyze<S: Source>(src: &S, plan: Option<&Plan>, opts: &Options) -
         }
     }
     let manual = summary(&data, &fitted, g, &params);
-    let mut sanity = checks::checks(m, src, &data, fitted.accel.as_ref().map(|a| &a.triad), g, &mut warnings);
-    sanity.push(sanity::plausible_with(&params, sanity::ACCEL_OFFSET_MAX_MANUAL));
+    let mut sanity = checks::checks(
+        m,
+        src,
+        &data,
+        fitted.accel.as_ref().map(|a| &a.triad),
+        g,
+        &mut warnings,
+    );
+    sanity.push(sanity::plausible_with(
+        &params,
+        sanity::ACCEL_OFFSET_MAX_MANUAL,
+    ));
     let (rows, extent) = (src.imu_rows(), src.imu_extent());
-    let step = if rows > 1 { (extent.1 - extent.0) / (rows - 1) as f64 } else { f64::NAN };
+    let step = if rows > 1 {
+        (extent.1 - extent.0) / (rows - 1) as f64
+    } else {
+        f64::NAN
+    };
     let mut res = Results {
         format: results::FORMAT.into(),
         verdict: results::RunVerdict::default(),
@@ -151,7 +182,10 @@ pub(crate) fn analyze<S: Source>(src: &S, plan: Option<&Plan>, opts: &Options) -
     };
     let mut q = BTreeMap::new();
     if let Some(man) = &res.manual {
-        q.insert("accel.residual.std".to_string(), (man.gravity_rms_calibrated_mps2, 0.0));
+        q.insert(
+            "accel.residual.std".to_string(),
+            (man.gravity_rms_calibrated_mps2, 0.0),
+        );
     }
     res.acceptance = accept::evaluate(plan, &res, &q, &Default::default(), &mut warnings);
     res.warnings = warnings;
@@ -164,17 +198,25 @@ pub(crate) fn analyze<S: Source>(src: &S, plan: Option<&Plan>, opts: &Options) -
 fn fit(d: &Data, g: f64) -> Fitted {
     let poses: Vec<&Pose> = d.poses.iter().collect();
     let all_faces = !poses.is_empty()
-        && poses.iter().all(|p| p.attitude == Attitude::Nominal && p.face.is_some());
+        && poses
+            .iter()
+            .all(|p| p.attitude == Attitude::Nominal && p.face.is_some());
     let mut warnings = Vec::new();
     if all_faces && let Some(t) = accel::from_faces(&poses, g) {
         let tol = poses.iter().map(|p| p.tol_rad).fold(0.0, f64::max);
         let gyro = gyro::from_axis_turns(&d.turns, gyro::faces_bias(&poses), tol);
         if gyro.is_none() {
-            warnings.push("the gyro scale needs a turn about each body axis with its nominal `angle_deg`".into());
+            warnings.push(
+                "the gyro scale needs a turn about each body axis with its nominal `angle_deg`"
+                    .into(),
+            );
         }
         return Fitted {
             method: "six_face",
-            accel: Some(accel_fit::Out { triad: t, convention: None }),
+            accel: Some(accel_fit::Out {
+                triad: t,
+                convention: None,
+            }),
             gyro,
             turns: Vec::new(),
             warnings,
@@ -194,7 +236,10 @@ fn fit(d: &Data, g: f64) -> Fitted {
     };
     Fitted {
         method: "multi_pose",
-        accel: accel.map(|t| accel_fit::Out { triad: t, convention: Some(accel::CONVENTION) }),
+        accel: accel.map(|t| accel_fit::Out {
+            triad: t,
+            convention: Some(accel::CONVENTION),
+        }),
         gyro,
         turns,
         warnings,
@@ -210,7 +255,12 @@ fn turn_fit(d: &Data, a: &Triad, rest: &Pose) -> (Option<Triad>, Vec<results::Tu
     for t in &d.turns {
         if let (Some(f), Some(to)) = (t.from, t.to) {
             let (pf, pt) = (&d.poses[f], &d.poses[to]);
-            prepared.push(gyro::Prepared::of(t, &bias.0, accel::calibrated(a, pf), accel::calibrated(a, pt)));
+            prepared.push(gyro::Prepared::of(
+                t,
+                &bias.0,
+                accel::calibrated(a, pf),
+                accel::calibrated(a, pt),
+            ));
             ids.push(t.id.clone());
         }
     }
@@ -233,7 +283,11 @@ fn turn_fit(d: &Data, a: &Triad, rest: &Pose) -> (Option<Triad>, Vec<results::Tu
 
 fn rms(v: impl Iterator<Item = f64>) -> f64 {
     let (s, n) = v.fold((0.0, 0usize), |(s, n), x| (s + x * x, n + 1));
-    if n == 0 { f64::NAN } else { (s / n as f64).sqrt() }
+    if n == 0 {
+        f64::NAN
+    } else {
+        (s / n as f64).sqrt()
+    }
 }
 
 /// The `manual` block of results.json.
@@ -258,7 +312,11 @@ fn summary(d: &Data, f: &Fitted, g: f64, params: &BTreeMap<String, Parameter>) -
             .filter(|(_, p)| p.value_u().is_some())
             .map(|(k, _)| k.clone())
             .collect(),
-        convention: f.accel.as_ref().and_then(|a| a.convention).map(str::to_string),
+        convention: f
+            .accel
+            .as_ref()
+            .and_then(|a| a.convention)
+            .map(str::to_string),
         gravity_mps2: g,
         gravity_rms_raw_mps2: rms(poses.iter().map(|p| p.raw_mps2 - g)),
         gravity_rms_calibrated_mps2: rms(poses.iter().map(|p| p.calibrated_mps2 - g)),
@@ -272,7 +330,10 @@ fn summary(d: &Data, f: &Fitted, g: f64, params: &BTreeMap<String, Parameter>) -
 /// What each fit used, in words (`model.fits`).
 fn model_fits(f: &Fitted, d: &Data) -> Vec<String> {
     let n_turns = if f.method == "six_face" {
-        d.turns.iter().filter(|t| t.axis.is_some() && t.angle_deg.is_some()).count()
+        d.turns
+            .iter()
+            .filter(|t| t.axis.is_some() && t.angle_deg.is_some())
+            .count()
     } else {
         f.turns.len()
     };
@@ -281,8 +342,12 @@ fn model_fits(f: &Fitted, d: &Data) -> Vec<String> {
         _ => "accel multi_pose (gravity's magnitude; attitudes unknown)",
     };
     let gyro = match f.method {
-        "six_face" => "gyro bias from the faces, K_g from the turns about body axes (integrated angle / nominal angle)",
-        _ => "gyro bias from the initial rest, K_g from the turns between poses (gravity's direction carried)",
+        "six_face" => {
+            "gyro bias from the faces, K_g from the turns about body axes (integrated angle / nominal angle)"
+        }
+        _ => {
+            "gyro bias from the initial rest, K_g from the turns between poses (gravity's direction carried)"
+        }
     };
     vec![
         format!("{what} from {} poses", d.poses.len()),
@@ -302,7 +367,9 @@ fn uses(m: &crate::recording::Manifest, d: &Data, f: &Fitted) -> Vec<SegmentUse>
                 used.push("accel".to_string());
             }
             if f.gyro.is_some() {
-                if pose == Some(0) && f.method == "multi_pose" || pose.is_some() && f.method == "six_face" {
+                if pose == Some(0) && f.method == "multi_pose"
+                    || pose.is_some() && f.method == "six_face"
+                {
                     used.push("gyro_bias".into());
                 }
                 let turn_used = s.kind == SegmentKind::Turn
