@@ -119,7 +119,9 @@ impl Data {
             .filter(|a| attitude_unknown(&segs[a.seg]))
             .map(|a| segs[a.seg].id.clone())
             .collect();
-        accs.retain(|a| !attitude_unknown(&segs[a.seg]));
+        // A hand turn has no reference either: no table follows the hand (its integral is
+        // the manual calibration's, `ratecal analyze`).
+        accs.retain(|a| !attitude_unknown(&segs[a.seg]) && segs[a.seg].kind != SegmentKind::Turn);
         let spans: Vec<(f64, f64)> = accs
             .iter()
             .map(|a| (segs[a.seg].t_start, segs[a.seg].t_end))
