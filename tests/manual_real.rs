@@ -4,6 +4,9 @@
 //! faces and three hand turns) and an MPU-6050 (eight hand-held poses). Each figure is
 //! compared with what the sources' authors published, never with our own earlier output.
 
+// Matrix loops index several arrays at once; iterators would hide that.
+#![allow(clippy::needless_range_loop)]
+
 mod support;
 use support::*;
 

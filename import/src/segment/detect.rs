@@ -236,6 +236,7 @@ mod tests {
             static_min_s: 2.0,
             threshold: 6.0,
             window_s: 0.5,
+            attitude: None,
             at: 0..0,
         };
         let found = b.detect(&d);

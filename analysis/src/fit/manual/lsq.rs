@@ -110,7 +110,7 @@ fn covariance(
 pub(crate) fn normal_inverse(j: &DMatrix<f64>) -> Option<DMatrix<f64>> {
     let jtj = j.transpose() * j;
     let d: Vec<f64> = (0..jtj.nrows()).map(|k| jtj[(k, k)].sqrt()).collect();
-    if d.iter().any(|v| !(*v > 0.0) || !v.is_finite()) {
+    if d.iter().any(|v| v.is_nan() || *v <= 0.0 || !v.is_finite()) {
         return None;
     }
     let scaled = DMatrix::from_fn(jtj.nrows(), jtj.ncols(), |a, b| jtj[(a, b)] / (d[a] * d[b]));
@@ -119,7 +119,7 @@ pub(crate) fn normal_inverse(j: &DMatrix<f64>) -> Option<DMatrix<f64>> {
         .eigenvalues
         .iter()
         .fold((f64::INFINITY, 0.0f64), |(l, h), &e| (l.min(e), h.max(e)));
-    if !(lo > 1e-12 * hi) {
+    if lo.is_nan() || lo <= 1e-12 * hi {
         return None;
     }
     let inv = scaled.try_inverse()?;
