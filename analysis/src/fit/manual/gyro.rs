@@ -152,6 +152,10 @@ pub(crate) fn from_axis_turns(
         let (Some((j, sign)), Some(angle)) = (t.axis, t.angle_deg) else {
             continue;
         };
+        // Another system's manifest may say anything: a turn of no angle determines nothing.
+        if !angle.is_finite() || angle.abs() < 1.0 || t.t.len() < 2 {
+            continue;
+        }
         let n = t.t.len();
         let mut sum = Vector3::zeros();
         for r in 1..n {
