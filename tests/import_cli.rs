@@ -110,26 +110,40 @@ fn ferraris_session_is_the_hand_converted_example() {
     assert!(manifest.contains(&sha(&map)), "{manifest}");
     assert!(manifest.contains("table: synthesized"), "{manifest}");
 
-    // Analysed with the seed model, it agrees with the example (whose windows were rounded
-    // by hand: a sample at each edge may differ).
+    // Its faces are `nominal` (the map): analysed, it is calibrated by the six-face
+    // solution, which equals the closed form of exact faces computed here from the hand
+    // conversion's own windows (rounded by hand: a sample at each edge may differ): the
+    // bias is the mean of the six faces' means, column j of K_a their difference over 2 g.
     let o = ratecal(&["analyze", "run", "--out", "imp.json"], cwd);
     assert_eq!(code(&o), 0, "{}", text(&o));
-    let o = ratecal(
-        &["analyze", example.to_str().unwrap(), "--out", "ex.json"],
-        cwd,
-    );
-    assert_eq!(code(&o), 0, "{}", text(&o));
-    let (a, e) = (json(&cwd.join("imp.json")), json(&cwd.join("ex.json")));
-    for ax in ["x", "y", "z"] {
-        let d = |n: &str| (param(&a, n) - param(&e, n)).abs();
-        assert!(d(&format!("accel.bias.{ax}")) < 1e-4, "accel.bias.{ax}");
+    let a = json(&cwd.join("imp.json"));
+    assert_eq!(a["manual"]["method"], "six_face");
+    let g = 9.8095;
+    let window = |t0: f64, t1: f64| -> [f64; 3] {
+        let w: Vec<&Vec<f64>> = ex.iter().filter(|r| r[0] >= t0 && r[0] <= t1).collect();
+        std::array::from_fn(|k| w.iter().map(|r| r[1 + k]).sum::<f64>() / w.len() as f64)
+    };
+    let faces = [
+        window(5.27344, 12.41211),
+        window(15.82031, 23.05664),
+        window(27.48047, 32.20703),
+        window(36.52344, 40.54688),
+        window(44.16016, 48.58398),
+        window(52.5, 58.42773),
+    ];
+    for (i, ax) in ["x", "y", "z"].iter().enumerate() {
+        let bias = faces.iter().map(|f| f[i]).sum::<f64>() / 6.0;
+        let scale = (faces[2 * i][i] - faces[2 * i + 1][i]) / (2.0 * g) - 1.0;
+        let got_b = param(&a, &format!("accel.bias.{ax}"));
+        let got_s = param(&a, &format!("accel.scale.{ax}"));
         assert!(
-            d(&format!("accel.scale.{ax}")) < 10.0,
-            "accel.scale.{ax} (ppm)"
+            (got_b - bias).abs() < 1e-4,
+            "accel.bias.{ax}: {got_b} vs {bias}"
         );
         assert!(
-            d(&format!("gyro.bias.{ax}")) < 2e-3,
-            "gyro.bias.{ax} (deg/s)"
+            (got_s - 1e6 * scale).abs() < 10.0,
+            "accel.scale.{ax}: {got_s} vs {}",
+            1e6 * scale
         );
     }
 
@@ -353,4 +367,66 @@ fn map_mistakes_are_located_in_the_map() {
         "map.yaml:4:",
         &["no column `acc_zz`", "acc_z"],
     );
+    // A nominal face says how well it is known; a turn's axis is a body axis.
+    let m = MAP.replace("up: +z }", "up: +z, attitude: nominal }");
+    refused(
+        &session(|_, _| {}),
+        &m,
+        "map.yaml:7:",
+        &[
+            "`attitude: nominal` needs `tolerance_deg`",
+            "tolerance_deg: 0.5",
+        ],
+    );
+    let m = MAP.replace("up: +z }", "up: +z, attitude: feedback }");
+    refused(
+        &session(|_, _| {}),
+        &m,
+        "map.yaml:7:",
+        &["without the table's feedback"],
+    );
+    let m = MAP.replace(
+        "kind: rate, samples: [620, 880], axis: z, rate_dps: 100",
+        "kind: turn, samples: [620, 880], axis: outer, angle_deg: 360",
+    );
+    refused(
+        &session(|_, _| {}),
+        &m,
+        "map.yaml:9:",
+        &["`outer` is not a body axis"],
+    );
+}
+
+#[test]
+fn turns_and_attitudes_are_written_to_the_manifest() {
+    let m = MAP
+        .replace(
+            "up: +z }",
+            "up: +z, attitude: nominal, tolerance_deg: 0.5 }",
+        )
+        .replace("up: +x }", "attitude: unknown }")
+        .replace(
+            "kind: rate, samples: [620, 880], axis: z, rate_dps: 100",
+            "kind: turn, samples: [620, 880], axis: -z, angle_deg: -360",
+        );
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(tmp.path().join("s.csv"), session(|_, _| {})).unwrap();
+    std::fs::write(tmp.path().join("map.yaml"), m).unwrap();
+    let o = ratecal(
+        &["import", "s.csv", "--map", "map.yaml", "--out", "run"],
+        tmp.path(),
+    );
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let text = std::fs::read_to_string(tmp.path().join("run/manifest.yaml")).unwrap();
+    let man: serde_json::Value = serde_saphyr::from_str(&text).unwrap();
+    let s = &man["segments"];
+    assert_eq!(s[0]["attitude"], "nominal");
+    assert_eq!(s[0]["tolerance_deg"], 0.5);
+    assert_eq!(s[1]["attitude"], "unknown");
+    assert!(s[1]["up"].is_null(), "{text}");
+    assert_eq!(s[2]["kind"], "turn");
+    assert_eq!(s[2]["axis"], "-z");
+    assert_eq!(s[2]["angle_deg"], -360.0);
+    // No segment of a recording without a table is held by feedback.
+    assert!(!text.contains("attitude: feedback"), "{text}");
 }

@@ -25,21 +25,27 @@ fn numbers(path: &Path, skip: usize) -> Vec<Vec<f64>> {
         .collect()
 }
 
-/// Every detected static interval: (t_start, t_end, up) from the manifest's segments
-/// (`up: oblique` for a pose with no body axis near vertical).
+/// Every detected static interval: (t_start, t_end, oblique) from the manifest's static
+/// segments (`Some` when no body axis is near vertical: the manifest has no `up`); each is
+/// `attitude: unknown` (hand-held), and a free `turn` lies between each two.
 fn intervals(run: &Path) -> Vec<(f64, f64, Option<String>)> {
     let text = std::fs::read_to_string(run.join("manifest.yaml")).unwrap();
     let m: serde_json::Value = serde_saphyr::from_str(&text).unwrap();
     let mut v: Vec<(f64, f64, Option<String>)> = Vec::new();
-    for s in m["segments"].as_array().unwrap() {
+    let segs = m["segments"].as_array().unwrap();
+    for (i, s) in segs.iter().enumerate() {
+        if s["kind"] == "turn" {
+            // Between two poses, from the end of one to the start of the next.
+            assert_eq!(s["t_start"], segs[i - 1]["t_end"]);
+            assert_eq!(s["t_end"], segs[i + 1]["t_start"]);
+            continue;
+        }
         assert_eq!(s["kind"], "static");
+        assert_eq!(s["attitude"], "unknown");
         v.push((
             s["t_start"].as_f64().unwrap(),
             s["t_end"].as_f64().unwrap(),
-            s["up"]
-                .as_str()
-                .filter(|u| *u == "oblique")
-                .map(String::from),
+            s["up"].is_null().then(|| "oblique".to_string()),
         ));
     }
     v.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -140,38 +146,22 @@ fn imu_tk_xsens_poses_are_found_and_static_by_the_factory_calibration() {
         }
     }
 
-    // The session's many oblique poses are static segments marked `up: oblique`, and the
-    // six-position fits of `analyze` skip them (with a warning), using the faces only.
+    // The session's many oblique poses are static segments of unknown attitude, like the
+    // rest; `analyze` calibrates from all of them (gravity's magnitude) and the turns.
     let oblique: Vec<usize> = (0..found.len()).filter(|&i| found[i].2.is_some()).collect();
     assert!(oblique.len() >= 20, "{} oblique", oblique.len());
     assert!(found.len() - oblique.len() >= 6);
     let o = ratecal(&["analyze", "run", "--out", "results.json"], tmp.path());
-    // 3: the verdict is not pass (nominal zero counts, no rate segment): still analysed.
     assert!(matches!(code(&o), 0 | 3), "{}", text(&o));
     let r = json(&tmp.path().join("results.json"));
-    let warned = format!("{} oblique static segment(s) skipped", oblique.len());
-    assert!(
-        r["warnings"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .any(|w| w.as_str().unwrap().starts_with(&warned)),
-        "{}",
-        r["warnings"]
-    );
-    let segs = r["segments"].as_array().unwrap();
-    assert_eq!(segs.len(), found.len());
-    for (i, s) in segs.iter().enumerate() {
+    for s in r["segments"].as_array().unwrap() {
         let used = s["used_for"].as_array().unwrap();
-        if oblique.contains(&i) {
-            assert!(used.is_empty(), "{}: {used:?}", s["id"]);
+        let want = if s["kind"] == "static" {
+            "accel"
         } else {
-            assert!(
-                used.iter().any(|u| u.as_str().unwrap().contains("accel")),
-                "{}: {used:?}",
-                s["id"]
-            );
-        }
+            "gyro_full"
+        };
+        assert!(used.iter().any(|u| u == want), "{}: {used:?}", s["id"]);
     }
 }
 

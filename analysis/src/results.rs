@@ -66,6 +66,62 @@ pub struct Results {
     /// The swaying segments' velocity drifts behind the `size_effect.*` parameters.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub size_effect: Option<SizeEffectDrifts>,
+    /// A calibration without a table (poses of `nominal` or `unknown` attitude): its method,
+    /// what the poses determine and how well the calibrated poses read gravity.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub manual: Option<ManualFit>,
+}
+
+/// How a recording without a table was calibrated (docs/results.md, `manual`).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ManualFit {
+    /// `six_face` (nominal faces, Ferraris) or `multi_pose` (unknown attitudes, Tedaldi).
+    pub method: String,
+    /// The parameters the poses and turns determine (results.json keys).
+    pub determined: Vec<String>,
+    /// The convention that fixes what the poses cannot tell apart, when one applies.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub convention: Option<String>,
+    /// The site's gravity the poses were fitted to, m/s^2.
+    pub gravity_mps2: f64,
+    /// Each pose's |specific force| before and after the calibration, m/s^2.
+    pub poses: Vec<PoseGravity>,
+    /// RMS of |specific force| - g over the poses, raw, m/s^2.
+    pub gravity_rms_raw_mps2: f64,
+    /// The same through the calibration, m/s^2.
+    pub gravity_rms_calibrated_mps2: f64,
+    /// Each turn between two poses: how far gravity's direction, carried through the turn
+    /// by the gyros, lands from the direction measured after it (deg).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub turns: Vec<TurnMiss>,
+    /// RMS of those angles with the nominal gyro model (scale 1, no cross-axis), deg.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub turn_rms_nominal_deg: Option<f64>,
+    /// RMS of those angles with the calibrated gyros, deg.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub turn_rms_calibrated_deg: Option<f64>,
+}
+
+/// One pose's gravity reading.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PoseGravity {
+    /// Segment id.
+    pub segment: String,
+    /// |mean specific force| as recorded, m/s^2.
+    pub raw_mps2: f64,
+    /// The same through the calibration, m/s^2.
+    pub calibrated_mps2: f64,
+}
+
+/// One turn's miss of gravity's direction (deg), nominal and calibrated gyros.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TurnMiss {
+    /// Segment id.
+    pub segment: String,
+    /// With the nominal gyro model, deg.
+    pub nominal_deg: f64,
+    /// With the calibrated gyros, deg.
+    pub calibrated_deg: f64,
 }
 
 /// A joint fit's parameters (results.json keys, in order) and their correlation matrix.

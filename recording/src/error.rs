@@ -247,6 +247,31 @@ pub enum RecordingError {
         span: SourceSpan,
     },
 
+    /// A static segment's `attitude` that cannot be used: `nominal` without a positive,
+    /// finite `tolerance_deg`.
+    #[error("{file}:{line}:{column}: segment `{id}` {problem}")]
+    #[diagnostic(code(recording::attitude), help("{help}"))]
+    BadAttitude {
+        /// File name.
+        file: String,
+        /// Line.
+        line: u64,
+        /// Column.
+        column: u64,
+        /// Segment id.
+        id: String,
+        /// What is wrong.
+        problem: String,
+        /// What would fix it.
+        help: String,
+        /// File text.
+        #[source_code]
+        src: Excerpt,
+        /// The segment.
+        #[label("this segment")]
+        span: SourceSpan,
+    },
+
     /// A format tag this version does not read.
     #[error("{file}:{line}:{column}: unknown recording format `{found}`")]
     #[diagnostic(

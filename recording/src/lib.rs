@@ -55,7 +55,7 @@ pub use error::{RecordingError, yaml_offset};
 pub use excerpt::Excerpt;
 pub use files::{FileState, WrittenFile, hash_folder, hash_folder_known, regular, sha256_file};
 pub use manifest::{
-    AbortRecord, EnvironmentRecord, FORMAT, LinkRecord, Manifest, ManifestStation, Mount,
+    AbortRecord, Attitude, EnvironmentRecord, FORMAT, LinkRecord, Manifest, ManifestStation, Mount,
     ProcedureRef, ResumeRecord, RunInfo, Segment, SegmentKind, SyncRecord, TableAxes, WriteFailure,
 };
 pub use read::{OpenRecording, SpanRows, parse_manifest, read, read_imu, read_table};

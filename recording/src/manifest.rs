@@ -82,6 +82,33 @@ pub enum SegmentKind {
     Rate,
     /// One axis swaying sinusoidally.
     Oscillation,
+    /// A rotation by hand (or anything that holds no constant rate) between two static
+    /// segments; `axis` (a signed body axis) and `angle_deg` when the procedure asked for one.
+    Turn,
+}
+
+/// How well a static segment's attitude is known (spec/recording-format.md).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Attitude {
+    /// The table's angle feedback holds it (the default).
+    #[default]
+    Feedback,
+    /// A fixture's face placed by hand: the nominal attitude within `tolerance_deg`.
+    Nominal,
+    /// A hand-held pose: only gravity's magnitude is known.
+    Unknown,
+}
+
+impl Attitude {
+    /// The manifest's word (`feedback`, `nominal`, `unknown`).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Attitude::Feedback => "feedback",
+            Attitude::Nominal => "nominal",
+            Attitude::Unknown => "unknown",
+        }
+    }
 }
 
 /// One acquisition window.
@@ -124,6 +151,16 @@ pub struct Segment {
     /// fits skip). Written by `ratecal import`; absent in a station's recordings.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub up: Option<String>,
+    /// Nominal angle of a `turn` about its `axis`, deg.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angle_deg: Option<f64>,
+    /// How well a static segment's attitude is known (absent: `feedback`, or `unknown`
+    /// for an old recording's `up: oblique`; see [`Segment::attitude`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub attitude: Option<Attitude>,
+    /// Tolerance of a `nominal` attitude, deg (required with it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerance_deg: Option<f64>,
 }
 
 impl Segment {
@@ -144,12 +181,26 @@ impl Segment {
             roll_deg: None,
             mount: None,
             up: None,
+            angle_deg: None,
+            attitude: None,
+            tolerance_deg: None,
         }
     }
 
-    /// Whether the segment is an oblique static pose (`up: oblique`).
+    /// Whether the segment is a static pose whose attitude is unknown (`attitude: unknown`,
+    /// or `up: oblique` of a recording imported before the key existed).
     pub fn is_oblique(&self) -> bool {
-        self.up.as_deref() == Some("oblique")
+        self.kind == SegmentKind::Static && self.attitude() == Attitude::Unknown
+    }
+
+    /// How well the attitude is known: the `attitude` key, else `unknown` for an old
+    /// recording's `up: oblique`, else `feedback`.
+    pub fn attitude(&self) -> Attitude {
+        match (self.attitude, self.up.as_deref()) {
+            (Some(a), _) => a,
+            (None, Some("oblique")) => Attitude::Unknown,
+            _ => Attitude::Feedback,
+        }
     }
 }
 

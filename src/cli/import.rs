@@ -95,6 +95,14 @@ fn print_summary(map: &ImportMap, s: &Summary) {
         let what = match (f.kind, f.up, f.rate) {
             (SegmentKind::Static, Some(u), _) => u.name(),
             (_, _, Some((a, r))) => format!("{} {r} deg/s", a.name()),
+            (SegmentKind::Turn, _, _) => match f.turn.and_then(|t| t.axis.zip(t.angle_deg)) {
+                Some(((k, s), a)) => format!(
+                    "{}{} {a} deg",
+                    if s < 0.0 { "-" } else { "" },
+                    ["x", "y", "z"][k]
+                ),
+                None => "free".into(),
+            },
             _ => String::new(),
         };
         outln!(
@@ -110,9 +118,18 @@ fn print_summary(map: &ImportMap, s: &Summary) {
     }
     if !s.oblique.is_empty() {
         outln!(
-            "note: {} oblique static segment(s) (no body axis within 10 deg of vertical) are \
-             marked `up: oblique` in the manifest: the six-position fits skip them",
+            "note: {} static segment(s) of unknown attitude (hand-held poses) are marked \
+             `attitude: unknown` in the manifest: the fits use only gravity's magnitude there",
             s.oblique.len()
+        );
+    }
+    if !s.nominal_by_default.is_empty() {
+        outln!(
+            "note: {} face(s) without `attitude` in the map are `attitude: nominal` within the \
+             import's check of `up` (tolerance_deg: {}): declare `attitude: nominal` with your \
+             fixture's tolerance for tighter misalignments",
+            s.nominal_by_default.len(),
+            ratecal_import::UP_TOLERANCE_DEG
         );
     }
     match &map.table {

@@ -24,6 +24,7 @@
 
 mod hidden;
 mod imu;
+mod manual;
 mod motion;
 mod rot;
 mod scenario;
@@ -33,6 +34,7 @@ mod write;
 
 pub use hidden::{CustomFn, Hidden, HiddenTruth};
 pub use imu::{GaussMarkov, Imu};
+pub use manual::{ManualKind, ManualSession, ManualTruth, write_manual};
 pub use motion::{AxesState, Axis, Plan, SegmentSpec, Step, Timeline};
 pub use rot::{M3, V3};
 pub use scenario::{Scenario, Thermal};

@@ -68,3 +68,8 @@ pub fn rodrigues(u: V3, th: f64) -> M3 {
     }
     out
 }
+
+/// The transpose of `m`.
+pub fn transpose(m: &M3) -> M3 {
+    std::array::from_fn(|i| std::array::from_fn(|j| m[j][i]))
+}

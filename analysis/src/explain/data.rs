@@ -42,13 +42,26 @@ pub(crate) struct Data {
     /// Whether the table stream is a table's feedback (not synthesized from declared
     /// attitudes by an import with `table: none`): table-side effects need it.
     pub table_feedback: bool,
+    /// The largest `tolerance_deg` of the nominal static segments, rad (0 without any): a
+    /// face placed by hand tilts within it, which a misalignment mimics.
+    pub tilt_rad: f64,
 }
 
 /// Whether a segment's attitude is unknown to the recording: a pose of a multi-position
 /// session that no body axis is near vertical in (`up: oblique`). Its specific force is
 /// not the table stream's, so no fit may use it as such.
 fn attitude_unknown(s: &crate::recording::Segment) -> bool {
-    s.up.as_deref() == Some("oblique")
+    s.is_oblique()
+}
+
+/// The largest tolerance of the recording's nominal static attitudes, rad.
+fn placement_tilt_rad(m: &crate::recording::Manifest) -> f64 {
+    m.segments
+        .iter()
+        .filter(|s| s.attitude() == crate::recording::Attitude::Nominal)
+        .filter_map(|s| s.tolerance_deg)
+        .fold(0.0, f64::max)
+        .to_radians()
 }
 
 /// Whether the manifest's table stream is a table's feedback: `ratecal import` names a
@@ -106,7 +119,9 @@ impl Data {
             .filter(|a| attitude_unknown(&segs[a.seg]))
             .map(|a| segs[a.seg].id.clone())
             .collect();
-        accs.retain(|a| !attitude_unknown(&segs[a.seg]));
+        // A hand turn has no reference either: no table follows the hand (its integral is
+        // the manual calibration's, `ratecal analyze`).
+        accs.retain(|a| !attitude_unknown(&segs[a.seg]) && segs[a.seg].kind != SegmentKind::Turn);
         let spans: Vec<(f64, f64)> = accs
             .iter()
             .map(|a| (segs[a.seg].t_start, segs[a.seg].t_end))
@@ -163,6 +178,7 @@ impl Data {
             left_out,
             table_feedback: has_table_feedback(m),
             grade,
+            tilt_rad: placement_tilt_rad(m),
         })
     }
 

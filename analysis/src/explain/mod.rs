@@ -172,15 +172,18 @@ pub(crate) fn explain_fitted(
     };
     if !data.left_out.is_empty() {
         warnings.push(format!(
-            "{} static segments with no body axis near vertical (up: oblique) are left out: \
-             explain needs each segment's attitude ({})",
+            "{} static segments of unknown attitude (attitude: unknown, or an old recording's \
+             up: oblique) are left out: explain needs each segment's attitude, and a hand-held \
+             pose has none to tilt ({})",
             data.left_out.len(),
             data.left_out.join(", ")
         ));
     }
+    let tilt = observe::tilt_in_start(data, &mut start);
     // What this recording cannot determine is not fitted: its columns are skipped in
     // every model grown from `start`.
-    let observed = observe::observe(data, &start);
+    let mut observed = observe::observe(data, &start);
+    observed.entries.extend(tilt);
     start.skip.extend(observed.skip.iter().copied());
     let all: Vec<usize> = (0..data.accs.len()).collect();
     let (sa, sg) = seed_segments(m, data);

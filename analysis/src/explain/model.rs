@@ -94,7 +94,7 @@ pub(crate) fn fit_with(
     wander: WanderRule,
 ) -> (Fit, Vec<usize>) {
     let merged = data.merged(accel, gyro);
-    fit_terms_merged(
+    let (mut f, unobs) = fit_terms_merged(
         &data.layout,
         &data.accs,
         &data.excitation,
@@ -103,7 +103,31 @@ pub(crate) fn fit_with(
         gyro,
         Some(&merged),
         wander,
-    )
+    );
+    tilt_as_nuisance(data, &mut f);
+    (f, unobs)
+}
+
+/// On faces placed by hand (`attitude: nominal`), a placement tilt is never physics: each
+/// face's tilt is a nuisance within its tolerance, which a misalignment cannot be told
+/// apart from. Its variance (two faces' tilts, each of standard deviation `tilt_rad`
+/// across the face, halved) joins each accelerometer misalignment's, so that neither its
+/// test nor its u credits the IMU with what the hand did.
+fn tilt_as_nuisance(data: &Data, f: &mut Fit) {
+    if data.tilt_rad <= 0.0 {
+        return;
+    }
+    let var = (1e3 * data.tilt_rad).powi(2) / 2.0;
+    for (e, fx) in data.layout.effects.iter().enumerate() {
+        if fx.id() != "accel_misalignment" {
+            continue;
+        }
+        for g in data.layout.columns_of(e) {
+            if f.estimated.contains(&g) && data.layout.param(g).unit == "mrad" {
+                f.cov[(g, g)] += var;
+            }
+        }
+    }
 }
 
 /// Misfit of channel `c` over `segs` under `fit`: its residual sum of squares in units of

@@ -72,6 +72,60 @@ pub(crate) fn observe(data: &Data, start: &Terms) -> Observability {
     out
 }
 
+/// On faces placed by hand (`attitude: nominal`) a placement tilt is never physics: each
+/// face's tilt is a nuisance within its tolerance, and on six faces an accelerometer
+/// misalignment cannot be told apart from it. The misalignment joins the starting model
+/// (so that what the two leave in the residuals is credited to neither, nor called
+/// unexplained) and is listed as not observable, with what would tell them apart.
+pub(crate) fn tilt_in_start(data: &Data, start: &mut Terms) -> Vec<NotObservable> {
+    if data.tilt_rad <= 0.0 {
+        return Vec::new();
+    }
+    // Each face's tilt is an offset of its own on the accelerometers (up to g times the
+    // tolerance): a bias that drifts, decays or steps between faces cannot be told from it.
+    let mut out = Vec::new();
+    let in_time: Vec<usize> = data
+        .probes
+        .iter()
+        .filter(|(_, p)| p.sensor == ratecal_physics::effects::Sensor::Accel && p.form.in_time())
+        .map(|p| p.0)
+        .collect();
+    if !in_time.is_empty() {
+        for &e in &in_time {
+            start.skip.extend(data.layout.columns_of(e));
+        }
+        out.push(NotObservable {
+            candidate: "form_accel_in_time".into(),
+            reason: format!(
+                "on faces placed by hand within {:.2} deg each face's tilt offsets the \
+                 accelerometers by up to g times that: a bias that drifts, decays or steps \
+                 between faces cannot be told apart from it",
+                data.tilt_rad.to_degrees()
+            ),
+            observed_by: "a rate table's angle feedback, or repeated faces".into(),
+        });
+    }
+    let Some(e) = data.layout.index("accel_misalignment") else {
+        return out;
+    };
+    if !start.effects.contains(&e) {
+        start.effects.push(e);
+    }
+    out.push(NotObservable {
+        candidate: "accel_misalignment".into(),
+        reason: format!(
+            "on faces placed by hand within {:.2} deg (attitude: nominal) a misalignment cannot \
+             be told apart from the faces' tilts: `ratecal analyze` states it as exact faces \
+             give it, with the tilts in its u",
+            data.tilt_rad.to_degrees()
+        ),
+        observed_by: "a rate table's angle feedback, or poses whose attitude is known better \
+                      than the misalignment"
+            .into(),
+    });
+    out
+}
+
 /// The columns of candidate `e` that the recording cannot determine, with why.
 fn check(data: &Data, start: &Terms, e: usize) -> Vec<(usize, Why)> {
     let lay = &data.layout;

@@ -12,6 +12,7 @@ mod accept;
 mod allan;
 mod gyro;
 pub(crate) mod joint;
+mod manual;
 mod models;
 pub(crate) mod prep;
 mod repeat;
@@ -107,6 +108,9 @@ pub fn analyze_source<S: Source>(
     opts: &Options,
 ) -> Result<Results, S::Error> {
     let m = src.manifest();
+    if manual::is_manual(m) {
+        return manual::analyze(src, plan, opts);
+    }
     let sel = select::select(m, plan, opts);
     let mut out = Out {
         warnings: sel.warnings.clone(),
@@ -227,6 +231,7 @@ pub fn analyze_source<S: Source>(
         warnings: Vec::new(),
         fits: Default::default(),
         size_effect: out.size_effect.take(),
+        manual: None,
     };
     res.fits = fitted.fits;
     res.model

@@ -85,7 +85,7 @@ pub(crate) fn recording_checks(
     ]
 }
 
-fn time_increasing(imu: &CadenceReport, table: &CadenceReport) -> SanityCheck {
+pub(crate) fn time_increasing(imu: &CadenceReport, table: &CadenceReport) -> SanityCheck {
     let name = "time_increasing";
     for (file, c) in [("imu.csv", imu), ("table.csv", table)] {
         if let Some((prev, t)) = c.backwards {
@@ -103,7 +103,7 @@ fn time_increasing(imu: &CadenceReport, table: &CadenceReport) -> SanityCheck {
     )
 }
 
-fn clocks_overlap(imu: (f64, f64), table: &TableStream) -> SanityCheck {
+pub(crate) fn clocks_overlap(imu: (f64, f64), table: &TableStream) -> SanityCheck {
     let name = "clocks_overlap";
     let (Some(&t0), Some(&t1)) = (table.t.first(), table.t.last()) else {
         return SanityCheck::new(name, SanityStatus::Fail, "table.csv holds no samples");
@@ -129,7 +129,11 @@ fn clocks_overlap(imu: (f64, f64), table: &TableStream) -> SanityCheck {
 }
 
 /// Gaps and jitter are counted and located in a warning; they never refuse a recording.
-fn sampling(imu: &CadenceReport, table: &CadenceReport, warnings: &mut Vec<String>) -> SanityCheck {
+pub(crate) fn sampling(
+    imu: &CadenceReport,
+    table: &CadenceReport,
+    warnings: &mut Vec<String>,
+) -> SanityCheck {
     let mut parts = Vec::new();
     for (file, c) in [("imu.csv", imu), ("table.csv", table)] {
         let hz = 1.0 / c.nominal_step_s;
@@ -319,7 +323,12 @@ fn gyro_follows_table(moving: &[(&RawSums, &str)], rest: &[(&RawSums, &str)]) ->
 
 /// The entry of a check judged segment by segment: `fail` when the worst segment exceeds
 /// its tolerance (with `hint`), `pass` with the worst one's figures, or `not_evaluated`.
-fn verdict(name: &str, worst: Option<(f64, String)>, none: &str, hint: &str) -> SanityCheck {
+pub(crate) fn verdict(
+    name: &str,
+    worst: Option<(f64, String)>,
+    none: &str,
+    hint: &str,
+) -> SanityCheck {
     match worst {
         None => SanityCheck::new(name, SanityStatus::NotEvaluated, none),
         Some((excess, detail)) if excess > 0.0 || excess.is_nan() => {
@@ -333,12 +342,25 @@ fn verdict(name: &str, worst: Option<(f64, String)>, none: &str, hint: &str) -> 
 /// and size-effect coordinates inside the ranges an IMU of any grade and a table have (a scale factor of -90 % is a units error, not a
 /// calibration).
 pub(crate) fn plausible(params: &BTreeMap<String, Parameter>) -> SanityCheck {
+    plausible_with(params, ACCEL_BIAS_MAX)
+}
+
+/// Largest plausible accelerometer offset of a part calibrated without a table, m/s^2:
+/// consumer parts' raw offsets reach hundreds of mg (the MPU-6050 session: 115 mg), and
+/// a manual calibration is the first one they get.
+pub const ACCEL_OFFSET_MAX_MANUAL: f64 = 5.0;
+
+/// [`plausible`] with the accelerometer bias allowed up to `accel_bias_max`, m/s^2.
+pub(crate) fn plausible_with(
+    params: &BTreeMap<String, Parameter>,
+    accel_bias_max: f64,
+) -> SanityCheck {
     let name = "fitted_values_plausible";
     let rule = |n: &str, unit: &str| -> Option<f64> {
         let kind = n.split('.').nth(1)?;
         match (n.split('.').next()?, kind, unit) {
             ("accel" | "gyro", "scale", "ppm") => Some(SCALE_MAX * 1e6),
-            ("accel", "bias", "m/s^2") => Some(ACCEL_BIAS_MAX),
+            ("accel", "bias", "m/s^2") => Some(accel_bias_max),
             ("gyro", "bias", "deg/s") => Some(GYRO_BIAS_MAX),
             ("accel" | "gyro", "misalignment", "mrad") => Some(MISALIGNMENT_MAX),
             ("size_effect", _, "mm") => Some(SIZE_EFFECT_MAX_MM),
@@ -374,7 +396,7 @@ pub(crate) fn plausible(params: &BTreeMap<String, Parameter>) -> SanityCheck {
             name,
             SanityStatus::Pass,
             format!(
-                "{checked} fitted values within +-{:.0} % scale, +-{ACCEL_BIAS_MAX} m/s^2 and +-{GYRO_BIAS_MAX} deg/s bias, +-{MISALIGNMENT_MAX} mrad misalignment, +-{LEVER_ARM_MAX_MM} mm lever arm, +-{SIZE_EFFECT_MAX_MM} mm size effect",
+                "{checked} fitted values within +-{:.0} % scale, +-{accel_bias_max} m/s^2 and +-{GYRO_BIAS_MAX} deg/s bias, +-{MISALIGNMENT_MAX} mrad misalignment, +-{LEVER_ARM_MAX_MM} mm lever arm, +-{SIZE_EFFECT_MAX_MM} mm size effect",
                 SCALE_MAX * 100.0
             ),
         )

@@ -82,6 +82,7 @@ fn kind_name(k: SegmentKind) -> &'static str {
         SegmentKind::Static => "static",
         SegmentKind::Rate => "rate",
         SegmentKind::Oscillation => "oscillation",
+        SegmentKind::Turn => "turn",
     }
 }
 

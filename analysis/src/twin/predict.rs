@@ -180,5 +180,6 @@ pub(super) fn kind_name(k: crate::recording::SegmentKind) -> &'static str {
         K::Static => "static",
         K::Rate => "rate",
         K::Oscillation => "oscillation",
+        K::Turn => "turn",
     }
 }

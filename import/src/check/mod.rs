@@ -112,7 +112,7 @@ pub fn check(map: &ImportMap, found: &[Found], source: &str) -> Result<(), Box<I
                     return Err(at_map(map, d.at.clone(), ErrorKind::Units, &what, &help));
                 }
             }
-            SegmentKind::Oscillation => {}
+            SegmentKind::Oscillation | SegmentKind::Turn => {}
         }
     }
     Ok(())

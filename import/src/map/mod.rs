@@ -2,6 +2,7 @@
 //! units and axes, which segments the data hold, and the site. Every refusal is located in
 //! the map file.
 
+mod attitude;
 mod raw;
 mod resolve;
 mod segments;
@@ -151,6 +152,8 @@ pub struct Detect {
     pub threshold: f64,
     /// Window of the moving variance, s.
     pub window_s: f64,
+    /// The detected poses' attitude (`None`: `unknown`, the default of a hand-held session).
+    pub attitude: Option<Attitude>,
     /// Where `segments:` is in the map.
     pub at: Range<usize>,
 }
@@ -168,6 +171,10 @@ pub struct DeclSegment {
     pub up: Option<Up>,
     /// Rotation axis and rate, deg/s (rate).
     pub rate: Option<(RateAxis, f64)>,
+    /// A turn's signed body axis and nominal angle, deg, when the map gives them.
+    pub turn: Option<Turn>,
+    /// The declared attitude of a static segment, when the map gives one.
+    pub attitude: Option<Attitude>,
     /// Where the segment is in the map.
     pub at: Range<usize>,
     /// Where its range is.
@@ -192,6 +199,26 @@ pub enum Up {
     Axis(usize, f64),
     /// No body axis within 10 deg of vertical.
     Oblique,
+}
+
+/// How well a static segment's attitude is known, as the map declares it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Attitude {
+    /// The table's feedback holds it (needs a feedback file).
+    Feedback,
+    /// The nominal face within `tolerance_deg`.
+    Nominal(f64),
+    /// Only gravity's magnitude is known.
+    Unknown,
+}
+
+/// A turn's body axis (index, sign) and nominal angle, deg; each optional.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Turn {
+    /// Signed body axis.
+    pub axis: Option<(usize, f64)>,
+    /// Nominal angle, deg.
+    pub angle_deg: Option<f64>,
 }
 
 /// The axis a rate segment turns about.

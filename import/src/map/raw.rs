@@ -142,6 +142,15 @@ pub struct RawSegment {
     pub axis: Option<Spanned<String>>,
     #[serde(default)]
     pub rate_dps: Option<Spanned<f64>>,
+    /// Nominal angle of a turn, deg.
+    #[serde(default)]
+    pub angle_deg: Option<Spanned<f64>>,
+    /// `feedback`, `nominal` or `unknown` (a static segment).
+    #[serde(default)]
+    pub attitude: Option<Spanned<String>>,
+    /// Tolerance of a nominal attitude, deg.
+    #[serde(default)]
+    pub tolerance_deg: Option<Spanned<f64>>,
 }
 
 /// `segments: { detect: {...} }`.
@@ -163,6 +172,12 @@ pub struct RawDetect {
     /// Window of the moving variance (`"0.5 s"`, default 0.5 s).
     #[serde(default)]
     pub window: Option<Spanned<String>>,
+    /// The detected poses' attitude: `unknown` (default without feedback) or `nominal`.
+    #[serde(default)]
+    pub attitude: Option<Spanned<String>>,
+    /// Tolerance of a nominal attitude, deg.
+    #[serde(default)]
+    pub tolerance_deg: Option<Spanned<f64>>,
 }
 
 impl<'de> Deserialize<'de> for RawSegments {

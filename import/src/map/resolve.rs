@@ -118,10 +118,12 @@ impl Resolver<'_> {
                             ))
                         }
                     })?;
+                    let attitude = self.detect_attitude(d, table.is_some())?;
                     Segments::Detect(Detect {
                         static_min_s,
                         threshold,
                         window_s,
+                        attitude,
                         at: self.at(&s.referenced),
                     })
                 }

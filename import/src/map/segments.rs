@@ -52,11 +52,13 @@ impl Resolver<'_> {
         let kind = match v.kind.value.as_str() {
             "static" => SegmentKind::Static,
             "rate" => SegmentKind::Rate,
+            "turn" => SegmentKind::Turn,
             k => {
                 return Err(self.err(
                     self.at(&v.kind.referenced),
                     &format!("segment kind `{k}` cannot be imported"),
-                    "kind is `static` or `rate` (an oscillation needs the table's feedback)",
+                    "kind is `static`, `rate` or `turn` (an oscillation needs the table's \
+                     feedback)",
                 ));
             }
         };
@@ -104,18 +106,33 @@ impl Resolver<'_> {
                     })?,
             ),
         };
+        let attitude = self.seg_attitude(v, feedback)?;
+        let unknown = attitude == Some(Attitude::Unknown);
         let rate = match kind {
             SegmentKind::Static => {
-                if up.is_none() && !feedback {
+                if up.is_none() && !feedback && !unknown {
                     return Err(self.err(
                         at,
                         &format!("static segment `{}` needs `up`", v.id.value),
                         "without table feedback the attitude comes from `up`: the body axis \
-                         that points up (+x, -z...) or `oblique`",
+                         that points up (+x, -z...), or `attitude: unknown` for a hand-held pose",
+                    ));
+                }
+                if matches!(attitude, Some(Attitude::Nominal(_)))
+                    && !matches!(up, Some(Up::Axis(..)))
+                {
+                    return Err(self.err(
+                        at,
+                        &format!(
+                            "nominal static segment `{}` needs `up` (a body axis)",
+                            v.id.value
+                        ),
+                        "a nominal attitude is a face: `up: +x`, `up: -z`...",
                     ));
                 }
                 None
             }
+            SegmentKind::Turn => None,
             _ => {
                 let (Some(axis), Some(r)) = (&v.axis, &v.rate_dps) else {
                     return Err(self.err(
@@ -152,12 +169,22 @@ impl Resolver<'_> {
                 Some((ax, r.value))
             }
         };
+        let turn = match kind {
+            SegmentKind::Turn => Some(self.turn(v)?),
+            _ => None,
+        };
         Ok(DeclSegment {
             id: v.id.value.clone(),
             kind,
             range,
-            up,
+            up: if unknown && up.is_none() {
+                Some(Up::Oblique)
+            } else {
+                up
+            },
             rate,
+            turn,
+            attitude,
             at,
             range_at,
             up_at,

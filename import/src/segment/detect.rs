@@ -5,7 +5,7 @@
 //! gravity when one body axis is within 10 deg of vertical; other intervals are oblique.
 
 use super::{Found, Stretch, Thinned};
-use crate::map::{Detect, Up};
+use crate::map::{Detect, Turn, Up};
 use crate::read::RowAt;
 use ratecal_recording::SegmentKind;
 
@@ -88,6 +88,8 @@ impl Blocks {
                     stretch: s,
                     up: Some(up),
                     rate: None,
+                    turn: None,
+                    attitude: d.attitude,
                     decl: None,
                 });
             }
@@ -101,8 +103,44 @@ impl Blocks {
             }
         }
         flush(&mut run, &mut out);
-        out
+        with_turns(out)
     }
+}
+
+/// The poses with a free `turn` between each two (the motion between them: its own
+/// samples, no axis, no nominal angle).
+fn with_turns(poses: Vec<Found>) -> Vec<Found> {
+    let mut out = Vec::with_capacity(2 * poses.len());
+    for p in poses {
+        if let Some(prev) = out
+            .last()
+            .filter(|f: &&Found| f.kind == SegmentKind::Static)
+        {
+            let (a, b) = (&prev.stretch, &p.stretch);
+            if b.samples.0 > a.samples.1 + 1 {
+                let stretch = Stretch {
+                    n: b.samples.0 - a.samples.1 - 1,
+                    samples: (a.samples.1 + 1, b.samples.0 - 1),
+                    lines: (a.lines.1 + 1, b.lines.0.saturating_sub(1)),
+                    t: (a.t.1, b.t.0),
+                    ..Stretch::default()
+                };
+                let n = out.iter().filter(|f| f.kind == SegmentKind::Turn).count();
+                out.push(Found {
+                    id: format!("turn/{:02}", n + 1),
+                    kind: SegmentKind::Turn,
+                    stretch,
+                    up: None,
+                    rate: None,
+                    turn: Some(Turn::default()),
+                    attitude: None,
+                    decl: None,
+                });
+            }
+        }
+        out.push(p);
+    }
+    out
 }
 
 /// Adds block `b` (sums only) to the interval `r`.
@@ -198,12 +236,23 @@ mod tests {
             static_min_s: 2.0,
             threshold: 6.0,
             window_s: 0.5,
+            attitude: None,
             at: 0..0,
         };
         let found = b.detect(&d);
-        let ups: Vec<_> = found.iter().map(|f| f.up.unwrap().name()).collect();
+        let ups: Vec<_> = found
+            .iter()
+            .filter_map(|f| f.up)
+            .map(|u| u.name())
+            .collect();
         assert_eq!(ups, ["+z", "+x"]);
         assert!(found[0].stretch.t.1 < 10.0 && found[0].stretch.t.1 > 9.0);
-        assert!(found[1].stretch.t.0 >= 12.0 && found[1].stretch.t.0 < 12.6);
+        assert!(found[2].stretch.t.0 >= 12.0 && found[2].stretch.t.0 < 12.6);
+        // The motion between the two poses is a turn from the first's end to the second's start.
+        assert_eq!(found[1].kind, SegmentKind::Turn);
+        assert_eq!(
+            found[1].stretch.t,
+            (found[0].stretch.t.1, found[2].stretch.t.0)
+        );
     }
 }

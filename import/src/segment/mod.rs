@@ -11,7 +11,7 @@ pub use attitude::{face_up, turn};
 pub use stats::{Stretch, Thinned, norm};
 
 use crate::error::{ErrorKind, ImportError, Say};
-use crate::map::{DeclSegment, ImportMap, RateAxis, SegRange, Segments, Up};
+use crate::map::{Attitude, DeclSegment, ImportMap, RateAxis, SegRange, Segments, Turn, Up};
 use crate::read::RowAt;
 use ratecal_recording::SegmentKind;
 
@@ -28,6 +28,10 @@ pub struct Found {
     pub up: Option<Up>,
     /// Axis and rate (rate).
     pub rate: Option<(RateAxis, f64)>,
+    /// Axis and nominal angle (turn).
+    pub turn: Option<Turn>,
+    /// The attitude the map declared (static; `None`: the default, see the write).
+    pub attitude: Option<Attitude>,
     /// Index of the declaring entry in the map (`None` when detected).
     pub decl: Option<usize>,
 }
@@ -115,6 +119,8 @@ impl Tracker {
                 stretch: s,
                 up: d.up,
                 rate: d.rate,
+                turn: d.turn,
+                attitude: d.attitude,
                 decl: Some(k),
             });
         }

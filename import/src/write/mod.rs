@@ -10,13 +10,13 @@ pub use provenance::{Conversion, FileHash, Provenance};
 
 use crate::check;
 use crate::error::{ErrorKind, ImportError};
-use crate::map::{ImportMap, Segments, TimeSpec, Up};
+use crate::map::{ImportMap, RateAxis, Segments, TimeSpec, Up};
 use crate::read::Rows;
 use crate::segment::table::{Pose, synthesize};
 use crate::segment::{Found, Stretch, Tracker, face_up, turn};
 use ratecal_recording::{
-    Columns, FORMAT, ImuSample, Manifest, ManifestStation, RecordingWriter, Segment, SegmentKind,
-    TableAxes, WrittenFile,
+    Attitude, Columns, FORMAT, ImuSample, Manifest, ManifestStation, RecordingWriter, Segment,
+    SegmentKind, TableAxes, WrittenFile,
 };
 use std::path::{Path, PathBuf};
 
@@ -33,8 +33,12 @@ pub struct Summary {
     pub t: (f64, f64),
     /// The manifest's segments.
     pub segments: Vec<Found>,
-    /// The oblique static intervals among the segments (`up: oblique`).
+    /// The static segments whose attitude is unknown (`attitude: unknown`: hand-held
+    /// poses, which the six-position fits skip).
     pub oblique: Vec<Found>,
+    /// The static segments made `attitude: nominal` within the import's own check of `up`
+    /// ([`crate::UP_TOLERANCE_DEG`]) because the map gave no attitude.
+    pub nominal_by_default: Vec<String>,
     /// Whether the segments were detected.
     pub detected: bool,
     /// Table samples synthesized or read from the feedback file.
@@ -152,16 +156,25 @@ pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> 
     let hashes = rows.finish();
     let found = tracker.finish(map, &all)?;
     check::check(map, &found, rows.name())?;
-    // Oblique poses stay among the segments, marked `up: oblique` (the six-position fits
-    // skip them); the summary lists them apart.
+    let feedback = map.table.is_some();
+    // Poses of unknown attitude stay among the segments, marked `attitude: unknown`; the
+    // summary lists them apart.
     let oblique: Vec<Found> = found
         .iter()
-        .filter(|f| f.kind == SegmentKind::Static && f.up == Some(Up::Oblique))
+        .filter(|f| {
+            f.kind == SegmentKind::Static && attitude_of(f, feedback) == Some(Attitude::Unknown)
+        })
         .cloned()
+        .collect();
+    let nominal_by_default: Vec<String> = found
+        .iter()
+        .filter(|f| f.kind == SegmentKind::Static && f.attitude.is_none() && !feedback)
+        .filter(|f| matches!(f.up, Some(Up::Axis(..))) && f.decl.is_some())
+        .map(|f| f.id.clone())
         .collect();
     let kept = found;
 
-    let (poses, segments) = poses(&kept);
+    let (poses, segments) = poses(&kept, feedback);
     let mut table_samples = 0u64;
     let mut table_file = None;
     if let Some(feed) = &map.table {
@@ -243,6 +256,7 @@ pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> 
         t: all.t,
         segments: kept,
         oblique,
+        nominal_by_default,
         detected: matches!(map.segments, Segments::Detect(_)),
         table_samples,
         files,
@@ -277,8 +291,31 @@ fn manifest(map: &ImportMap, segments: Vec<Segment>) -> Manifest {
     }
 }
 
+/// The manifest's attitude of a static segment: the map's, else (without feedback) a
+/// declared face is nominal within the import's check of `up` and any other pose unknown.
+fn attitude_of(f: &Found, feedback: bool) -> Option<Attitude> {
+    let face = matches!(f.up, Some(Up::Axis(..)));
+    match f.attitude {
+        Some(crate::map::Attitude::Feedback) => None,
+        Some(crate::map::Attitude::Nominal(_)) if !face => Some(Attitude::Unknown),
+        Some(crate::map::Attitude::Nominal(_)) => Some(Attitude::Nominal),
+        Some(crate::map::Attitude::Unknown) => Some(Attitude::Unknown),
+        None if feedback => None,
+        None if face && f.decl.is_some() => Some(Attitude::Nominal),
+        None => Some(Attitude::Unknown),
+    }
+}
+
+/// The tolerance of a nominal attitude, deg.
+fn tolerance_of(f: &Found) -> f64 {
+    match f.attitude {
+        Some(crate::map::Attitude::Nominal(t)) => t,
+        _ => crate::UP_TOLERANCE_DEG,
+    }
+}
+
 /// The table attitude of each kept segment and its manifest entry.
-fn poses(kept: &[Found]) -> (Vec<Pose>, Vec<Segment>) {
+fn poses(kept: &[Found], feedback: bool) -> (Vec<Pose>, Vec<Segment>) {
     let mut poses = Vec::with_capacity(kept.len());
     let mut segs = Vec::with_capacity(kept.len());
     let mut last = (0.0, 0.0);
@@ -286,9 +323,19 @@ fn poses(kept: &[Found]) -> (Vec<Pose>, Vec<Segment>) {
         let (t0, t1) = f.stretch.t;
         let mut seg = Segment::new(f.id.clone(), f.kind, t0, t1);
         seg.up = match (f.kind, f.up) {
-            (SegmentKind::Static, Some(u)) => Some(u.name()),
+            (SegmentKind::Static, Some(u @ Up::Axis(..))) => Some(u.name()),
             _ => None,
         };
+        if f.kind == SegmentKind::Static {
+            seg.attitude = attitude_of(f, feedback);
+            if seg.attitude == Some(Attitude::Nominal) {
+                seg.tolerance_deg = Some(tolerance_of(f));
+            }
+        }
+        if let Some(t) = f.turn {
+            seg.axis = t.axis.map(|(k, s)| RateAxis::Body(k, s).name());
+            seg.angle_deg = t.angle_deg;
+        }
         let pose = match (f.up, f.rate) {
             (up, Some((axis, rate))) => {
                 // A turn starts from its own `up` when the map gives one.

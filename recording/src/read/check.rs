@@ -174,6 +174,18 @@ pub(super) fn check_segments(
                 "a segment lies inside both imu.csv and table.csv; check its times".into(),
             ));
         }
+        if let Some((problem, help)) = attitude_problem(seg) {
+            return Err(RecordingError::BadAttitude {
+                file: file.to_string(),
+                line,
+                column,
+                id: seg.id.clone(),
+                problem,
+                help,
+                src: Excerpt::around(file, text.as_bytes(), offset, offset + len).0,
+                span: Excerpt::around(file, text.as_bytes(), offset, offset + len).1,
+            });
+        }
         if !imu_holds_sample(seg.t_start, seg.t_end) {
             return Err(RecordingError::EmptySegment {
                 file: file.to_string(),
@@ -188,4 +200,25 @@ pub(super) fn check_segments(
         }
     }
     Ok(())
+}
+
+/// What is wrong with a segment's `attitude` and `tolerance_deg`, and what would fix it.
+fn attitude_problem(seg: &crate::Segment) -> Option<(String, String)> {
+    let tol = seg.tolerance_deg;
+    match seg.attitude {
+        Some(crate::Attitude::Nominal) => match tol {
+            None => Some((
+                "is `attitude: nominal` without `tolerance_deg`".into(),
+                "a nominal attitude says how well it is known: add `tolerance_deg` (deg, e.g. \
+                 `tolerance_deg: 0.5` for a fixture's face placed on a bench)"
+                    .into(),
+            )),
+            Some(t) if !(t.is_finite() && t > 0.0) => Some((
+                format!("has `tolerance_deg: {t}`"),
+                "tolerance_deg is a positive number of degrees".into(),
+            )),
+            _ => None,
+        },
+        _ => None,
+    }
 }
