@@ -164,7 +164,7 @@ impl Ck<'_> {
         };
         let up = self.face(face);
         let tol = match within {
-            Some(v) => Some(self.tolerance(v)?),
+            Some(v) => Some(self.face_tolerance(v)?),
             None => None,
         };
         let up = up?;
@@ -179,7 +179,7 @@ impl Ck<'_> {
         }))
     }
 
-    fn tolerance(&mut self, v: &Value) -> Option<f64> {
+    fn face_tolerance(&mut self, v: &Value) -> Option<f64> {
         let q = self.quantity(v, Dim::Angle, "a pose tolerance")?;
         if q.value <= 0.0 || q.value > MAX_TOLERANCE_DEG {
             self.err(
