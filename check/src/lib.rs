@@ -12,10 +12,11 @@
 //! `check::duplicate_step`, `check::duplicate_segment`, `check::duplicate_param`,
 //! `check::segment_in_repeat`, `check::bad_segment_name`, `check::no_segment`,
 //! `check::loop_arity`, `check::expansion_too_large`, `check::unobservable`,
-//! `check::station_limit`, `check::import`, `check::structure`, `check::missing_runs`.
+//! `check::station_limit`, `check::manual_station`, `check::no_rest`, `check::import`, `check::structure`, `check::missing_runs`.
 
 mod accept;
 mod header;
+mod manual;
 mod motion;
 mod observe;
 mod registry;
@@ -65,6 +66,9 @@ pub struct StationLimits {
     pub accel_range_mps2: f64,
     /// Table and mount geometry.
     pub geometry: Geometry,
+    /// Whether the station's table is the operator (`table.driver: manual`): `place` and
+    /// `turn` instead of `move` and `spin`.
+    pub manual: bool,
 }
 
 /// Options of a check.

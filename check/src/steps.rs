@@ -88,6 +88,7 @@ pub(crate) struct Walk {
     pub step: String,
     pub max_list_len: u64,
     pub verify_from: Vec<ast::Spanned<String>>,
+    pub manual: super::manual::ManualWalk,
 }
 
 pub(crate) fn move_time(dist_deg: f64, v: f64, a: f64) -> f64 {
@@ -196,6 +197,24 @@ impl Ck<'_> {
         out: &mut Vec<Node>,
     ) {
         match s {
+            Stmt::Move(..) | Stmt::Spin { .. } | Stmt::Stop(..) | Stmt::Oscillate { .. } => {
+                self.table_statement(span)
+            }
+            Stmt::Acquire { .. } => self.rest_missing(),
+            _ => {}
+        }
+        match s {
+            Stmt::Place {
+                face,
+                within,
+                message,
+            } => out.extend(
+                self.place(face.as_ref(), within.as_ref(), message.as_ref(), span)
+                    .map(Node::Do),
+            ),
+            Stmt::Turn { about, segment } => {
+                out.extend(self.turn(about.as_ref(), segment, span).map(Node::Do))
+            }
             Stmt::Move(angles) => {
                 if let Some(a) = self.move_to(angles, span) {
                     out.push(Node::Do(a));
@@ -287,6 +306,7 @@ impl Ck<'_> {
             }
             Stmt::Settle(b) => {
                 let st = self.settle(b);
+                self.settled(&st);
                 self.walk.time_s += st.min_time_s;
                 out.push(Node::Do(Action::Settle(st)));
             }

@@ -193,6 +193,7 @@ fn station(max_rate: f64, gyro_range: f64, max_accel: f64) -> CheckOptions {
             gyro_range_dps: gyro_range,
             accel_range_mps2: 16.0 * 9.80665,
             geometry: Geometry::seed(),
+            manual: false,
         }),
     }
 }

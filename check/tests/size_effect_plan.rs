@@ -15,6 +15,7 @@ fn station(max_accel: f64) -> CheckOptions {
             gyro_range_dps: 400.0,
             accel_range_mps2: 16.0 * 9.80665,
             geometry: Geometry::vertical_outer(),
+            manual: false,
         }),
     }
 }

@@ -18,6 +18,7 @@
 
 pub mod emulate;
 pub mod frame;
+pub mod hand;
 pub mod line;
 pub mod link;
 pub mod registry;
@@ -31,6 +32,6 @@ pub use station::{
     DEFAULT_STATION_YAML, SWAYING_STATION_YAML, Station, StationError, StationInfo, yaml_offset,
 };
 pub use traits::{
-    DriverError, DriverErrorKind, ImuDriver, ImuInfo, ImuSample, LinkStats, TableAxisId,
+    DriverError, DriverErrorKind, ImuDriver, ImuInfo, ImuSample, LinkStats, OperatorAsk, TableAxisId,
     TableCommand, TableDriver, TableInfo, TableSample,
 };

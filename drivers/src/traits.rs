@@ -151,6 +151,25 @@ pub struct LinkStats {
     pub device_offset_s: Option<f64>,
 }
 
+/// What the operator of a manual station is asked for. Vectors are body axes (unit).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum OperatorAsk {
+    /// A pose: `up` the body axis brought up within `tolerance_deg` (`None`: a free pose).
+    Pose {
+        /// The body axis to bring up.
+        up: Option<[f64; 3]>,
+        /// How far from it the pose may be, deg.
+        tolerance_deg: f64,
+    },
+    /// A hand turn about a body axis by an angle (`None`: a free turn).
+    Turn {
+        /// Body axis and angle, deg.
+        about: Option<([f64; 3], f64)>,
+    },
+    /// The pose just found was refused: the operator is asked again.
+    Refused,
+}
+
 /// A rate table.
 #[async_trait]
 pub trait TableDriver: Send {
@@ -163,6 +182,14 @@ pub trait TableDriver: Send {
     /// How the link delivered its samples (`None` for a simulated or replayed table).
     fn link_stats(&self) -> Option<LinkStats> {
         None
+    }
+    /// Passes a request to the operator of a manual station (the interpreter has prompted
+    /// it; a simulated operator acts on it). A rate table has no operator: refused.
+    async fn ask(&mut self, _ask: OperatorAsk) -> Result<(), DriverError> {
+        Err(DriverError::new(
+            DriverErrorKind::InvalidCommand,
+            "this table has no operator to place or turn the unit",
+        ))
     }
 }
 

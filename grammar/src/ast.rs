@@ -422,6 +422,22 @@ pub enum Stmt {
         /// What the operator is told.
         message: Option<Spanned<String>>,
     },
+    /// `place +x up [within 5 deg] ["message"]` or `place free ["message"]` (manual station).
+    Place {
+        /// The body axis brought up (`+x`, or a loop variable); `None`: a free pose.
+        face: Option<Ident>,
+        /// How far the pose may be from the face (an angle).
+        within: Option<Value>,
+        /// What the operator is told.
+        message: Option<Spanned<String>>,
+    },
+    /// `turn about +x by 360 deg as "turn/x"` or `turn free as "turn/1"` (manual station).
+    Turn {
+        /// The body axis turned about (`+x`, or a loop variable) and the angle; `None`: free.
+        about: Option<(Ident, Value)>,
+        /// Segment name template of the turn.
+        segment: Spanned<String>,
+    },
 }
 
 /// An entry of a settle block.

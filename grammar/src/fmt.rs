@@ -278,6 +278,30 @@ fn stmt(w: &mut Writer, s: &Stmt) {
             }
             w.line(&l);
         }
+        Stmt::Place {
+            face,
+            within,
+            message,
+        } => {
+            let mut l = match face {
+                Some(f) => format!("place {} up", f.node),
+                None => "place free".to_string(),
+            };
+            if let Some(v) = within {
+                l.push_str(&format!(" within {}", value(v, 0)));
+            }
+            if let Some(m) = message {
+                l.push_str(&format!(" {}", string(&m.node)));
+            }
+            w.line(&l);
+        }
+        Stmt::Turn { about, segment } => {
+            let what = match about {
+                Some((f, a)) => format!("about {} by {}", f.node, value(a, 0)),
+                None => "free".to_string(),
+            };
+            w.line(&format!("turn {what} as {}", string(&segment.node)));
+        }
     }
 }
 

@@ -373,6 +373,8 @@ fn stmt(p: P) -> Stmt {
         Rule::accept => Stmt::Accept(accept_from(it)),
         Rule::verify => Stmt::Verify(verify_from(it, sp)),
         Rule::abort => Stmt::Abort(abort_from(it)),
+        Rule::place => place(it),
+        Rule::turn => turn(it),
         _ => {
             let axis = text(next());
             Stmt::Remount {
@@ -381,6 +383,37 @@ fn stmt(p: P) -> Stmt {
             }
         }
     }
+}
+
+fn place(mut it: pest::iterators::Pairs<Rule>) -> Stmt {
+    let what = it.next().expect("place pose");
+    let message = it.next().map(string);
+    if what.as_rule() == Rule::free {
+        return Stmt::Place {
+            face: None,
+            within: None,
+            message,
+        };
+    }
+    let mut parts = what.into_inner();
+    let face = text(parts.next().expect("place face"));
+    let within = parts.next().map(value);
+    Stmt::Place {
+        face: Some(face),
+        within,
+        message,
+    }
+}
+
+fn turn(mut it: pest::iterators::Pairs<Rule>) -> Stmt {
+    let what = it.next().expect("turn motion");
+    let segment = string(it.next().expect("turn segment"));
+    let about = (what.as_rule() == Rule::turn_about).then(|| {
+        let mut parts = what.into_inner();
+        let face = text(parts.next().expect("turn axis"));
+        (face, value(parts.next().expect("turn angle")))
+    });
+    Stmt::Turn { about, segment }
 }
 
 // accept/verify/abort appear both in a procedure and in a step; both lower from the

@@ -94,5 +94,6 @@ pub fn station_limits(st: &Station) -> StationLimits {
         gyro_range_dps: st.imu.gyro_range.get(),
         accel_range_mps2: st.imu.accel_range.get(),
         geometry: st.geometry(),
+        manual: st.table.driver.kind.operator,
     }
 }

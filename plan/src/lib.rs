@@ -191,6 +191,36 @@ pub enum Action {
         /// What the operator is told.
         message: String,
     },
+    /// Manual station: the operator places the unit and keeps it still; the next settle
+    /// waits for the IMU's rest and checks the pose.
+    Place(Pose),
+    /// Manual station: the operator turns the unit by hand; recorded as a `turn` segment
+    /// from the end of the last pose to the rest the next settle finds.
+    Turn(HandTurn),
+}
+
+/// A pose the operator is asked for.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Pose {
+    /// The body axis brought up (`+x`, `-z`); `None`: a free, hand-held pose.
+    pub up: Option<String>,
+    /// How far gravity may be from that axis, deg (`None` for a free pose).
+    pub tolerance_deg: Option<f64>,
+    /// What the operator is told.
+    pub message: String,
+}
+
+/// A hand turn the operator is asked for.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct HandTurn {
+    /// Segment id template of the turn.
+    pub segment: String,
+    /// The body axis turned about (`+x`); `None`: a free turn.
+    pub axis: Option<String>,
+    /// Nominal angle about `axis`, deg.
+    pub angle_deg: Option<f64>,
+    /// What the operator is told.
+    pub message: String,
 }
 
 /// Settle conditions, all of which must hold at once.

@@ -252,6 +252,19 @@ impl Live {
         )
     }
 
+    /// Mean accelerometer vector over the completed blocks inside `[from, to]` (`None`
+    /// without any).
+    pub fn accel_mean(&self, from: f64, to: f64) -> Option<[f64; 3]> {
+        let (mut sum, mut n) = ([0.0; 3], 0u32);
+        for b in self.imu.iter().filter(|b| b.first_t >= from && b.last_t <= to) {
+            for (k, s) in sum.iter_mut().enumerate() {
+                *s += b.sum[k];
+            }
+            n += b.n;
+        }
+        (n > 0).then(|| sum.map(|s| s / f64::from(n)))
+    }
+
     /// Largest value of a table channel over `[from, to]` (`None` without samples).
     pub fn table_max(&self, channel: usize, from: f64, to: f64) -> Option<f64> {
         let mut it = self

@@ -5,6 +5,7 @@
 
 pub use crate::station::{DRIVERS, DriverKind, DriverSpec, Settings, kind};
 
+use crate::hand::{HandImu, HandTable, HandWorld, ManualTable, SharedHand};
 use crate::link::{Endpoint, FramedImu, LinkTable};
 use crate::sim::{SharedWorld, SimImu, SimTable};
 use crate::station::Station;
@@ -23,9 +24,18 @@ pub struct Context<'a> {
     /// Origin of the host clock every hardware link maps its device time onto.
     pub start: Instant,
     world: Option<SharedWorld>,
+    hand: Option<SharedHand>,
 }
 
 impl Context<'_> {
+    /// The simulated operator (made on first use, then shared by table and IMU).
+    pub fn hand(&mut self) -> SharedHand {
+        let seed = self.seed;
+        self.hand
+            .get_or_insert_with(|| Arc::new(Mutex::new(HandWorld::new(seed))))
+            .clone()
+    }
+
     /// The simulated world (made on first use, then shared by table and IMU).
     pub fn world(&mut self) -> SharedWorld {
         self.world
@@ -68,6 +78,14 @@ pub fn builders(kind: &DriverKind) -> Builders {
                 Ok(Box::new(crate::replay::ReplayImu::open(dir, c.station)?))
             }),
         },
+        "manual" => Builders {
+            table: Some(manual_table),
+            imu: None,
+        },
+        "hand" => Builders {
+            table: Some(|c, _| Ok(Box::new(HandTable::new(c.station, c.hand(), true)))),
+            imu: None,
+        },
         _ => Builders {
             table: None,
             imu: None,
@@ -85,7 +103,21 @@ fn required<'a>(v: Option<&'a String>, key: &str) -> Result<&'a String, DriverEr
     })
 }
 
+/// A manual station's table: the operator; with a simulated IMU, a simulated operator
+/// in real time (its prompts shown to a person, the hand simulated).
+fn manual_table(c: &mut Context<'_>, _: &Settings) -> Result<Box<dyn TableDriver>, DriverError> {
+    if c.station.imu.driver.kind.name == "sim" {
+        return Ok(Box::new(HandTable::new(c.station, c.hand(), false)));
+    }
+    Ok(Box::new(ManualTable::new(c.station, c.start)))
+}
+
 fn sim_imu(c: &mut Context<'_>, _: &Settings) -> Result<Box<dyn ImuDriver>, DriverError> {
+    let table = c.station.table.driver.kind;
+    if table.operator {
+        let simulated = table.simulated;
+        return Ok(Box::new(HandImu::new(c.station, c.hand(), c.seed, simulated)));
+    }
     if !c.station.table.driver.kind.simulated {
         return Err(DriverError::new(
             DriverErrorKind::InvalidCommand,
@@ -147,6 +179,7 @@ pub fn build(station: &Station, seed: u64) -> Result<Drivers, DriverError> {
         seed,
         start: Instant::now(),
         world: None,
+        hand: None,
     };
     let (table, imu) = (&station.table.driver, &station.imu.driver);
     let no = |what: &str, k: &DriverKind| {
@@ -205,7 +238,8 @@ mod tests {
 
     #[test]
     fn every_kind_has_its_builders() {
-        for k in DRIVERS {
+        // A manual station's operator is its table: its IMU is read by another driver.
+        for k in DRIVERS.iter().filter(|k| !k.operator) {
             let b = builders(k);
             assert!(b.table.is_some() && b.imu.is_some(), "{}", k.name);
         }

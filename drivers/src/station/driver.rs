@@ -20,6 +20,9 @@ pub struct DriverKind {
     /// Whether its samples carry their host arrival time (`t_host`, a column of the
     /// recording's streams).
     pub host_arrival: bool,
+    /// Whether the operator is the table (a manual station: `place` and `turn` instead of
+    /// `move` and `spin`).
+    pub operator: bool,
     /// The settings it takes, each with whether it is required (none: written `driver:
     /// NAME`).
     pub keys: &'static [(&'static str, bool)],
@@ -39,6 +42,7 @@ pub const DRIVERS: &[DriverKind] = &[
         name: "sim",
         simulated: true,
         host_arrival: false,
+        operator: false,
         keys: &[],
         about: "simulated station (physics.md), seeded, virtual time",
     },
@@ -46,6 +50,7 @@ pub const DRIVERS: &[DriverKind] = &[
         name: "tcp",
         simulated: false,
         host_arrival: true,
+        operator: false,
         keys: &[("address", true), ("timeout", false)],
         about: "table over the line protocol, IMU over binary frames (docs/protocols.md), TCP",
     },
@@ -53,6 +58,7 @@ pub const DRIVERS: &[DriverKind] = &[
         name: "serial",
         simulated: false,
         host_arrival: true,
+        operator: false,
         keys: &[("port", true), ("baud", false), ("timeout", false)],
         about: "the same protocols over a serial port (tokio-serial)",
     },
@@ -60,8 +66,25 @@ pub const DRIVERS: &[DriverKind] = &[
         name: "replay",
         simulated: false,
         host_arrival: false,
+        operator: false,
         keys: &[("recording", true)],
         about: "replays the streams of a recording folder in time",
+    },
+    DriverKind {
+        name: "manual",
+        simulated: false,
+        host_arrival: false,
+        operator: true,
+        keys: &[],
+        about: "no rate table: the operator places and turns the unit, prompted on the terminal",
+    },
+    DriverKind {
+        name: "hand",
+        simulated: true,
+        host_arrival: false,
+        operator: true,
+        keys: &[],
+        about: "a simulated operator for a manual station (--dry-run): tilted poses, uneven turns, a tremor",
     },
 ];
 

@@ -66,7 +66,12 @@ pub fn station_for(
     };
     let mut station = Station::from_yaml(&yaml, &name).map_err(|e| Report::new(*e))?;
     crate::station::load(&mut station, &yaml, path)?;
-    if dry_run {
+    if dry_run && station.table.driver.kind.operator {
+        // A manual station's dry run simulates the operator and the IMU in its hand.
+        station.table.driver = ratecal_drivers::DriverSpec::new("hand", Default::default())
+            .map_err(|e| miette!("internal: {e}"))?;
+        station.imu.driver = ratecal_drivers::DriverSpec::sim();
+    } else if dry_run {
         station.table.driver = ratecal_drivers::DriverSpec::sim();
         station.imu.driver = ratecal_drivers::DriverSpec::sim();
     }

@@ -1,5 +1,7 @@
 //! The control loop and the walk over the plan's steps.
 
+mod manual;
+
 use super::command::{AxisCmd, CmdState, axis_id, substitute};
 use super::live::{ImuRow, Live, TableRow, stability_unmet};
 use super::monitor::{Fire, Monitor};
@@ -82,6 +84,8 @@ pub async fn execute(
         simulated: info.simulated && table_info.simulated,
         timeouts_since: None,
         warned_nonfinite: false,
+        manual: manual::Manual::default(),
+        operator: plan.steps.iter().flat_map(|s| s.body.iter()).any(asks_operator),
     };
     ex.journal(JournalEvent::Start {
         procedure: plan.name.clone(),
@@ -137,6 +141,14 @@ pub async fn execute(
     })
 }
 
+/// Whether a node asks the operator of a manual station for something.
+fn asks_operator(n: &Node) -> bool {
+    match n {
+        Node::Do(a) => matches!(a, Action::Place(_) | Action::Turn(_)),
+        Node::Repeat { body, .. } => body.iter().any(asks_operator),
+    }
+}
+
 /// Stability windows used by a node (to size the live window).
 fn stabilities(n: &Node) -> Vec<f64> {
     match n {
@@ -187,6 +199,11 @@ struct Exec<'a> {
     simulated: bool,
     timeouts_since: Option<f64>,
     warned_nonfinite: bool,
+    /// The operator's last request (a manual station).
+    manual: manual::Manual,
+    /// Whether the plan asks an operator (`place`, `turn`): static segments then carry the
+    /// attitude asked for, not the table's.
+    operator: bool,
 }
 
 impl Exec<'_> {
@@ -322,6 +339,8 @@ impl Exec<'_> {
             }
             Action::Settle(s) => self.settle(s).await?,
             Action::Acquire(acq) => self.acquire(acq, vars).await?,
+            Action::Place(p) => self.place(p).await?,
+            Action::Turn(t) => self.turn(t, vars).await?,
             Action::Remount { rotation, message } => {
                 if !self.progress.confirm(message) {
                     return Err(self.abort("operator declined the remount".into(), message.clone()));
@@ -381,6 +400,23 @@ impl Exec<'_> {
     }
 
     async fn settle(&mut self, s: &Settle) -> Res {
+        if !self.awaiting_operator() {
+            return self.settle_plain(s).await;
+        }
+        loop {
+            let since = self.now();
+            if self.manual.need_motion {
+                self.await_motion(s, since).await?;
+            }
+            self.settle_plain(s).await?;
+            let now = self.now();
+            if self.at_rest(s, now).await? {
+                return Ok(());
+            }
+        }
+    }
+
+    async fn settle_plain(&mut self, s: &Settle) -> Res {
         let since = self.now();
         loop {
             let now = self.now();
@@ -495,6 +531,7 @@ impl Exec<'_> {
             .cmd
             .segment(id.clone(), t_start, t_end, self.last_table.as_ref());
         seg.mount = self.pending_mount.take();
+        self.manual_segment(&mut seg);
         if let Err(e) = self.sink.segment(seg) {
             return Err(self.abort("recording error".into(), e.to_string()));
         }
