@@ -140,7 +140,7 @@ impl Exec<'_> {
                     up.to_uppercase()
                 );
                 self.journal(JournalEvent::Warning {
-                    rule: "pose refused".into(),
+                    rule: "pose".into(),
                     values: text.clone(),
                 });
                 self.progress.message(&text);
