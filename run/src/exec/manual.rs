@@ -114,7 +114,7 @@ impl Exec<'_> {
         s.stable.iter().any(|st| {
             self.live
                 .peak_to_peak(st.signal, now - MOTION_WINDOW_S, now)
-                .is_some_and(|p| p.iter().any(|v| !(*v <= st.max_fluctuation)))
+                .is_some_and(|p| p.iter().any(|v| v.is_nan() || *v > st.max_fluctuation))
         }) || s.stable.is_empty()
     }
 
