@@ -11,7 +11,10 @@ use std::path::Path;
 use support::*;
 
 fn manual_station() -> String {
-    format!("{}/drivers/stations/manual.yaml", env!("CARGO_MANIFEST_DIR"))
+    format!(
+        "{}/drivers/stations/manual.yaml",
+        env!("CARGO_MANIFEST_DIR")
+    )
 }
 
 fn manifest(dir: &Path) -> Manifest {
@@ -69,7 +72,11 @@ fn six_face_dry_run_records_faces_and_turns_and_ends_in_a_report() {
     }
     // The simulated operator puts the second face asked for (-X) upside down once.
     assert!(said.contains("refused: gravity is on +X"), "{said}");
-    assert_eq!(said.matches("Place the unit with -X up").count(), 1, "{said}");
+    assert_eq!(
+        said.matches("Place the unit with -X up").count(),
+        1,
+        "{said}"
+    );
     assert!(said.contains("place the unit with -X up again"), "{said}");
     let r = json(&tmp.path().join("run/results.json"));
     assert_eq!(r["manual"]["method"], "six_face", "{r}");
@@ -93,7 +100,11 @@ fn multi_pose_dry_run_records_unknown_poses_between_free_turns() {
     assert_eq!((statics.len(), turns.len()), (15, 14));
     assert!(statics.iter().all(|s| s.attitude() == Attitude::Unknown));
     assert!(statics[0].t_end - statics[0].t_start >= 30.0);
-    assert!(turns.iter().all(|t| t.axis.is_none() && t.angle_deg.is_none()));
+    assert!(
+        turns
+            .iter()
+            .all(|t| t.axis.is_none() && t.angle_deg.is_none())
+    );
     // Pose, turn, pose, ...: each turn between the rests around it.
     for (k, s) in m.segments.iter().enumerate() {
         let want = if k % 2 == 0 {
@@ -150,12 +161,10 @@ fn the_prompts_in_a_terminal_wait_for_rest_and_refuse_a_wrong_face() {
     let dir = tmp.path();
     std::fs::write(dir.join("p.rcal"), PTY_PROC).unwrap();
     // A manual station whose IMU is simulated: the prompts are real, the hand simulated.
-    let station = std::fs::read_to_string(manual_station())
-        .unwrap()
-        .replace(
-            "driver: { serial: { port: /dev/ttyUSB0, baud: 921600 } }",
-            "driver: sim",
-        );
+    let station = std::fs::read_to_string(manual_station()).unwrap().replace(
+        "driver: { serial: { port: /dev/ttyUSB0, baud: 921600 } }",
+        "driver: sim",
+    );
     std::fs::write(dir.join("station.yaml"), station).unwrap();
     let cmd = format!(
         "{} run p.rcal --station station.yaml --out run",
@@ -169,12 +178,19 @@ fn the_prompts_in_a_terminal_wait_for_rest_and_refuse_a_wrong_face() {
         .output()
         .expect("util-linux `script` runs the binary in a pseudo-terminal");
     let screen = String::from_utf8_lossy(&o.stdout).replace('\r', "");
-    let at = |s: &str| screen.find(s).unwrap_or_else(|| panic!("no `{s}` in\n{screen}"));
+    let at = |s: &str| {
+        screen
+            .find(s)
+            .unwrap_or_else(|| panic!("no `{s}` in\n{screen}"))
+    };
     let first = at("Place the unit with +Z up on the fixture, then keep it still");
     let second = at("Place the unit with -X up on the fixture, then keep it still");
     let refused = at("refused: gravity is on +X");
     let turn = at("Turn the unit by 90 deg about -X, then put it down and keep it still");
-    assert!(first < second && second < refused && refused < turn, "{screen}");
+    assert!(
+        first < second && second < refused && refused < turn,
+        "{screen}"
+    );
     // Real time: the run waited for the simulated hand's moves and rests.
     assert!(t0.elapsed().as_secs_f64() > 8.0, "{:?}", t0.elapsed());
     let m = manifest(&dir.join("run"));

@@ -153,7 +153,10 @@ impl Ck<'_> {
         self.walk.time_s += PLACE_S;
         let Some(face) = face else {
             let message = message.map_or_else(
-                || "Hold the unit in a new pose, different from the last ones, then keep it still".into(),
+                || {
+                    "Hold the unit in a new pose, different from the last ones, then keep it still"
+                        .into()
+                },
                 |m| m.node.clone(),
             );
             return Some(Action::Place(Pose {
@@ -169,7 +172,12 @@ impl Ck<'_> {
         };
         let up = up?;
         let message = message.map_or_else(
-            || format!("Place the unit with {} up on the fixture, then keep it still", up.to_uppercase()),
+            || {
+                format!(
+                    "Place the unit with {} up on the fixture, then keep it still",
+                    up.to_uppercase()
+                )
+            },
             |m| m.node.clone(),
         );
         Some(Action::Place(Pose {
@@ -223,7 +231,8 @@ impl Ck<'_> {
                 segment: id,
                 axis: None,
                 angle_deg: None,
-                message: "Turn the unit freely to a new pose, then put it down and keep it still".into(),
+                message: "Turn the unit freely to a new pose, then put it down and keep it still"
+                    .into(),
             }));
         };
         let axis = self.face(face);

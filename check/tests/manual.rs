@@ -32,10 +32,16 @@ fn place_needs_a_manual_station_and_move_a_table() {
     assert!(check_text("p.rcal", PLACE, &NoImports, &opts(true)).is_ok());
     assert!(check_text("p.rcal", MOVE, &NoImports, &opts(false)).is_ok());
     let r = refused(PLACE, false);
-    assert!(r.contains("check::manual_station") && r.contains("needs a manual station"), "{r}");
+    assert!(
+        r.contains("check::manual_station") && r.contains("needs a manual station"),
+        "{r}"
+    );
     assert!(r.contains("p.rcal:3:5") && r.contains("help:"), "{r}");
     let r = refused(MOVE, true);
-    assert!(r.contains("a manual station has no rate table to move"), "{r}");
+    assert!(
+        r.contains("a manual station has no rate table to move"),
+        "{r}"
+    );
     assert!(r.contains("p.rcal:3:5") && r.contains("help:"), "{r}");
 }
 
@@ -47,6 +53,12 @@ fn a_place_plans_the_pose_and_its_tolerance() {
         _ => None,
     });
     let pose = pose.expect("a place action");
-    assert_eq!((pose.up.as_deref(), pose.tolerance_deg), (Some("+z"), Some(5.0)));
-    assert!(pose.message.contains("Place the unit with +Z up on the fixture"));
+    assert_eq!(
+        (pose.up.as_deref(), pose.tolerance_deg),
+        (Some("+z"), Some(5.0))
+    );
+    assert!(
+        pose.message
+            .contains("Place the unit with +Z up on the fixture")
+    );
 }

@@ -32,6 +32,6 @@ pub use station::{
     DEFAULT_STATION_YAML, SWAYING_STATION_YAML, Station, StationError, StationInfo, yaml_offset,
 };
 pub use traits::{
-    DriverError, DriverErrorKind, ImuDriver, ImuInfo, ImuSample, LinkStats, OperatorAsk, TableAxisId,
-    TableCommand, TableDriver, TableInfo, TableSample,
+    DriverError, DriverErrorKind, ImuDriver, ImuInfo, ImuSample, LinkStats, OperatorAsk,
+    TableAxisId, TableCommand, TableDriver, TableInfo, TableSample,
 };

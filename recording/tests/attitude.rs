@@ -43,7 +43,10 @@ fn turns_and_attitudes_read_back() {
     assert_eq!(s[0].attitude(), Attitude::Nominal);
     assert_eq!(s[0].tolerance_deg, Some(0.5));
     assert_eq!(s[1].kind, SegmentKind::Turn);
-    assert_eq!((s[1].axis.as_deref(), s[1].angle_deg), (Some("-x"), Some(360.0)));
+    assert_eq!(
+        (s[1].axis.as_deref(), s[1].angle_deg),
+        (Some("-x"), Some(360.0))
+    );
     assert_eq!(s[2].attitude(), Attitude::Unknown);
     assert_eq!((s[3].axis.as_deref(), s[3].angle_deg), (None, None));
     // An old recording's oblique pose is a pose of unknown attitude.
@@ -52,8 +55,14 @@ fn turns_and_attitudes_read_back() {
     assert_eq!(s[5].attitude(), Attitude::Feedback);
     // Written back, the keys survive.
     let text = ratecal_recording::manifest_yaml(&r.manifest).unwrap();
-    assert!(text.contains("attitude: nominal") && text.contains("tolerance_deg: 0.5"), "{text}");
-    assert!(text.contains("kind: turn") && text.contains("angle_deg: 360"), "{text}");
+    assert!(
+        text.contains("attitude: nominal") && text.contains("tolerance_deg: 0.5"),
+        "{text}"
+    );
+    assert!(
+        text.contains("kind: turn") && text.contains("angle_deg: 360"),
+        "{text}"
+    );
 }
 
 #[test]
@@ -67,8 +76,13 @@ fn err_nominal_without_tolerance_is_located() {
     let e = read(dir.path()).unwrap_err();
     let msg = e.to_string();
     assert!(msg.contains("manifest.yaml:7:"), "{msg}");
-    assert!(msg.contains("`face`") && msg.contains("tolerance_deg"), "{msg}");
-    let help = miette::Diagnostic::help(&e).map(|h| h.to_string()).unwrap_or_default();
+    assert!(
+        msg.contains("`face`") && msg.contains("tolerance_deg"),
+        "{msg}"
+    );
+    let help = miette::Diagnostic::help(&e)
+        .map(|h| h.to_string())
+        .unwrap_or_default();
     assert!(help.contains("tolerance_deg"), "{help}");
 }
 

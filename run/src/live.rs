@@ -256,7 +256,11 @@ impl Live {
     /// without any).
     pub fn accel_mean(&self, from: f64, to: f64) -> Option<[f64; 3]> {
         let (mut sum, mut n) = ([0.0; 3], 0u32);
-        for b in self.imu.iter().filter(|b| b.first_t >= from && b.last_t <= to) {
+        for b in self
+            .imu
+            .iter()
+            .filter(|b| b.first_t >= from && b.last_t <= to)
+        {
             for (k, s) in sum.iter_mut().enumerate() {
                 *s += b.sum[k];
             }

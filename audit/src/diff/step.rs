@@ -91,11 +91,16 @@ impl<'a> View<'a> {
                     .push(format!("remount {rotation:?} \"{message}\""));
             }
             Action::Place(p) => self.attitudes.push(match &p.up {
-                Some(up) => format!("place {up} up within {} deg", fmt_num(p.tolerance_deg.unwrap_or(0.0))),
+                Some(up) => format!(
+                    "place {up} up within {} deg",
+                    fmt_num(p.tolerance_deg.unwrap_or(0.0))
+                ),
                 None => "place free".into(),
             }),
             Action::Turn(t) => self.motions.push(match (&t.axis, t.angle_deg) {
-                (Some(a), Some(d)) => format!("turn about {a} by {} deg as {}", fmt_num(d), t.segment),
+                (Some(a), Some(d)) => {
+                    format!("turn about {a} by {} deg as {}", fmt_num(d), t.segment)
+                }
                 _ => format!("turn free as {}", t.segment),
             }),
             Action::Stop { .. } => {}

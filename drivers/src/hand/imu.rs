@@ -87,7 +87,9 @@ impl ImuDriver for HandImu {
             }
             self.next_k += 1;
             let st = w.state(t - self.model.delay_at_s(t), &mut self.hint);
-            let (a, g) = self.model.outputs(&self.signals(t, st.c_bl, st.w_b, st.dw_b));
+            let (a, g) = self
+                .model
+                .outputs(&self.signals(t, st.c_bl, st.w_b, st.dw_b));
             let mut s = ImuSample {
                 t,
                 accel: [0.0; 3],

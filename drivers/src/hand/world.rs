@@ -110,7 +110,10 @@ impl HandWorld {
         let now = self.now();
         let t0 = self.moves.last().map_or(0.0, |m| m.t0 + m.dur).max(now) + REACTION_S;
         match ask {
-            OperatorAsk::Pose { up: Some(up), tolerance_deg } => {
+            OperatorAsk::Pose {
+                up: Some(up),
+                tolerance_deg,
+            } => {
                 let up = unit(Vec3::from(up));
                 self.asked = Some((up, tolerance_deg));
                 self.faces += 1;
@@ -122,7 +125,9 @@ impl HandWorld {
                 let (u, a) = (self.random_axis(), self.free_angle());
                 self.turn(t0, u, a);
             }
-            OperatorAsk::Turn { about: Some((axis, deg)) } => {
+            OperatorAsk::Turn {
+                about: Some((axis, deg)),
+            } => {
                 self.turn(t0, unit(Vec3::from(axis)), deg.to_radians());
             }
             OperatorAsk::Turn { about: None } => {
@@ -152,7 +157,11 @@ impl HandWorld {
         let z = Vec3::z();
         let c = up.cross(&z);
         let align = if c.norm() < 1e-9 {
-            if up.z > 0.0 { Mat3::identity() } else { rotation(&Vec3::x(), PI) }
+            if up.z > 0.0 {
+                Mat3::identity()
+            } else {
+                rotation(&Vec3::x(), PI)
+            }
         } else {
             rotation(&unit(c), up.dot(&z).clamp(-1.0, 1.0).acos())
         };
@@ -168,7 +177,15 @@ impl HandWorld {
         let v = unit(u.cross(&self.random_axis()));
         let uneven = 0.5 + 0.4 * self.gauss().clamp(-1.0, 1.0);
         let dur = 1.5 + angle.abs() / PI * 2.0 + 0.5 * self.rng.random::<f64>();
-        let m = Move { t0, dur, c0: self.last, u, angle, v, uneven };
+        let m = Move {
+            t0,
+            dur,
+            c0: self.last,
+            u,
+            angle,
+            v,
+            uneven,
+        };
         self.last = m.c0 * rotation(&u, angle);
         self.moves.push(m);
     }
@@ -198,12 +215,17 @@ impl HandWorld {
         let env = (PI * s).sin();
         let denv = PI * (PI * s).cos() / m.dur;
         let delta = TREMOR_RAD * env * (w * (t - m.t0)).sin();
-        let ddelta = TREMOR_RAD * (denv * (w * (t - m.t0)).sin() + env * w * (w * (t - m.t0)).cos());
+        let ddelta =
+            TREMOR_RAD * (denv * (w * (t - m.t0)).sin() + env * w * (w * (t - m.t0)).cos());
         let r_v = rotation(&m.v, delta);
         let c_lb = m.c0 * rotation(&m.u, phi) * r_v;
         // C_LB = C0 R(u, phi) R(v, delta): w_B = R(v, delta)^T u phi' + v delta'.
         let w_b = r_v.transpose() * m.u * dphi + m.v * ddelta;
-        HandState { c_bl: c_lb.transpose(), w_b, dw_b: r_v.transpose() * m.u * ddphi }
+        HandState {
+            c_bl: c_lb.transpose(),
+            w_b,
+            dw_b: r_v.transpose() * m.u * ddphi,
+        }
     }
 
     /// When the last move asked for ends, s (the unit is down and still after it).
@@ -213,14 +235,22 @@ impl HandWorld {
 }
 
 fn at_rest(c_lb: Mat3) -> HandState {
-    HandState { c_bl: c_lb.transpose(), w_b: Vec3::zeros(), dw_b: Vec3::zeros() }
+    HandState {
+        c_bl: c_lb.transpose(),
+        w_b: Vec3::zeros(),
+        dw_b: Vec3::zeros(),
+    }
 }
 
 /// Axis and angle of a rotation matrix (angle in [0, pi]).
 fn axis_angle(r: &Mat3) -> (Vec3, f64) {
     let c = ((r.trace() - 1.0) / 2.0).clamp(-1.0, 1.0);
     let angle = c.acos();
-    let v = Vec3::new(r[(2, 1)] - r[(1, 2)], r[(0, 2)] - r[(2, 0)], r[(1, 0)] - r[(0, 1)]);
+    let v = Vec3::new(
+        r[(2, 1)] - r[(1, 2)],
+        r[(0, 2)] - r[(2, 0)],
+        r[(1, 0)] - r[(0, 1)],
+    );
     if v.norm() > 1e-6 {
         return (v / v.norm(), angle);
     }
@@ -229,7 +259,9 @@ fn axis_angle(r: &Mat3) -> (Vec3, f64) {
     }
     // Half a turn: the axis is the column of R + I with the largest norm.
     let m = r + Mat3::identity();
-    let k = (0..3).max_by(|a, b| m.column(*a).norm().total_cmp(&m.column(*b).norm())).unwrap_or(0);
+    let k = (0..3)
+        .max_by(|a, b| m.column(*a).norm().total_cmp(&m.column(*b).norm()))
+        .unwrap_or(0);
     (unit(m.column(k).into()), angle)
 }
 
@@ -240,7 +272,10 @@ mod tests {
     #[test]
     fn a_placed_face_is_up_within_its_tolerance() {
         let mut w = HandWorld::new(3);
-        w.ask(OperatorAsk::Pose { up: Some([0.0, -1.0, 0.0]), tolerance_deg: 5.0 });
+        w.ask(OperatorAsk::Pose {
+            up: Some([0.0, -1.0, 0.0]),
+            tolerance_deg: 5.0,
+        });
         let s = w.state(1e6, &mut 0);
         let up_b = s.c_bl * Vec3::z();
         assert!(up_b.dot(&Vec3::new(0.0, -1.0, 0.0)) > 5f64.to_radians().cos());
@@ -249,7 +284,9 @@ mod tests {
     #[test]
     fn the_rates_integrate_to_the_attitude() {
         let mut w = HandWorld::new(5);
-        w.ask(OperatorAsk::Turn { about: Some(([1.0, 0.0, 0.0], 90.0)) });
+        w.ask(OperatorAsk::Turn {
+            about: Some(([1.0, 0.0, 0.0], 90.0)),
+        });
         let (mut c, dt) = (Mat3::identity(), 1e-4);
         let mut hint = 0;
         let mut t = 0.0;

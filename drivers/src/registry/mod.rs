@@ -116,7 +116,12 @@ fn sim_imu(c: &mut Context<'_>, _: &Settings) -> Result<Box<dyn ImuDriver>, Driv
     let table = c.station.table.driver.kind;
     if table.operator {
         let simulated = table.simulated;
-        return Ok(Box::new(HandImu::new(c.station, c.hand(), c.seed, simulated)));
+        return Ok(Box::new(HandImu::new(
+            c.station,
+            c.hand(),
+            c.seed,
+            simulated,
+        )));
     }
     if !c.station.table.driver.kind.simulated {
         return Err(DriverError::new(

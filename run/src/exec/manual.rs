@@ -71,11 +71,7 @@ impl Exec<'_> {
 
     pub(super) async fn turn(&mut self, t: &HandTurn, vars: &[(String, u64)]) -> Res {
         self.progress.message(&t.message);
-        let about = t
-            .axis
-            .as_deref()
-            .and_then(axis_vector)
-            .zip(t.angle_deg);
+        let about = t.axis.as_deref().and_then(axis_vector).zip(t.angle_deg);
         self.ask(OperatorAsk::Turn { about }).await?;
         let start = self.manual.last_rest_end.unwrap_or_else(|| self.now());
         let id = substitute(&t.segment, vars);
@@ -176,7 +172,12 @@ impl Exec<'_> {
         self.manual.last_rest_end = Some(seg.t_end);
         seg.pitch_deg = None;
         seg.roll_deg = None;
-        match self.manual.pose.as_ref().and_then(|p| p.up.clone().zip(p.tolerance_deg)) {
+        match self
+            .manual
+            .pose
+            .as_ref()
+            .and_then(|p| p.up.clone().zip(p.tolerance_deg))
+        {
             Some((up, tol)) => {
                 seg.up = Some(up);
                 seg.attitude = Some(Attitude::Nominal);

@@ -85,7 +85,11 @@ pub async fn execute(
         timeouts_since: None,
         warned_nonfinite: false,
         manual: manual::Manual::default(),
-        operator: plan.steps.iter().flat_map(|s| s.body.iter()).any(asks_operator),
+        operator: plan
+            .steps
+            .iter()
+            .flat_map(|s| s.body.iter())
+            .any(asks_operator),
     };
     ex.journal(JournalEvent::Start {
         procedure: plan.name.clone(),
