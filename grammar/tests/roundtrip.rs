@@ -56,6 +56,11 @@ fn statement() -> impl Strategy<Value = String> {
         Just("fit accel bias_scale from a/*, b using c { outliers 3 sigma lowpass butterworth order 4 cutoff 10 Hz }".to_string()),
         Just("remount x up \"turn \\\"it\\\"\"".to_string()),
         num().prop_map(|a| format!("oscillate outer amplitude {a} deg period 5 s for 60 s")),
+        num().prop_map(|a| format!("place -y up within {a} deg \"on its side\"")),
+        Just("place free".to_string()),
+        Just("place top up".to_string()),
+        num().prop_map(|a| format!("turn about +z by {a} deg as \"turn/{{k}}\"")),
+        Just("turn free as \"t\"".to_string()),
     ]
 }
 

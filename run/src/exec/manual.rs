@@ -110,7 +110,7 @@ impl Exec<'_> {
         s.stable.iter().any(|st| {
             self.live
                 .peak_to_peak(st.signal, now - MOTION_WINDOW_S, now)
-                .is_some_and(|p| p.iter().any(|v| *v > st.max_fluctuation || v.is_nan()))
+                .is_some_and(|p| p.iter().any(|v| v.is_nan() || *v > st.max_fluctuation))
         }) || s.stable.is_empty()
     }
 
@@ -136,7 +136,7 @@ impl Exec<'_> {
                     up.to_uppercase()
                 );
                 self.journal(JournalEvent::Warning {
-                    rule: "pose refused".into(),
+                    rule: "pose".into(),
                     values: text.clone(),
                 });
                 self.progress.message(&text);
