@@ -37,10 +37,13 @@ fn every_registered_kind_parses_from_its_name() {
         "tcp" => "{ tcp: { address: \"127.0.0.1:9\", timeout: 1 s } }".into(),
         "serial" => "{ serial: { port: /dev/ttyUSB0, baud: 115200 } }".into(),
         "replay" => "{ replay: { recording: runs/a } }".into(),
+        "manual" => "manual".into(),
+        "hand" => "hand".into(),
         other => panic!("a kind this test does not know: {other}"),
     };
     for k in DRIVERS {
-        let imu = if k.name == "sim" {
+        // The operator kinds are tables only: their IMU is another driver.
+        let imu = if matches!(k.name, "sim" | "manual" | "hand") {
             "sim".into()
         } else {
             settings(k.name)

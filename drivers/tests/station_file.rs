@@ -48,6 +48,12 @@ fn wrong_unit_is_located() {
 #[test]
 fn every_example_station_parses_and_builds() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("stations");
+    // Hardware links (the manual station's serial IMU) start their readers on a runtime.
+    let rt = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .unwrap();
+    let _inside = rt.enter();
     let mut n = 0;
     for entry in std::fs::read_dir(dir).unwrap() {
         let path = entry.unwrap().path();
