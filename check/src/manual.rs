@@ -4,7 +4,6 @@
 //! is followed by a `settle` that watches the IMU, so that the step begins at rest.
 
 use super::Ck;
-use super::steps::SegInfo;
 use super::values::{Val, suggest};
 use ratecal_grammar::Diagnostic;
 use ratecal_grammar::ast::{Ident, Span, Spanned, Value};
@@ -213,19 +212,7 @@ impl Ck<'_> {
         self.manual_statement(span, "turn");
         self.walk.time_s += TURN_S;
         let id = self.segment_id(&segment.node, segment.span)?;
-        let repeats = self
-            .walk
-            .repeats
-            .iter()
-            .filter(|(_, n)| *n > 1)
-            .map(|(v, _)| v.clone())
-            .collect();
-        self.walk.segments.push(SegInfo {
-            id: id.clone(),
-            span: segment.span,
-            motion: self.walk.motion.clone(),
-            repeats,
-        });
+        self.register_segment(&id, segment.span);
         let Some((face, angle)) = about else {
             return Some(Action::Turn(HandTurn {
                 segment: id,

@@ -101,6 +101,24 @@ pub(crate) fn move_time(dist_deg: f64, v: f64, a: f64) -> f64 {
 }
 
 impl Ck<'_> {
+    /// Registers segment `id` (an acquisition or a hand turn) at the walk's motion, with
+    /// the repeat variables (count > 1) that enclose it.
+    pub(crate) fn register_segment(&mut self, id: &str, span: Span) {
+        let repeats = self
+            .walk
+            .repeats
+            .iter()
+            .filter(|(_, n)| *n > 1)
+            .map(|(v, _)| v.clone())
+            .collect();
+        self.walk.segments.push(SegInfo {
+            id: id.to_string(),
+            span,
+            motion: self.walk.motion.clone(),
+            repeats,
+        });
+    }
+
     pub(crate) fn table_limits(&self) -> (f64, f64) {
         self.station
             .as_ref()
@@ -332,21 +350,9 @@ impl Ck<'_> {
                 let r = self.quantity(rate, Dim::Frequency, "a sample rate");
                 let id = self.segment_id(&segment.node, segment.span);
                 let Some(id) = id else { return };
-                let repeats = self
-                    .walk
-                    .repeats
-                    .iter()
-                    .filter(|(_, n)| *n > 1)
-                    .map(|(v, _)| v.clone())
-                    .collect();
                 // Registered even when its duration or rate is wrong, so that fits naming
                 // it do not report a second, spurious error.
-                self.walk.segments.push(SegInfo {
-                    id: id.clone(),
-                    span: segment.span,
-                    motion: self.walk.motion.clone(),
-                    repeats,
-                });
+                self.register_segment(&id, segment.span);
                 let (Some(d), Some(r)) = (d, r) else { return };
                 self.walk.time_s += d.value;
                 out.push(Node::Do(Action::Acquire(Acquire {
