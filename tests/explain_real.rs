@@ -17,17 +17,7 @@ use std::path::{Path, PathBuf};
 
 /// Imports `sources` with `map_name` into `dir/run` and explains it; the JSON.
 fn import_and_explain(dir: &Path, sources: &[PathBuf], map_name: &str) -> Value {
-    let mut args: Vec<String> = vec!["import".into()];
-    args.extend(sources.iter().map(|s| s.to_str().unwrap().to_string()));
-    args.extend([
-        "--map".into(),
-        import_map(map_name),
-        "--out".into(),
-        "run".into(),
-    ]);
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let o = ratecal(&args, dir);
-    assert_eq!(code(&o), 0, "{}", text(&o));
+    import_to_run(dir, sources, map_name);
     let o = ratecal(&["explain", "run", "--format", "json"], dir);
     assert!(matches!(code(&o), 0 | 1), "{}", text(&o));
     serde_json::from_slice(&o.stdout).unwrap_or_else(|e| panic!("{e}: {}", text(&o)))
@@ -177,10 +167,7 @@ fn mpu6050_hand_held_session_reports_nothing_implausible() {
 
 #[test]
 fn imu_tk_xsens_session_reports_nothing_implausible() {
-    let (Some(acc), Some(gyr)) = (
-        shared_path("real/imu_tk/xsens_acc.mat"),
-        shared_path("real/imu_tk/xsens_gyro.mat"),
-    ) else {
+    let Some([acc, gyr]) = xsens_session() else {
         return;
     };
     let tmp = tempfile::tempdir().unwrap();

@@ -54,10 +54,7 @@ fn intervals(run: &Path) -> Vec<(f64, f64, Option<String>)> {
 
 #[test]
 fn imu_tk_xsens_poses_are_found_and_static_by_the_factory_calibration() {
-    let (Some(acc), Some(gyr)) = (
-        shared_path("real/imu_tk/xsens_acc.mat"),
-        shared_path("real/imu_tk/xsens_gyro.mat"),
-    ) else {
+    let Some([acc, gyr]) = xsens_session() else {
         return;
     };
     let tmp = tempfile::tempdir().unwrap();

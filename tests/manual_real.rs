@@ -15,17 +15,7 @@ use std::path::{Path, PathBuf};
 
 /// Imports `sources` with `map` into `dir/run` and analyses it; results.json as JSON.
 fn calibrate(dir: &Path, sources: &[PathBuf], map: &str) -> Value {
-    let mut args = vec!["import".to_string()];
-    args.extend(sources.iter().map(|p| p.display().to_string()));
-    args.extend([
-        "--map".into(),
-        import_map(map),
-        "--out".into(),
-        "run".into(),
-    ]);
-    let a: Vec<&str> = args.iter().map(String::as_str).collect();
-    let o = ratecal(&a, dir);
-    assert_eq!(code(&o), 0, "{}", text(&o));
+    import_to_run(dir, sources, map);
     let o = ratecal(&["analyze", "run", "--out", "results.json"], dir);
     // Not judged (no procedure): exit 0; the sanity checks must hold.
     assert_eq!(code(&o), 0, "{}", text(&o));
@@ -69,10 +59,7 @@ fn mat_mul(a: [[f64; 3]; 3], b: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
 
 #[test]
 fn imu_tk_xsens_poses_read_the_authors_gravity_and_turns_carry_it() {
-    let (Some(acc), Some(gyr)) = (
-        shared_path("real/imu_tk/xsens_acc.mat"),
-        shared_path("real/imu_tk/xsens_gyro.mat"),
-    ) else {
+    let Some([acc, gyr]) = xsens_session() else {
         return;
     };
     let tmp = tempfile::tempdir().unwrap();

@@ -150,3 +150,27 @@ pub fn import_map(name: &str) -> String {
         .join(name);
     p.to_str().unwrap().to_string()
 }
+
+/// Imports `sources` with the example map `map` (`docs/examples/import/`) into `dir/run`;
+/// the import must succeed.
+pub fn import_to_run(dir: &Path, sources: &[PathBuf], map: &str) {
+    let mut args = vec!["import".to_string()];
+    args.extend(sources.iter().map(|p| p.display().to_string()));
+    args.extend([
+        "--map".into(),
+        import_map(map),
+        "--out".into(),
+        "run".into(),
+    ]);
+    let a: Vec<&str> = args.iter().map(String::as_str).collect();
+    let o = ratecal(&a, dir);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+}
+
+/// imu_tk's Xsens session in `../shared/real/imu_tk/` (accelerometer, gyro), if present.
+pub fn xsens_session() -> Option<[PathBuf; 2]> {
+    Some([
+        shared_path("real/imu_tk/xsens_acc.mat")?,
+        shared_path("real/imu_tk/xsens_gyro.mat")?,
+    ])
+}
