@@ -140,11 +140,12 @@ fn fifty_gauss_markov_nulls_at_most_one_with_a_finding() {
     assert!(with <= 1, "{with}/50");
 }
 
-/// One Gauss-Markov null, its seed from `GM_SEED`: what the sweep's failures are read with.
+/// One Gauss-Markov null, its seed from `GM_SEED` (309 by default, a seed the scan once
+/// failed): a failing seed of the sweep rerun alone, with `RATECAL_EXPLAIN_DEBUG=1`.
 #[test]
 #[ignore]
-fn one_gauss_markov_null() {
+fn one_gauss_markov_null_finds_nothing() {
     let seed = std::env::var("GM_SEED").map_or(309, |s| s.parse().unwrap());
     let f = false_findings(&explain_witness(&gm_null(seed)));
-    eprintln!("seed {seed}: {f:?}");
+    assert!(f.is_empty(), "seed {seed}: {f:?}");
 }
