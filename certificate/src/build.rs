@@ -87,7 +87,7 @@ pub fn type_a_dof(results: &Results, quantity: &str) -> f64 {
     (used.1 - used.0 as f64).max(1.0)
 }
 
-/// `value +- U unit (k = 2.05, 95 %)`, `U` to two significant digits and the value to
+/// `value ± U unit (k = 2.05, 95 %)`, `U` to two significant digits and the value to
 /// the same decimal place.
 pub fn gum_text(value: f64, expanded: f64, k: f64, unit: &str) -> String {
     let decimals = if expanded > 0.0 && expanded.is_finite() {
@@ -95,8 +95,9 @@ pub fn gum_text(value: f64, expanded: f64, k: f64, unit: &str) -> String {
     } else {
         6
     };
+    let u = crate::units::pretty(unit);
     format!(
-        "{value:.decimals$} +- {expanded:.decimals$} {unit} (k = {k:.2}, {:.0} %)",
+        "{value:.decimals$} ± {expanded:.decimals$} {u} (k = {k:.2}, {:.0} %)",
         COVERAGE * 100.0
     )
 }
@@ -161,8 +162,8 @@ pub fn build(input: Input<'_>) -> Certificate {
             pl.steps
                 .iter()
                 .map(|s| match &s.title {
-                    Some(t) => format!("{t} (step `{}`)", s.name),
-                    None => format!("step `{}`", s.name),
+                    Some(t) => format!("{t} (step “{}”)", s.name),
+                    None => format!("step “{}”", s.name),
                 })
                 .collect()
         })
@@ -217,7 +218,7 @@ pub fn build(input: Input<'_>) -> Certificate {
             calibration_date,
             issue_date: input.issue_date,
             location: format!(
-                "{} (latitude {:.4} deg)",
+                "{} (latitude {:.4}°)",
                 input.lab.address.replace('\n', ", ").trim(),
                 site.latitude_deg
             ),
@@ -359,11 +360,11 @@ mod tests {
     fn results_are_rounded_to_two_significant_digits_of_u() {
         assert_eq!(
             gum_text(-653.123, 11.74, 2.048, "ppm"),
-            "-653 +- 12 ppm (k = 2.05, 95 %)"
+            "-653 ± 12 ppm (k = 2.05, 95 %)"
         );
         assert_eq!(
             gum_text(0.0120023, 0.0000371, 1.96, "m/s^2"),
-            "0.012002 +- 0.000037 m/s^2 (k = 1.96, 95 %)"
+            "0.012002 ± 0.000037 m/s² (k = 1.96, 95 %)"
         );
     }
 }

@@ -109,7 +109,7 @@ fn read_lab(path: &Path) -> miette::Result<Lab> {
             span: (span, 0).into(),
             label: e.to_string().lines().next().unwrap_or("here").to_string(),
             help: "keys: name, address, accreditation, certificate_prefix, optional logo \
-                   (docs/certificate.md)"
+                   and template (docs/certificate.md)"
                 .into(),
         }
     })?;
@@ -139,7 +139,36 @@ fn read_lab(path: &Path) -> miette::Result<Lab> {
             .into());
         }
     }
+    if let Some(template) = &lab.template {
+        let file = path.parent().unwrap_or(Path::new(".")).join(template);
+        if let Err(e) = std::fs::read_to_string(&file) {
+            return Err(Located {
+                message: format!("the template `{template}` cannot be read"),
+                span: key_span(&text, None, "template"),
+                src: NamedSource::new(name, text),
+                label: format!("{}: {e}", file.display()),
+                help: "a Typst file (UTF-8), its path relative to the laboratory file: copy \
+                       certificate/templates/certificate.typ to start; or remove the key"
+                    .into(),
+            }
+            .into());
+        }
+    }
     Ok(lab)
+}
+
+/// The template `LAB.yaml` names (its path as the name diagnostics show), else the
+/// default one.
+pub fn lab_template(lab_file: &Path, lab: &Lab) -> miette::Result<render::Template> {
+    let Some(t) = &lab.template else {
+        return Ok(render::Template::default());
+    };
+    let file = lab_file.parent().unwrap_or(Path::new(".")).join(t);
+    let text = read_text(&file, "name a Typst file relative to the laboratory file")?;
+    Ok(render::Template {
+        name: file.display().to_string(),
+        text,
+    })
 }
 
 /// The logo `file`, read and decoded (a PNG or JPEG), or why it cannot be drawn.

@@ -17,6 +17,7 @@ pub mod issue;
 mod model;
 pub mod render;
 pub mod terms;
+pub mod units;
 
 pub use build::{Input, build, gum_text, type_a_dof};
 pub use model::{

@@ -24,6 +24,10 @@ pub struct Lab {
     /// every page of the PDF.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub logo: Option<String>,
+    /// A Typst template file, relative to `LAB.yaml`, that typesets the PDF in place of the
+    /// default one (`certificate/templates/certificate.typ` is the default, to copy).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub template: Option<String>,
 }
 
 /// A calibration certificate.

@@ -1,7 +1,7 @@
 //! `ratecal certificate`: the seal verified, the certificate issued
 //! (`ratecal_certificate::issue`) and rendered in the format asked for.
 
-use ratecal_certificate::issue::{Request, issue, lab_logo};
+use ratecal_certificate::issue::{Request, issue, lab_logo, lab_template};
 use ratecal_certificate::render;
 use std::path::Path;
 
@@ -49,25 +49,17 @@ pub fn certificate(args: &Request, format: Format, out: Option<&Path>) -> u8 {
         }
         Format::Md => render::markdown(&certificate).into_bytes(),
         Format::Html => render::html(&certificate).into_bytes(),
-        Format::Pdf => {
-            match render::pdf(&certificate, lab_logo(&args.lab, &certificate.lab).as_ref()) {
-                Ok(b) => b,
-                Err(e) => {
-                    errln!(
-                        "{:?}",
-                        miette::miette!(
-                            code = "certificate::pdf",
-                            "cannot typeset the certificate: {e}"
-                        )
-                    );
-                    return 1;
-                }
+        Format::Pdf => match typeset(args, &certificate) {
+            Ok(b) => b,
+            Err(e) => {
+                errln!("{e:?}");
+                return 1;
             }
-        }
+        },
     };
     match out {
         Some(path) => {
-            if let Err(e) = std::fs::write(path, &bytes) {
+            if let Err(e) = write_aside(path, &bytes) {
                 errln!("cannot write {}: {e}", path.display());
                 return 1;
             }
@@ -83,4 +75,32 @@ pub fn certificate(args: &Request, format: Format, out: Option<&Path>) -> u8 {
         }
     }
     0
+}
+
+/// The PDF, through the laboratory's template or the default one.
+fn typeset(
+    args: &Request,
+    certificate: &ratecal_certificate::Certificate,
+) -> miette::Result<Vec<u8>> {
+    let template = lab_template(&args.lab, &certificate.lab)?;
+    let logo = lab_logo(&args.lab, &certificate.lab);
+    Ok(render::pdf(
+        certificate,
+        &template,
+        logo.as_ref().map(|l| l.file()),
+    )?)
+}
+
+/// Writes `bytes` beside `path` and renames it into place: a reader never sees half a
+/// certificate, and a failure leaves no file at `path`.
+fn write_aside(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "certificate".into());
+    let aside = path.with_file_name(format!(".{name}.partial"));
+    std::fs::write(&aside, bytes)?;
+    std::fs::rename(&aside, path).inspect_err(|_| {
+        let _ = std::fs::remove_file(&aside);
+    })
 }

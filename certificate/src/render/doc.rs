@@ -3,6 +3,7 @@
 
 use crate::budget::TermStatus;
 use crate::model::{Certificate, END_MARK, REPRODUCTION};
+use crate::units::with_unit;
 
 /// One block of the certificate's body.
 #[derive(Debug, Clone, PartialEq)]
@@ -124,10 +125,10 @@ pub fn blocks(c: &Certificate) -> Vec<Block> {
         .temperature_c
         .map(|[mean, lo, hi]| {
             format!(
-                "mean {} degC, range {} degC to {} degC",
-                num(mean),
-                num(lo),
-                num(hi)
+                "mean {}, range {} to {}",
+                with_unit(&num(mean), "degC"),
+                with_unit(&num(lo), "degC"),
+                with_unit(&num(hi), "degC")
             )
         })
         .unwrap_or_else(|| "not recorded".into());
@@ -136,10 +137,10 @@ pub fn blocks(c: &Certificate) -> Vec<Block> {
         (
             "Gravity".into(),
             format!(
-                "{} m/s^2{} (source: {})",
-                num(m.gravity_mps2),
+                "{}{} (source: {})",
+                with_unit(&num(m.gravity_mps2), "m/s^2"),
                 m.gravity_u_mps2
-                    .map(|u| format!(", standard uncertainty {} m/s^2", num(u)))
+                    .map(|u| format!(", standard uncertainty {}", with_unit(&num(u), "m/s^2")))
                     .unwrap_or_else(|| ", uncertainty not stated".into()),
                 m.gravity_source
             ),
@@ -147,8 +148,8 @@ pub fn blocks(c: &Certificate) -> Vec<Block> {
         (
             "Latitude".into(),
             format!(
-                "{} deg (source: {})",
-                num(m.latitude_deg),
+                "{} (source: {})",
+                with_unit(&num(m.latitude_deg), "deg"),
                 m.latitude_source
             ),
         ),
@@ -159,7 +160,7 @@ pub fn blocks(c: &Certificate) -> Vec<Block> {
         c.model_equation.join(". ")
     )));
     b.push(Block::Para(
-        "Each result is stated as value +- U, the expanded uncertainty with the coverage factor \
+        "Each result is stated as value ± U, the expanded uncertainty with the coverage factor \
          k for a coverage probability of about 95 % (GUM, JCGM 100:2008)."
             .into(),
     ));
@@ -183,14 +184,14 @@ pub fn blocks(c: &Certificate) -> Vec<Block> {
                     vec![
                         k.name.clone(),
                         k.value
-                            .map(|v| format!("{} {}", num(v), k.unit))
+                            .map(|v| with_unit(&num(v), &k.unit))
                             .unwrap_or_else(|| "-".into()),
                         match k.op.as_str() {
-                            "within" => format!("within ±{} {}", num(k.limit), k.unit),
-                            op => format!("{op} {} {}", num(k.limit), k.unit),
+                            "within" => format!("within ±{}", with_unit(&num(k.limit), &k.unit)),
+                            op => format!("{op} {}", with_unit(&num(k.limit), &k.unit)),
                         },
                         k.expanded
-                            .map(|u| format!("{} {}", num(u), k.unit))
+                            .map(|u| with_unit(&num(u), &k.unit))
                             .unwrap_or_else(|| "-".into()),
                         k.statement.clone(),
                     ]
@@ -234,18 +235,15 @@ pub fn blocks(c: &Certificate) -> Vec<Block> {
     b.push(Block::Heading("Annex: uncertainty budget".into()));
     for bu in &c.budget {
         b.push(Block::Para(format!(
-            "{} = {} {}: u_c = {} {}, nu_eff = {}, k = {:.2}, U = {} {}",
+            "{} = {}: u_c = {}, ν_eff = {}, k = {:.2}, U = {}",
             bu.quantity,
-            num(bu.value),
-            bu.unit,
-            num(bu.u_c),
-            bu.unit,
+            with_unit(&num(bu.value), &bu.unit),
+            with_unit(&num(bu.u_c), &bu.unit),
             bu.nu_eff
                 .map(|n| format!("{n:.1}"))
-                .unwrap_or_else(|| "infinite".into()),
+                .unwrap_or_else(|| "∞".into()),
             bu.k,
-            num(bu.expanded),
-            bu.unit
+            with_unit(&num(bu.expanded), &bu.unit)
         )));
         b.push(Block::Table(
             [
@@ -266,15 +264,18 @@ pub fn blocks(c: &Certificate) -> Vec<Block> {
                         t.source.clone(),
                         format!("{:?}", t.evaluation),
                         t.distribution.clone(),
-                        t.stated.clone().unwrap_or_else(|| "-".into()),
-                        t.sensitivity.clone(),
+                        t.stated
+                            .as_deref()
+                            .map(crate::units::pretty)
+                            .unwrap_or_else(|| "-".into()),
+                        crate::units::pretty(&t.sensitivity),
                         match (t.status, t.u) {
-                            (TermStatus::Stated, Some(u)) => format!("{} {}", num(u), bu.unit),
+                            (TermStatus::Stated, Some(u)) => with_unit(&num(u), &bu.unit),
                             _ => "not stated".into(),
                         },
                         t.dof
                             .map(|d| format!("{d:.0}"))
-                            .unwrap_or_else(|| "inf".into()),
+                            .unwrap_or_else(|| "∞".into()),
                     ]
                 })
                 .collect(),

@@ -1,56 +1,60 @@
-//! The laboratory's logo, drawn in the top margin of every page of the PDF, right-aligned
-//! above the header: a JPEG embedded as it is (DCTDecode: only its frame header is read), a
-//! PNG decoded by the `png` crate to 8-bit samples, its alpha channel as a soft mask.
+//! The laboratory's logo, checked before anything is typeset: a PNG that the `png` crate
+//! decodes (8-bit samples after expansion) or a JPEG with a readable frame header. The
+//! template draws it (`image(sys.inputs.logo)`) in the top margin of every page, 30 pt
+//! high, right-aligned.
 
-use lopdf::{Dictionary, Document, Object, Stream, content::Content, content::Operation};
+use super::typeset::LogoFile;
 
-/// A decoded logo, ready to embed.
-#[derive(Debug, Clone)]
+/// A logo that can be drawn.
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Logo {
     width: u32,
     height: u32,
-    image: Stream,
-    mask: Option<Stream>,
+    file: LogoFile,
 }
-
-/// The logo's height on the page, pt, and its widest width.
-const HEIGHT_PT: f32 = 30.0;
-const MAX_WIDTH_PT: f32 = 150.0;
-/// Distance of the logo's top from the page's top edge and of its right side from the
-/// page's right edge (the page decorator's 15 mm margin), pt.
-const TOP_PT: f32 = 8.0;
-const RIGHT_PT: f32 = 42.52;
 
 impl Logo {
     /// Reads a PNG or JPEG file's bytes; the error says why it cannot be drawn.
     pub fn from_bytes(bytes: &[u8]) -> Result<Logo, String> {
-        if bytes.starts_with(b"\x89PNG\r\n\x1a\n") {
-            png_logo(bytes)
+        let (width, height, extension) = if bytes.starts_with(b"\x89PNG\r\n\x1a\n") {
+            let (w, h) = png_size(bytes)?;
+            (w, h, "png")
         } else if bytes.starts_with(&[0xff, 0xd8, 0xff]) {
-            jpeg_logo(bytes)
+            let (h, w, n) = jpeg_frame(bytes).ok_or("a JPEG without a readable frame header")?;
+            if !matches!(n, 1 | 3 | 4) {
+                return Err(format!("a JPEG of {n} colour components"));
+            }
+            (w, h, "jpg")
         } else {
-            Err("neither a PNG nor a JPEG file".into())
+            return Err("neither a PNG nor a JPEG file".into());
+        };
+        if width == 0 || height == 0 {
+            return Err("an image of no pixels".into());
         }
+        Ok(Logo {
+            width,
+            height,
+            file: LogoFile {
+                bytes: bytes.to_vec(),
+                extension,
+            },
+        })
     }
 
     /// Width and height in pixels.
     pub fn size(&self) -> (u32, u32) {
         (self.width, self.height)
     }
+
+    /// The file as the template reads it.
+    pub fn file(&self) -> &LogoFile {
+        &self.file
+    }
 }
 
-fn image_dict(width: u32, height: u32, space: &str) -> Dictionary {
-    let mut d = Dictionary::new();
-    d.set("Type", Object::Name(b"XObject".to_vec()));
-    d.set("Subtype", Object::Name(b"Image".to_vec()));
-    d.set("Width", i64::from(width));
-    d.set("Height", i64::from(height));
-    d.set("ColorSpace", Object::Name(space.as_bytes().to_vec()));
-    d.set("BitsPerComponent", 8);
-    d
-}
-
-fn png_logo(bytes: &[u8]) -> Result<Logo, String> {
+/// Decodes the PNG's first frame (a logo that does not decode is refused here, not left
+/// to fail in the typesetter).
+fn png_size(bytes: &[u8]) -> Result<(u32, u32), String> {
     let bad = |e: png::DecodingError| format!("not a readable PNG: {e}");
     let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
     decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
@@ -63,33 +67,7 @@ fn png_logo(bytes: &[u8]) -> Result<Logo, String> {
     }
     let mut buf = vec![0; size];
     let frame = reader.next_frame(&mut buf).map_err(bad)?;
-    let (w, h) = (frame.width, frame.height);
-    let pixels = &buf[..frame.buffer_size()];
-    let (space, channels, alpha) = match frame.color_type {
-        png::ColorType::Grayscale => ("DeviceGray", 1, false),
-        png::ColorType::GrayscaleAlpha => ("DeviceGray", 1, true),
-        png::ColorType::Rgb => ("DeviceRGB", 3, false),
-        png::ColorType::Rgba => ("DeviceRGB", 3, true),
-        png::ColorType::Indexed => return Err("an indexed PNG that did not expand".into()),
-    };
-    if frame.bit_depth != png::BitDepth::Eight {
-        return Err(format!("a PNG of {:?} bits per sample", frame.bit_depth));
-    }
-    let stride = channels + usize::from(alpha);
-    let (mut color, mut mask) = (Vec::new(), Vec::new());
-    for px in pixels.chunks_exact(stride) {
-        color.extend_from_slice(&px[..channels]);
-        if alpha {
-            mask.push(px[channels]);
-        }
-    }
-    let mask = alpha.then(|| Stream::new(image_dict(w, h, "DeviceGray"), mask));
-    Ok(Logo {
-        width: w,
-        height: h,
-        image: Stream::new(image_dict(w, h, space), color),
-        mask,
-    })
+    Ok((frame.width, frame.height))
 }
 
 /// The frame header (SOFn) of a JPEG: height, width, components.
@@ -124,88 +102,6 @@ fn jpeg_frame(bytes: &[u8]) -> Option<(u32, u32, u8)> {
     None
 }
 
-fn jpeg_logo(bytes: &[u8]) -> Result<Logo, String> {
-    let (h, w, n) = jpeg_frame(bytes).ok_or("a JPEG without a readable frame header")?;
-    let space = match n {
-        1 => "DeviceGray",
-        3 => "DeviceRGB",
-        4 => "DeviceCMYK",
-        n => return Err(format!("a JPEG of {n} colour components")),
-    };
-    if w == 0 || h == 0 {
-        return Err("a JPEG of no pixels".into());
-    }
-    let mut dict = image_dict(w, h, space);
-    dict.set("Filter", Object::Name(b"DCTDecode".to_vec()));
-    let image = Stream::new(dict, bytes.to_vec()).with_compression(false);
-    Ok(Logo {
-        width: w,
-        height: h,
-        image,
-        mask: None,
-    })
-}
-
-/// Draws `logo` on every page of `doc`: one image object, referenced by each page.
-pub(super) fn stamp(doc: &mut Document, logo: &Logo) -> lopdf::Result<()> {
-    let mut image = logo.image.clone();
-    if let Some(mask) = &logo.mask {
-        let id = doc.add_object(mask.clone());
-        image.dict.set("SMask", Object::Reference(id));
-    }
-    let id = doc.add_object(image);
-    let aspect = logo.width as f32 / logo.height as f32;
-    let (w, h) = if HEIGHT_PT * aspect > MAX_WIDTH_PT {
-        (MAX_WIDTH_PT, MAX_WIDTH_PT / aspect)
-    } else {
-        (HEIGHT_PT * aspect, HEIGHT_PT)
-    };
-    let pages: Vec<lopdf::ObjectId> = doc.get_pages().into_values().collect();
-    for page in pages {
-        let (pw, ph) = page_size(doc, page);
-        doc.add_xobject(page, "RcLogo", id)?;
-        let ops = vec![
-            Operation::new("q", vec![]),
-            Operation::new(
-                "cm",
-                vec![
-                    w.into(),
-                    0.into(),
-                    0.into(),
-                    h.into(),
-                    (pw - RIGHT_PT - w).into(),
-                    (ph - TOP_PT - h).into(),
-                ],
-            ),
-            Operation::new("Do", vec![Object::Name(b"RcLogo".to_vec())]),
-            Operation::new("Q", vec![]),
-        ];
-        doc.add_to_page_content(page, Content { operations: ops })?;
-    }
-    Ok(())
-}
-
-/// A page's MediaBox width and height, pt (A4 when it has none).
-fn page_size(doc: &Document, page: lopdf::ObjectId) -> (f32, f32) {
-    let number = |o: &Object| {
-        o.as_float()
-            .ok()
-            .or_else(|| o.as_i64().ok().map(|v| v as f32))
-    };
-    doc.get_object(page)
-        .and_then(Object::as_dict)
-        .and_then(|d| d.get(b"MediaBox"))
-        .and_then(Object::as_array)
-        .ok()
-        .and_then(|b| {
-            Some((
-                number(b.get(2)?)? - number(b.first()?)?,
-                number(b.get(3)?)? - number(b.get(1)?)?,
-            ))
-        })
-        .unwrap_or((595.28, 841.89))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -221,10 +117,7 @@ mod tests {
         assert_eq!(jpeg_frame(&j), Some((48, 300, 3)));
         let logo = Logo::from_bytes(&j).unwrap();
         assert_eq!(logo.size(), (300, 48));
-        assert_eq!(
-            logo.image.dict.get(b"Filter").unwrap().as_name().unwrap(),
-            b"DCTDecode"
-        );
+        assert_eq!(logo.file().extension, "jpg");
         assert_eq!(jpeg_frame(&j[..20]), None);
         let scan_first = [0xff, 0xd8, 0xff, 0xda, 0, 8, 0, 0, 0, 0, 0, 0];
         assert!(Logo::from_bytes(&scan_first).is_err());

@@ -1,0 +1,298 @@
+//! The certificate as a laboratory's customer gets it: the **release** binary (built here
+//! when missing) issues a PDF whose text two readers that are not ours, poppler's
+//! `pdftotext` and Python's `pypdf`, both read back with every element in order; the PDF is
+//! PDF/A-2b with its fonts subset and embedded. Skipped, and saying so, only when
+//! `pdftotext` or `pypdf` is not installed (`.ci/run` installs both).
+
+mod support;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::time::Instant;
+use support::{MINI, code, text};
+
+/// The release binary beside the test's own (`target/release/ratecal`), built if needed.
+fn release_binary() -> PathBuf {
+    let debug = PathBuf::from(env!("CARGO_BIN_EXE_ratecal"));
+    let target = debug
+        .parent()
+        .and_then(Path::parent)
+        .expect("the binary sits in target/<profile>/");
+    let o = Command::new(env!("CARGO"))
+        .args(["build", "--release", "--bin", "ratecal", "-q"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env("CARGO_TARGET_DIR", target)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "release build: {}", text(&o));
+    target
+        .join("release")
+        .join(debug.file_name().expect("a file name"))
+}
+
+fn run(bin: &Path, args: &[&str], dir: &Path) -> Output {
+    Command::new(bin)
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap()
+}
+
+/// What is missing of pdftotext and pypdf, if anything.
+fn missing_tools() -> Vec<&'static str> {
+    let mut missing = Vec::new();
+    if Command::new("pdftotext").arg("-v").output().is_err() {
+        missing.push("pdftotext (poppler-utils)");
+    }
+    let pypdf = Command::new("python3")
+        .args(["-c", "import pypdf"])
+        .output();
+    if !pypdf.is_ok_and(|o| o.status.success()) {
+        missing.push("pypdf (python3)");
+    }
+    missing
+}
+
+/// The PDF's text by pdftotext, pages separated by form feeds.
+fn pdftotext(pdf: &Path) -> String {
+    let o = Command::new("pdftotext")
+        .args(["-enc", "UTF-8"])
+        .arg(pdf)
+        .arg("-")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "pdftotext: {}", text(&o));
+    String::from_utf8(o.stdout).unwrap()
+}
+
+/// The PDF's text by pypdf, pages separated by form feeds.
+fn pypdf(pdf: &Path) -> String {
+    let script = "import sys, pypdf\n\
+                  r = pypdf.PdfReader(sys.argv[1])\n\
+                  sys.stdout.write('\\f'.join(p.extract_text() for p in r.pages))\n";
+    let o = Command::new("python3")
+        .args(["-c", script])
+        .arg(pdf)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "pypdf: {}", text(&o));
+    String::from_utf8(o.stdout).unwrap()
+}
+
+/// Collapses whitespace, so that a phrase wrapped over two lines is still found.
+fn flat(s: &str) -> String {
+    s.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// Finds each of `wanted` in `text`, each after the one before.
+fn in_order(reader: &str, text: &str, wanted: &[String]) {
+    let all = flat(text);
+    let mut from = 0;
+    for w in wanted {
+        match all[from..].find(w.as_str()) {
+            Some(i) => from += i + w.len(),
+            None => panic!(
+                "{reader}: `{w}` not found after byte {from} of the text: {}",
+                &all[from.min(all.len())..]
+            ),
+        }
+    }
+}
+
+/// A dry run of MINI with an acceptance check, approved and archived, in `dir/cal`.
+fn approved_run(bin: &Path, dir: &Path) {
+    let station = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/docs/examples/station.yaml"
+    ))
+    .unwrap()
+    .replace("due: 2030-06-30", "due: 2099-12-31");
+    std::fs::write(dir.join("s.yaml"), station).unwrap();
+    let with_check = MINI.replacen(
+        "  step statics",
+        "  accept accel.bias.x <= 80 mg\n\n  step statics",
+        1,
+    );
+    std::fs::write(dir.join("p.rcal"), with_check).unwrap();
+    for args in [
+        &[
+            "run",
+            "p.rcal",
+            "--dry-run",
+            "--station",
+            "s.yaml",
+            "--out",
+            "cal",
+        ][..],
+        &["key", "new", "keys"],
+        &[
+            "approve",
+            "cal",
+            "--signer",
+            "A. Metrologist",
+            "--role",
+            "Head of laboratory",
+            "--key",
+            "keys/lab.key",
+        ],
+        &["archive", "add", "cal", "--archive", "archive"],
+    ] {
+        let o = run(bin, args, dir);
+        assert!(matches!(code(&o), 0 | 3), "{args:?}: {}", text(&o));
+    }
+}
+
+#[test]
+fn a_release_certificate_reads_back_whole_and_in_order_in_pdftotext_and_pypdf() {
+    let missing = missing_tools();
+    if !missing.is_empty() {
+        eprintln!("skipped: {} not installed", missing.join(" and "));
+        return;
+    }
+    let bin = release_binary();
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    approved_run(&bin, dir);
+    let lab = concat!(env!("CARGO_MANIFEST_DIR"), "/docs/examples/lab.yaml");
+    let started = Instant::now();
+    let o = run(
+        &bin,
+        &[
+            "certificate",
+            "cal",
+            "--lab",
+            lab,
+            "--archive",
+            "archive",
+            "--customer",
+            "ACME Avionics",
+            "--order",
+            "PO-4711",
+            "--out",
+            "cert.pdf",
+        ],
+        dir,
+    );
+    let took = started.elapsed();
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let pdf = dir.join("cert.pdf");
+    let bytes = std::fs::read(&pdf).unwrap();
+    eprintln!(
+        "certificate: {:.3} s (whole process, release), PDF {} bytes",
+        took.as_secs_f64(),
+        bytes.len()
+    );
+    let results = support::json(&dir.join("cal/results.json"));
+    let sha = results["model"]["procedure"]["sha256"].as_str().unwrap();
+    let year = &ratecal_recording::rfc3339(std::time::SystemTime::now())[..4];
+    let number = format!("EICL-{year}-000001");
+    let poppler = pdftotext(&pdf);
+    let pages = poppler
+        .split('\u{c}')
+        .filter(|p| !p.trim().is_empty())
+        .count();
+    assert!(pages >= 2, "{pages} pages");
+    let mut wanted: Vec<String> = Vec::new();
+    for page in 1..=pages {
+        wanted.extend([
+            "Example Inertial Calibration Laboratory".to_string(),
+            "12 Gyroscope Lane, 2800 Kongens Lyngby, Denmark".into(),
+            "Accredited to ISO/IEC 17025 by DANAK".into(),
+            format!("Certificate No. {number}"),
+            format!("page {page} of {pages}"),
+        ]);
+        if page == 1 {
+            wanted.extend(
+                [
+                    "Calibration certificate",
+                    "Identification",
+                    "ACME Avionics",
+                    "PO-4711",
+                    "IMU SIM-TAC-100",
+                    "SIM-0001",
+                    "tactical",
+                    "mini version 1.0.0",
+                    sha,
+                    "Example Motion Systems",
+                    "EMS-2A-0042",
+                    "Method and conditions",
+                    "Two static attitudes",
+                    "°C",
+                    "9.8156 m/s²",
+                    "Results",
+                    "value ± U",
+                    "accel.bias.x",
+                    "m/s² (k = ",
+                    "95 %",
+                ]
+                .map(String::from),
+            );
+        }
+    }
+    wanted.extend(
+        [
+            "Statements of conformity",
+            "ILAC-G8",
+            "accel.bias.x <= 80 mg",
+            "Traceability",
+            "NMI-2026-0815",
+            "National Metrology Institute",
+            "due 2099-12-31",
+            "Approval",
+            "A. Metrologist",
+            "Head of laboratory",
+            "SHA256",
+            "Annex: uncertainty budget",
+            "gyro.scale.y",
+            "table rate accuracy",
+            "rectangular",
+            "This certificate shall not be reproduced except in full without the written \
+             approval of the laboratory.",
+        ]
+        .map(String::from),
+    );
+    wanted.push(format!("End of certificate {number}"));
+    in_order("pdftotext", &poppler, &wanted);
+    let py = pypdf(&pdf);
+    assert_eq!(py.split('\u{c}').count(), pages, "pypdf's pages");
+    in_order("pypdf", &py, &wanted);
+    assert!(
+        !flat(&poppler).contains("DRAFT"),
+        "an approved certificate says DRAFT"
+    );
+
+    // PDF/A-2b, fonts subset and embedded (a subset's name carries a six-letter tag).
+    let raw = String::from_utf8_lossy(&bytes);
+    assert!(raw.contains("<pdfaid:part>2</pdfaid:part>"), "not PDF/A-2");
+    assert!(raw.contains("<pdfaid:conformance>B</pdfaid:conformance>"));
+    assert!(raw.contains("/FontFile2"), "no embedded TrueType font");
+    assert!(
+        raw.match_indices("+DejaVuSans").count() >= 1,
+        "fonts not subset"
+    );
+
+    // Reissued with the same content: the same bytes.
+    let again = run(
+        &bin,
+        &[
+            "certificate",
+            "cal",
+            "--lab",
+            lab,
+            "--archive",
+            "archive",
+            "--customer",
+            "ACME Avionics",
+            "--order",
+            "PO-4711",
+            "--out",
+            "again.pdf",
+        ],
+        dir,
+    );
+    assert_eq!(code(&again), 0, "{}", text(&again));
+    assert!(
+        std::fs::read(dir.join("again.pdf")).unwrap() == bytes,
+        "not byte-identical"
+    );
+}
