@@ -11,8 +11,12 @@ use std::process::{Command, Output};
 use std::time::Instant;
 use support::{MINI, code, text};
 
-/// The release binary beside the test's own (`target/release/ratecal`), built if needed.
+/// The release binary: `RATECAL_RELEASE_BIN` when set, else the one beside the test's own
+/// (`target/release/ratecal`), built (or brought up to date) here.
 fn release_binary() -> PathBuf {
+    if let Some(bin) = std::env::var_os("RATECAL_RELEASE_BIN") {
+        return PathBuf::from(bin);
+    }
     let debug = PathBuf::from(env!("CARGO_BIN_EXE_ratecal"));
     let target = debug
         .parent()
