@@ -486,6 +486,49 @@ fn a_draft_says_so_on_every_page_and_refusals_have_their_exit_codes() {
         String::from_utf8_lossy(&certificate(dir, "acc", &["--format", "md"]).stdout).into_owned();
     assert!(md.contains("within ±80 mg"), "{md}");
 
+    // One decision rule, one U: the run judged with the full budgets it stored, and the
+    // certificate states the run's verdicts, each row with its rule and k.
+    let budgets = res["budgets"]
+        .as_array()
+        .expect("results.json holds the budgets");
+    for c in checks {
+        let run = acc.iter().find(|a| a["name"] == c["name"]).unwrap();
+        assert_eq!(c["verdict"], run["verdict"], "{c} / {run}");
+        assert_eq!(c["U"], run["U"], "{c} / {run}");
+        if !c["U"].is_null() {
+            assert!(c["k"].as_f64().unwrap() >= 1.95, "{c}");
+        }
+        assert!(
+            matches!(c["rule"].as_str(), Some("simple" | "guarded")),
+            "{c}"
+        );
+    }
+    let u_mg = |q: &str| {
+        let b = budgets.iter().find(|b| b["quantity"] == q).unwrap();
+        b["U"].as_f64().unwrap() / 9.80665 * 1000.0
+    };
+    let (lo, hi) = ["x", "y", "z"]
+        .map(|a| u_mg(&format!("accel.bias.{a}")))
+        .iter()
+        .fold((f64::MAX, 0.0f64), |(l, h), u| (l.min(*u), h.max(*u)));
+    let norm = checks
+        .iter()
+        .find(|c| c["name"] == "norm(accel.bias) <= 500 mg")
+        .unwrap();
+    let u_norm = norm["U"].as_f64().unwrap();
+    // The norm's U propagates the components' full budgets (weights summing to one in
+    // quadrature), not the fit's Type A alone.
+    assert!(
+        u_norm > 0.9 * lo && u_norm < 1.1 * hi,
+        "U(norm) {u_norm} mg outside the components' {lo}..{hi} mg"
+    );
+    // The budget's U of a parameter is the one its check was judged with.
+    let bias = checks
+        .iter()
+        .find(|c| c["name"] == "accel.bias.x <= 80 mg")
+        .unwrap();
+    assert!((bias["U"].as_f64().unwrap() - u_mg("accel.bias.x")).abs() < 1e-9);
+
     // A run not in the archive: exit 1, help names `ratecal archive add`.
     std::fs::write(dir.join("s.yaml"), &station).unwrap();
     let o = mini_run(dir, "loose", &["--station", "s.yaml"]);

@@ -45,7 +45,7 @@ fn explain_finds_the_lever_arm_and_draws_it_before_and_after() {
     assert_eq!(code(&o), 0, "{}", text(&o));
     // Acceptance values with their expanded uncertainty, U to two significant digits.
     let run_out = String::from_utf8_lossy(&o.stdout);
-    assert!(run_out.contains("acceptance (value ± expanded uncertainty U, k = 2):"));
+    assert!(run_out.contains("acceptance (value ± expanded uncertainty U, k as stated):"));
     let (v, u) = param(&run_out, "gyro.residual.std");
     assert!(
         v.starts_with("0.00") && u.starts_with("0.0000"),

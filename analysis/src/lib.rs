@@ -4,6 +4,7 @@
 //! table or opens a socket: the recording comes in through [`fit::Source`], and the CLI
 //! hands in what it read.
 
+pub mod budget;
 pub mod explain;
 pub mod fit;
 pub mod measured;

@@ -70,6 +70,11 @@ pub struct Results {
     /// what the poses determine and how well the calibrated poses read gravity.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub manual: Option<ManualFit>,
+    /// The GUM budget of every reported parameter (Type A from the fit, Type B from the
+    /// station's stated figures), when the analysis was given the station's figures: the
+    /// verdict, the report and the certificate state these `U` and `k`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub budgets: Vec<crate::budget::Budget>,
 }
 
 /// How a recording without a table was calibrated (docs/results.md, `manual`).
@@ -427,9 +432,14 @@ pub struct Acceptance {
     pub unit: String,
     /// Distance to the limit, positive on the passing side.
     pub margin: Option<f64>,
-    /// Expanded uncertainty of the value, k = 2.
+    /// Expanded uncertainty of the value: `k` times its standard uncertainty (the full
+    /// budget's for a calibrated parameter when the station states Type B figures).
     #[serde(rename = "U")]
     pub expanded_u: Option<f64>,
+    /// The coverage factor of `U` (2 for the run's Type A uncertainty alone; Student's t
+    /// of the budget's effective degrees of freedom otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub k: Option<f64>,
     /// `simple` or `guard_banded`.
     pub rule: String,
     /// Verdict.
@@ -720,6 +730,7 @@ mod tests {
             unit: String::new(),
             margin: None,
             expanded_u: None,
+            k: None,
             rule: "simple".into(),
             verdict,
             reason: None,

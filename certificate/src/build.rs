@@ -2,12 +2,14 @@
 //! the station's facts, the laboratory, the number the archive issued, the approval.
 
 use crate::budget::{Budget, COVERAGE};
+use crate::conformity::conformity;
 use crate::model::{
-    ApprovalBlock, Certificate, Conformity, ConformityCheck, FORMAT, Identification, Lab, Method,
-    ProcedureId, ResultLine, StationId, Traceability,
+    ApprovalBlock, Certificate, FORMAT, Identification, Lab, Method, ProcedureId, ResultLine,
+    StationId, Traceability,
 };
-use crate::terms::{Stated, budget};
-use ratecal_analysis::results::{Parameter, Results};
+use crate::terms::Stated;
+use ratecal_analysis::budget::budgets;
+use ratecal_analysis::results::Results;
 use ratecal_plan::Plan;
 use ratecal_recording::Manifest;
 
@@ -45,48 +47,6 @@ pub struct Input<'a> {
     pub approval: Option<ApprovalBlock>,
 }
 
-/// Quantities that describe noise rather than calibrate the model: not stated as results.
-fn reported(name: &str) -> bool {
-    ![".noise.", ".arw.", ".bias_instability."]
-        .iter()
-        .any(|n| name.contains(n))
-}
-
-/// The fit's Type A degrees of freedom for `quantity` (`sensor.family.axis`): the fit's
-/// uncertainty rests on the noise it estimates from the one-second block means of the
-/// segments that determine the quantity (physics.md's noise model), so each of those
-/// segments gives its one-second blocks less one (its mean). The segments are those used
-/// for the quantity's own fit (`used_for` `gyro_bias` for `gyro.bias.x`), else for the
-/// sensor's full model (`gyro_full`, `gyro`), else any of the sensor's fits. At least 1.
-pub fn type_a_dof(results: &Results, quantity: &str) -> f64 {
-    let mut parts = quantity.split('.');
-    let sensor = parts.next().unwrap_or("");
-    let family = parts.next().unwrap_or("");
-    let own = format!("{sensor}_{family}");
-    let prefix = format!("{sensor}_");
-    let count = |wanted: &dyn Fn(&str) -> bool| -> (usize, f64) {
-        results
-            .segments
-            .iter()
-            .filter(|s| s.used_for.iter().any(|u| wanted(u)))
-            .fold((0, 0.0), |(n, blocks), s| {
-                (n + 1, blocks + (s.t_end - s.t_start).round().max(1.0))
-            })
-    };
-    let full = format!("{sensor}_full");
-    let mut used = count(&|u| u == own);
-    if used.0 == 0 {
-        used = count(&|u| u == full);
-    }
-    if used.0 == 0 {
-        used = count(&|u| u == sensor);
-    }
-    if used.0 == 0 {
-        used = count(&|u| u.starts_with(&prefix));
-    }
-    (used.1 - used.0 as f64).max(1.0)
-}
-
 /// `value ± U unit (k = 2.05, 95 %)`, `U` to two significant digits and the value to
 /// the same decimal place.
 pub fn gum_text(value: f64, expanded: f64, k: f64, unit: &str) -> String {
@@ -106,15 +66,22 @@ pub fn gum_text(value: f64, expanded: f64, k: f64, unit: &str) -> String {
 pub fn build(input: Input<'_>) -> Certificate {
     let r = input.results;
     let m = input.manifest;
-    let mut budgets: Vec<Budget> = Vec::new();
-    for (name, p) in &r.parameters {
-        if let Parameter::Estimate { value, u, unit } = p
-            && reported(name)
-        {
-            let nu = type_a_dof(r, name);
-            budgets.push(budget(name, *value, *u, unit, nu, &input.stated));
+    let mut notes = input.notes;
+    // The analysis's budgets, which its verdict used; a results file written before the
+    // analysis computed them gets them now, and its checks keep the run's Type A U.
+    let budgets: Vec<Budget> = if r.budgets.is_empty() {
+        if !r.acceptance.is_empty() {
+            notes.push(
+                "The run was analysed without the station's Type B figures: its statements of \
+                 conformity use the fit's Type A uncertainty (k = 2); `ratecal analyze` the \
+                 run again to judge with the full budget."
+                    .into(),
+            );
         }
-    }
+        budgets(r, &input.stated)
+    } else {
+        r.budgets.clone()
+    };
     let results = budgets
         .iter()
         .map(|b| ResultLine {
@@ -127,7 +94,6 @@ pub fn build(input: Input<'_>) -> Certificate {
             text: gum_text(b.value, b.expanded, b.k, &b.unit),
         })
         .collect();
-    let mut notes = input.notes;
     let incomplete: Vec<&str> = budgets
         .iter()
         .filter(|b| !b.complete)
@@ -169,7 +135,7 @@ pub fn build(input: Input<'_>) -> Certificate {
         })
         .unwrap_or_default();
     let site = &m.station.site;
-    let statements = conformity(r, &budgets);
+    let statements = conformity(r);
     let method = Method {
         steps,
         temperature_c: r
@@ -260,96 +226,6 @@ fn equation(r: &Results) -> Vec<String> {
                 .into(),
         ]
     }
-}
-
-/// The conformity statements of the run's acceptance checks (ILAC-G8:2019). A check on a
-/// calibrated parameter states the certificate's U (its budget's, in the check's unit) and,
-/// under guarded acceptance, is decided with it; other checks keep the analysis's U.
-fn conformity(r: &Results, budgets: &[Budget]) -> Option<Conformity> {
-    if r.acceptance.is_empty() {
-        return None;
-    }
-    let guarded = r.acceptance.iter().any(|a| a.rule != "simple");
-    let rule = if guarded {
-        "ILAC-G8:2019 guarded acceptance: the guard band is the expanded uncertainty U \
-         (w = U, 95 %); a value within U of the limit is neither pass nor fail"
-    } else {
-        "ILAC-G8:2019 simple acceptance (shared risk): the value itself is compared with the \
-         limit; U is stated beside it"
-    };
-    let checks = r
-        .acceptance
-        .iter()
-        .map(|a| {
-            let mut verdict = serde_json::to_value(a.verdict)
-                .ok()
-                .and_then(|v| v.as_str().map(String::from))
-                .unwrap_or_default();
-            let from_budget = budgets
-                .iter()
-                .find(|b| b.quantity == a.quantity)
-                .and_then(|b| {
-                    let v = a.value?;
-                    (b.value != 0.0).then(|| (b.expanded * v / b.value).abs())
-                });
-            let expanded = from_budget.or(a.expanded_u);
-            let is_guarded = a.rule != "simple";
-            if let (Some(v), Some(u), true, Some(_)) = (a.value, expanded, is_guarded, from_budget)
-            {
-                // `within +-L` bounds |v| from above, like `<= L` on a parameter.
-                let upper = matches!(a.op.as_str(), "<=" | "<" | "within");
-                let v = if a.op == "within" { v.abs() } else { v };
-                let margin = if upper { a.limit - v } else { v - a.limit };
-                verdict = if margin >= u {
-                    "pass"
-                } else if margin < -u {
-                    "fail"
-                } else {
-                    "indeterminate"
-                }
-                .into();
-            }
-            let magnitude = |v: f64| if a.op == "within" { v.abs() } else { v };
-            let within_band = matches!((a.value, expanded),
-                (Some(v), Some(u)) if (magnitude(v) - a.limit).abs() < u);
-            let statement = match (a.value, verdict.as_str()) {
-                (None, _) => format!("{}: not evaluated", a.name),
-                (Some(_), "indeterminate") => format!(
-                    "{}: the value lies within the guard band around the limit: conformity can \
-                     be neither stated nor rejected",
-                    a.name
-                ),
-                (Some(_), v) => {
-                    let word = if v == "pass" {
-                        "conforms"
-                    } else {
-                        "does not conform"
-                    };
-                    let near = if within_band {
-                        " (the value lies within U of the limit)"
-                    } else {
-                        ""
-                    };
-                    format!("{}: {word}{near}", a.name)
-                }
-            };
-            ConformityCheck {
-                name: a.name.clone(),
-                value: a.value,
-                op: a.op.clone(),
-                limit: a.limit,
-                unit: a.unit.clone(),
-                expanded,
-                guard_band: expanded.filter(|_| is_guarded),
-                verdict,
-                statement,
-            }
-        })
-        .collect();
-    Some(Conformity {
-        rule: rule.into(),
-        checks,
-    })
 }
 
 #[cfg(test)]

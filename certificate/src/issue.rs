@@ -5,7 +5,6 @@
 //! the number taken from the archive's sequence (the same on reissue, the next with
 //! `amend`) and the approval taken from the seal.
 
-use crate::terms::{Stated, TemperatureCoefficients};
 use crate::{ApprovalBlock, Certificate, Input, Lab, StationId, render};
 use miette::{Diagnostic, NamedSource, SourceSpan};
 use ratecal_analysis::results::Results;
@@ -291,7 +290,6 @@ pub async fn issue(args: &Request) -> miette::Result<Certificate> {
         key_fingerprint: a.key_fingerprint,
     });
     let t = &station.table;
-    let deg = std::f64::consts::PI / 180.0;
     let input = Input {
         number: issued.number,
         replaces: issued.replaces,
@@ -310,25 +308,7 @@ pub async fn issue(args: &Request) -> miette::Result<Certificate> {
             serial: t.serial.clone(),
             accuracy_class: t.accuracy_class.clone(),
         },
-        stated: Stated {
-            rate_accuracy: t.rate_accuracy.map(|r| r.get()),
-            position_accuracy_rad: t.position_accuracy.map(|a| a.get() * deg),
-            axis_orthogonality_rad: t.axis_orthogonality.map(|a| a.get() * deg),
-            gravity_u_mps2: station.site.gravity_u_mps2,
-            gravity_mps2: manifest.station.site.gravity_mps2,
-            clock_accuracy: station.daq.and_then(|d| d.clock_accuracy).map(|r| r.get()),
-            temperature_stability_c: station.site.temperature_stability.map(|t| t.get()),
-            temperature_coefficients: station
-                .imu
-                .temperature_coefficients
-                .map(|c| TemperatureCoefficients {
-                    accel_bias: c.accel_bias,
-                    gyro_bias: c.gyro_bias,
-                    accel_scale: c.accel_scale,
-                    gyro_scale: c.gyro_scale,
-                })
-                .unwrap_or_default(),
-        },
+        stated: crate::stated(&station, manifest.station.site.gravity_mps2),
         reference: match cal {
             Some(c) => [Some(c.certificate), Some(c.issued_by), Some(c.due)],
             None => [None, None, None],

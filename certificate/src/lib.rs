@@ -11,16 +11,20 @@
 //! folder (through `ratecal-folder`'s reader), applies the traceability rules and takes the
 //! number from the archive; everything below it is handed its data.
 
-pub mod budget;
 mod build;
+mod conformity;
 pub mod issue;
 mod model;
 pub mod render;
-pub mod terms;
+mod stated;
 pub mod units;
 
-pub use build::{Input, build, gum_text, type_a_dof};
+pub use build::{Input, build, gum_text};
 pub use model::{
     ApprovalBlock, Certificate, Conformity, ConformityCheck, END_MARK, FORMAT, Identification, Lab,
     Method, ProcedureId, REPRODUCTION, ResultLine, StationId, Traceability,
 };
+/// The GUM budget, computed by the analysis (results.json `budgets`).
+pub use ratecal_analysis::budget;
+pub use ratecal_analysis::budget::{terms, type_a_dof};
+pub use stated::{stated, stated_of_folder};

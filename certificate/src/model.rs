@@ -184,6 +184,11 @@ pub struct ConformityCheck {
     /// The expanded uncertainty of the value.
     #[serde(rename = "U")]
     pub expanded: Option<f64>,
+    /// The coverage factor of `U` (the budget's for a calibrated parameter; 2 for the
+    /// run's Type A uncertainty).
+    pub k: Option<f64>,
+    /// `simple` or `guarded` (ILAC-G8).
+    pub rule: String,
     /// The guard band applied (`guarded` rule), in the unit.
     pub guard_band: Option<f64>,
     /// `pass`, `fail`, `indeterminate`, `not_evaluated`...

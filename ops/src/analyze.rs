@@ -58,8 +58,14 @@ pub fn analyze(args: &Request) -> u8 {
             }
         }
     }
+    // The first run's station states the Type B figures of the budgets (a folder without a
+    // station file is judged with the fit's Type A uncertainty, k = 2).
     let opts = Options {
         with: args.with.clone(),
+        stated: args
+            .runs
+            .first()
+            .and_then(|d| ratecal_certificate::stated_of_folder(d)),
         ..Options::default()
     };
     // The IMU stream is read a window at a time: a cell found bad there is refused as a

@@ -218,7 +218,7 @@ fn accept(a: &Accept) -> Value {
         "over_runs": a.over_runs,
         "rule": match a.rule {
             DecisionRule::Simple => "simple acceptance",
-            DecisionRule::GuardBanded => "guard-banded (k = 2)",
+            DecisionRule::GuardBanded => "guard-banded (w = U, the budget's k)",
         },
     })
 }

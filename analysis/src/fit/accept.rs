@@ -1,5 +1,8 @@
 //! Accuracy verification at segments no fit used, and evaluation of the procedure's
-//! thresholds: value, limit, margin, expanded uncertainty (k = 2), decision rule.
+//! thresholds: value, limit, margin, expanded uncertainty, decision rule. A calibrated
+//! parameter, or a function of several, is judged with its full budget's `U` and `k`
+//! (results.json `budgets`, when the station states its Type B figures); anything else
+//! with the run's Type A uncertainty at k = 2.
 
 use super::Out;
 use super::segment::{ChannelStats, Summary};
@@ -8,6 +11,9 @@ use crate::plan::{Accept, Cmp, DecisionRule, Plan, Quantity, VerifyPoint};
 use crate::recording::{Manifest, SegmentKind};
 use crate::results::{Acceptance, Results, Verdict, VerificationPoint};
 use ratecal_physics::{Mat3, Vec3};
+
+/// The coverage factor of a value with no budget (the run's Type A uncertainty).
+const K_TYPE_A: f64 = 2.0;
 use std::collections::{BTreeMap, HashMap};
 
 /// Where a verification segment was: mean feedback angles (deg) or axis and nominal rate.
@@ -97,7 +103,7 @@ pub(crate) fn evaluate(
         }
         let measured = lookup(&a.quantity, a.within, res, q);
         out.push(match measured {
-            Ok((v, u)) => judge(a, v, u, None),
+            Ok((v, u, k)) => judge(a, v, u, k, None),
             Err(why) => not_evaluated(a, &why),
         });
     }
@@ -136,6 +142,7 @@ pub(crate) fn evaluate(
                     lim,
                     p.max_error,
                     p.u,
+                    K_TYPE_A,
                     Some(format!(
                         "{} ({where_}, segment {})",
                         lim_name(lim),
@@ -167,7 +174,7 @@ pub(crate) fn evaluate(
                 within: false,
             };
             out.push(match value {
-                Some(v) => judge(&a, v, 0.0, None),
+                Some(v) => judge(&a, v, 0.0, K_TYPE_A, None),
                 None => not_evaluated(&a, "the recording holds no lab conditions (no environment block, no ambient column)"),
             });
         }
@@ -216,23 +223,23 @@ fn env_value(name: &str, res: &Results) -> Option<f64> {
     }
 }
 
-/// Value and standard uncertainty of a checked quantity, internal units.
+/// Value, standard uncertainty and coverage factor of a checked quantity, internal units.
 fn lookup(
     name: &str,
     within: bool,
     res: &Results,
     q: &BTreeMap<String, (f64, f64)>,
-) -> Result<(f64, f64), String> {
-    if let Some(v) = q.get(name) {
-        return Ok(*v);
+) -> Result<(f64, f64, f64), String> {
+    if let Some((v, u)) = q.get(name) {
+        return Ok((*v, *u, K_TYPE_A));
     }
     let (func, arg) = crate::plan::derived::split(name);
     if let Ok(d) = crate::plan::derived::derived(func, arg) {
-        return parameters(&d, res).map(|(v, u)| match (func, within) {
+        return parameters(&d, res).map(|(v, u, k)| match (func, within) {
             // A bare parameter is judged by its magnitude (docs/language.md); `within`
             // keeps the sign for the report and judges the magnitude itself.
-            (None, false) => (v.abs(), u),
-            _ => (v, u),
+            (None, false) => (v.abs(), u, k),
+            _ => (v, u, k),
         });
     }
     match name {
@@ -243,19 +250,22 @@ fn lookup(
                 .iter()
                 .filter(|p| p.sensor == sensor)
                 .max_by(|a, b| a.max_error.total_cmp(&b.max_error))
-                .map(|p| (p.max_error, p.u))
+                .map(|p| (p.max_error, p.u, K_TYPE_A))
                 .ok_or_else(|| "no segment outside the fits to verify at".into())
         }
-        "sync.error" => Ok((res.sync.max_sync_error_s, 0.0)),
+        "sync.error" => Ok((res.sync.max_sync_error_s, 0.0, K_TYPE_A)),
         _ => Err(format!("`{name}` is not a quantity the analysis computes")),
     }
 }
 
-/// Value and standard uncertainty (internal units) of a calibrated parameter or a function
-/// of several, propagated through the fit's correlations (`results.fits`).
-fn parameters(d: &crate::plan::derived::Derived, res: &Results) -> Result<(f64, f64), String> {
+/// Value, standard uncertainty (internal units) and coverage factor of a calibrated
+/// parameter or a function of several, propagated through the fit's correlations
+/// (`results.fits`): the components' full budgets when results.json has them, else the
+/// fit's Type A uncertainties at k = 2.
+fn parameters(d: &crate::plan::derived::Derived, res: &Results) -> Result<(f64, f64, f64), String> {
     let mut v = Vec::new();
     let mut u = Vec::new();
+    let mut to_bases = Vec::new();
     for name in &d.parameters {
         let Some(p) = res.parameters.get(name) else {
             return Err(format!("the analysis gave no `{name}`"));
@@ -270,6 +280,7 @@ fn parameters(d: &crate::plan::derived::Derived, res: &Results) -> Result<(f64, 
         };
         v.push(pv * to_base);
         u.push(pu * to_base);
+        to_bases.push(to_base);
     }
     let n = v.len();
     let mut r = vec![0.0; n * n];
@@ -278,7 +289,17 @@ fn parameters(d: &crate::plan::derived::Derived, res: &Results) -> Result<(f64, 
             r[i * n + j] = if i == j { 1.0 } else { correlation(res, a, b) };
         }
     }
-    Ok(crate::plan::derived::evaluate(d.func, &v, &u, &r))
+    let budgets: Option<Vec<(&crate::budget::Budget, f64)>> = d
+        .parameters
+        .iter()
+        .zip(&to_bases)
+        .map(|(name, f)| Some((res.budgets.iter().find(|b| &b.quantity == name)?, *f)))
+        .collect();
+    if let Some(components) = budgets {
+        return Ok(crate::budget::derived_budget(d.func, &components, &r));
+    }
+    let (value, u) = crate::plan::derived::evaluate(d.func, &v, &u, &r);
+    Ok((value, u, K_TYPE_A))
 }
 
 /// The correlation of two parameters in the joint fit that gave both (0 when none did).
@@ -342,10 +363,11 @@ fn factor(q: &Quantity) -> f64 {
     }
 }
 
-/// Applies the decision rule to a value (internal units) with standard uncertainty `u`.
-pub(crate) fn judge(a: &Accept, v: f64, u: f64, name: Option<String>) -> Acceptance {
+/// Applies the decision rule to a value (internal units) with standard uncertainty `u` and
+/// coverage factor `k`.
+pub(crate) fn judge(a: &Accept, v: f64, u: f64, k: f64, name: Option<String>) -> Acceptance {
     let f = factor(&a.limit);
-    let (value, limit, big_u) = (v / f, a.limit.written, 2.0 * u / f);
+    let (value, limit, big_u) = (v / f, a.limit.written, k * u / f);
     let upper = matches!(a.op, Cmp::Le | Cmp::Lt);
     // `within +-L` bounds both sides: the margin is to the nearer one.
     let judged = if a.within { value.abs() } else { value };
@@ -386,6 +408,7 @@ pub(crate) fn judge(a: &Accept, v: f64, u: f64, name: Option<String>) -> Accepta
         unit: a.limit.unit.clone(),
         margin: Some(margin),
         expanded_u: Some(big_u),
+        k: Some(k),
         rule: rule_str(a.rule).into(),
         verdict,
         reason: None,
@@ -411,6 +434,7 @@ pub(crate) fn not_evaluated(a: &Accept, why: &str) -> Acceptance {
         unit: a.limit.unit.clone(),
         margin: None,
         expanded_u: None,
+        k: None,
         rule: rule_str(a.rule).into(),
         verdict: Verdict::NotEvaluated,
         reason: Some(why.into()),

@@ -53,6 +53,10 @@ pub struct Options {
     /// Most IMU rows of a static segment held at once (its outlier test runs within each
     /// window of that many rows); a moving segment's windows are an eighth of it.
     pub window_rows: usize,
+    /// The Type B figures the station states: with them every reported parameter gets its
+    /// GUM budget (results.json `budgets`) and the checks on parameters are judged with
+    /// its `U` and `k`; without, with the fit's Type A uncertainty at k = 2.
+    pub stated: Option<crate::budget::terms::Stated>,
 }
 
 impl Default for Options {
@@ -63,6 +67,7 @@ impl Default for Options {
             path: String::new(),
             with: Vec::new(),
             window_rows: segment::WINDOW_ROWS,
+            stated: None,
         }
     }
 }
@@ -232,11 +237,15 @@ pub fn analyze_source<S: Source>(
         fits: Default::default(),
         size_effect: out.size_effect.take(),
         manual: None,
+        budgets: Vec::new(),
     };
     res.fits = fitted.fits;
     res.model
         .fits
         .extend(fitted.description.iter().map(|d| format!("joint {d}")));
+    if let Some(stated) = &opts.stated {
+        res.budgets = crate::budget::budgets(&res, stated);
+    }
     res.acceptance = accept::evaluate(plan, &res, &out.quantities, &wh, &mut out.warnings);
     let mut w = std::mem::take(&mut out.warnings);
     w.append(&mut res.warnings);

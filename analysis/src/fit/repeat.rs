@@ -95,7 +95,7 @@ pub fn analyze_runs<S: Source>(
                 None => not_evaluated(a, "no scale factor was determined in every run"),
                 Some(w) => {
                     let cv = w.cv.expect("filtered");
-                    let mut j = judge(a, cv, cv / (2.0 * (n - 1.0)).sqrt(), None);
+                    let mut j = judge(a, cv, cv / (2.0 * (n - 1.0)).sqrt(), 2.0, None);
                     j.reason = Some(format!(
                         "CV of the scale factors K (largest: {}); noise figures are not calibration parameters; biases and misalignments are near zero, where a CV is meaningless: their standard deviations are in `repeatability`",
                         w.name

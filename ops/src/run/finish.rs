@@ -232,7 +232,13 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
         errln!("no analysis: the recording cannot be read back");
     };
     let rec = Streamed::open(dir).map_err(unreadable).ok()?;
-    let mut results = analyze_source(&rec, Some(plan), &Options::default())
+    // The station's Type B figures: every parameter's full budget, and the checks on
+    // parameters judged with its U and k (the certificate states the same).
+    let opts = Options {
+        stated: ratecal_certificate::stated_of_folder(dir),
+        ..Options::default()
+    };
+    let mut results = analyze_source(&rec, Some(plan), &opts)
         .map_err(unreadable)
         .ok()?;
     let temperature = ratecal_render::TemperatureSeries::from_source(&rec)
@@ -246,7 +252,7 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
     }
     ratecal_recording::commit::crash_point("after-results");
     if !results.acceptance.is_empty() {
-        outln!("acceptance (value ± expanded uncertainty U, k = 2):");
+        outln!("acceptance (value ± expanded uncertainty U, k as stated):");
     }
     for a in &results.acceptance {
         let value = match (a.value, a.expanded_u) {
@@ -254,8 +260,9 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
             (Some(x), _) => format_value(x, &a.unit),
             (None, _) => format!("- {}", a.unit),
         };
+        let k = a.k.map(|k| format!(", k = {k:.2}")).unwrap_or_default();
         outln!(
-            "  {:>13}  {} = {value} (limit {} {})",
+            "  {:>13}  {} = {value} (limit {} {}{k})",
             a.verdict.label(),
             a.quantity,
             a.op,

@@ -179,6 +179,7 @@ pub(crate) fn analyze<S: Source>(
         fits: Default::default(),
         size_effect: None,
         manual: Some(manual),
+        budgets: Vec::new(),
     };
     let mut q = BTreeMap::new();
     if let Some(man) = &res.manual {

@@ -4,15 +4,26 @@
 //! (Welch-Satterthwaite, `nu_eff = u_c^4 / sum(u_i^4 / nu_i)`, a Type B term from stated
 //! bounds having infinitely many), the coverage factor `k` (Student's t, two-sided 95 %)
 //! and the expanded uncertainty `U = k u_c`.
+//!
+//! Computed at analysis time wherever the station states Type B figures
+//! ([`crate::fit::Options::stated`]) and stored in results.json (`budgets`): the run's
+//! verdict, the report and the certificate use the same `U` and `k`.
 
-use serde::Serialize;
+mod derived;
+mod dof;
+pub mod terms;
+
+pub use derived::{derived_budget, welch_satterthwaite};
+pub use dof::{budgets, reported, type_a_dof};
+
+use serde::{Deserialize, Serialize};
 use statrs::distribution::{ContinuousCDF, Normal, StudentsT};
 
 /// The coverage probability every result is stated at.
 pub const COVERAGE: f64 = 0.95;
 
 /// GUM's evaluation types.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Evaluation {
     /// Statistical analysis of the measurements (the fit).
     A,
@@ -21,7 +32,7 @@ pub enum Evaluation {
 }
 
 /// Whether the station file gives the figure a term needs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum TermStatus {
     /// Given: the term counts.
@@ -31,7 +42,7 @@ pub enum TermStatus {
 }
 
 /// One line of a budget.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Term {
     /// Where it comes from (`fit (Type A)`, `table rate accuracy`...).
     pub source: String,
@@ -101,7 +112,7 @@ impl TermBuilder {
 }
 
 /// The budget of one reported quantity.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Budget {
     /// As results.json names it (`gyro.scale.x`).
     pub quantity: String,

@@ -4,7 +4,7 @@
 //!
 //! - every quantity: the fit's Type A standard uncertainty, with the degrees of freedom of
 //!   the noise estimate it rests on: the one-second block means of the segments that
-//!   determine the quantity, less one per segment ([`crate::type_a_dof`]);
+//!   determine the quantity, less one per segment ([`super::type_a_dof`]);
 //! - `gyro.scale.*` (ppm): the table's rate accuracy `a` (a ratio of the rate),
 //!   rectangular, `u = a / sqrt(3)`, sensitivity 1;
 //! - `accel.bias.*` (m/s^2): the table's position accuracy and axis orthogonality (angles
@@ -22,10 +22,11 @@
 //!   temperature stability `dT` (`site.temperature_stability`, a bound): rectangular,
 //!   `u = |c| dT / sqrt(3)`, sensitivity `c`. Not stated unless both are.
 
-use crate::budget::{Budget, Evaluation, Term};
+use super::{Budget, Evaluation, Term};
+use serde::{Deserialize, Serialize};
 
 /// What the station file states for the budget (`None`: not stated).
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Stated {
     /// `table.rate_accuracy` as a ratio (10 ppm = 1e-5).
     pub rate_accuracy: Option<f64>,
@@ -46,7 +47,7 @@ pub struct Stated {
 }
 
 /// The IMU's temperature coefficients, per degC (`None`: not stated).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct TemperatureCoefficients {
     /// m/s^2 per degC.
     pub accel_bias: Option<f64>,
