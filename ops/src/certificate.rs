@@ -84,11 +84,8 @@ fn typeset(
 ) -> miette::Result<Vec<u8>> {
     let template = lab_template(&args.lab, &certificate.lab)?;
     let logo = lab_logo(&args.lab, &certificate.lab);
-    Ok(render::pdf(
-        certificate,
-        &template,
-        logo.as_ref().map(|l| l.file()),
-    )?)
+    render::pdf(certificate, &template, logo.as_ref().map(|l| l.file()))
+        .map_err(|e| miette::Report::new(*e))
 }
 
 /// Writes `bytes` beside `path` and renames it into place: a reader never sees half a

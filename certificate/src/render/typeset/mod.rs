@@ -65,7 +65,15 @@ pub fn pdf(
     c: &Certificate,
     template: &Template,
     logo: Option<&LogoFile>,
-) -> Result<Vec<u8>, TemplateError> {
+) -> Result<Vec<u8>, Box<TemplateError>> {
+    typeset(c, template, logo)
+}
+
+fn typeset(
+    c: &Certificate,
+    template: &Template,
+    logo: Option<&LogoFile>,
+) -> Result<Vec<u8>, Box<TemplateError>> {
     let data = serde_json::to_string(c).map_err(|e| TemplateError::internal(e.to_string()))?;
     let mut files = Vec::new();
     let mut inputs = Vec::new();
@@ -93,7 +101,7 @@ pub fn pdf(
         ..PdfOptions::default()
     };
     typst_pdf::pdf(&document, &options)
-        .map_err(|errors| TemplateError::from_typst(&world, template, &errors))
+        .map_err(|errors| Box::new(TemplateError::from_typst(&world, template, &errors)))
 }
 
 #[cfg(test)]
