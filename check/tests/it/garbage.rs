@@ -26,7 +26,7 @@ fn assert_graceful(text: &str) {
     }
 }
 
-const STANDARD: &str = include_str!("../../procedures/imu-2d-standard/1.0.0.rcal");
+const STANDARD: &str = include_str!("../../../procedures/imu-2d-standard/1.0.0.rcal");
 
 fn tokens() -> impl Strategy<Value = String> {
     let words = vec![

@@ -4,7 +4,7 @@ use ratecal_check::{CheckOptions, NoImports, StationLimits, check_text};
 use ratecal_physics::Geometry;
 use ratecal_plan::{Action, Axis, FitModel, Node, Plan, VerifyPoint};
 
-const STANDARD: &str = include_str!("../../procedures/imu-2d-standard/1.0.0.rcal");
+const STANDARD: &str = include_str!("../../../procedures/imu-2d-standard/1.0.0.rcal");
 
 fn standard() -> Plan {
     check_text("standard", STANDARD, &NoImports, &CheckOptions::default())
@@ -239,7 +239,7 @@ fn station_limits() {
             .any(|d| d.code == "check::station_limit" && d.message.contains("gyro range"))
     );
     // the swaying procedure peaks at 90 deg * (2 pi / 6 s)^2 = 98.7 deg/s^2
-    let sway = include_str!("../../procedures/size-effect/1.0.0.rcal");
+    let sway = include_str!("../../../procedures/size-effect/1.0.0.rcal");
     let mut opts = station(500.0, 400.0, 90.0);
     if let Some(s) = opts.station.as_mut() {
         s.geometry = Geometry::vertical_outer();
@@ -260,7 +260,7 @@ fn station_limits() {
 
 #[test]
 fn size_effect_procedure_remounts_each_axis_up() {
-    let text = include_str!("../../procedures/size-effect/1.0.0.rcal");
+    let text = include_str!("../../../procedures/size-effect/1.0.0.rcal");
     let plan = check_text("sway", text, &NoImports, &CheckOptions::default())
         .expect("checks")
         .plan;

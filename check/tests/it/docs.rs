@@ -3,7 +3,7 @@
 
 use ratecal_check::{CheckOptions, NoImports, check_text};
 
-const DOC: &str = include_str!("../../docs/language.md");
+const DOC: &str = include_str!("../../../docs/language.md");
 
 fn blocks() -> Vec<(String, String)> {
     let mut out = Vec::new();

@@ -2,8 +2,7 @@
 //! users see it; never a panic, never a blank report. Also: a lab's files override the
 //! bundled ones by name, partials included.
 
-mod render_common;
-
+use crate::render_common;
 use miette::{GraphicalReportHandler, GraphicalTheme};
 use ratecal_render::{Format, RenderError, Templates, render, render_template};
 use render_common::{fixture, full};

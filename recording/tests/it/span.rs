@@ -1,9 +1,7 @@
 //! Reading by time span: a span read equals that slice of a whole read, whatever the line
 //! ends, and a bad cell in a span is located where a whole read locates it.
 
-#[path = "../../tests/support/shared.rs"]
-mod shared;
-
+use crate::shared;
 use miette::{GraphicalReportHandler, GraphicalTheme};
 use ratecal_recording::{self as recording, ImuStream, Recording, RecordingError, TableStream};
 use std::path::Path;

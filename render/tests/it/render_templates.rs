@@ -1,8 +1,7 @@
 //! Snapshot of every bundled template against the fixed fixtures, plus the properties a
 //! report must have whatever its styling: the full hash, the dry-run banner, each section.
 
-mod render_common;
-
+use crate::render_common;
 use ratecal_render::{Format, Templates, render, render_all};
 use render_common::{foreign, full, minimal};
 

@@ -2,9 +2,7 @@
 //! standard procedure dry-runs in seconds and its recording is analysable; station faults
 //! end in a safe, aborted, readable recording.
 
-#[path = "../../tests/support/station/mod.rs"]
-mod common;
-
+use crate::common;
 use common::manifest;
 use common::plans::*;
 use ratecal_drivers::{DEFAULT_STATION_YAML, Station, registry};

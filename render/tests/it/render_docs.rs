@@ -1,8 +1,7 @@
 //! docs/report-templates.md documents every field of the data model: each top-level key,
 //! and each key of the pre-digested sections, of the full fixture's context is named there.
 
-mod render_common;
-
+use crate::render_common;
 use ratecal_render::context_json;
 
 #[test]

@@ -1,9 +1,7 @@
 //! The interpreter on a fake station under a paused clock: settle waits, timeouts, abort
 //! rules with persistence, segments and their kinds, files on disk after an abort, resume.
 
-#[path = "../../tests/support/station/mod.rs"]
-mod common;
-
+use crate::common;
 use common::plans::*;
 use common::*;
 use ratecal_plan::*;

@@ -5,7 +5,7 @@ use ratecal_check::{CheckOptions, NoImports, StationLimits, check_text};
 use ratecal_physics::Geometry;
 use ratecal_plan::{Action, Node};
 
-const SWAY: &str = include_str!("../../procedures/size-effect/1.1.0.rcal");
+const SWAY: &str = include_str!("../../../procedures/size-effect/1.1.0.rcal");
 
 fn station(max_accel: f64) -> CheckOptions {
     CheckOptions {

@@ -7,7 +7,7 @@
 
 use ratecal_check::{CheckOptions, EffectObservability, NoImports, check_text};
 
-const STANDARD: &str = include_str!("../../procedures/imu-2d-standard/1.0.0.rcal");
+const STANDARD: &str = include_str!("../../../procedures/imu-2d-standard/1.0.0.rcal");
 
 const SIX_FACES: &str = r#"procedure six-faces version 0.1.0 {
   step faces {

@@ -1,7 +1,6 @@
 //! The text an auditor signs and the stable JSON, for one revision of the standard plan.
 
-mod audit_support;
-
+use crate::audit_support;
 use audit_support::*;
 use ratecal_audit::{self as audit, render};
 use ratecal_plan::*;

@@ -1,8 +1,6 @@
 //! Reading recordings: the independent example folder, and located errors for bad ones.
 
-#[path = "../../tests/support/shared.rs"]
-mod shared;
-
+use crate::shared;
 use miette::{GraphicalReportHandler, GraphicalTheme};
 use ratecal_recording::{self as recording, RecordingError, SegmentKind};
 use std::path::Path;

@@ -1,7 +1,6 @@
 //! Semantic diff over hand-built plans: each kind of change, its direction, its path.
 
-mod audit_support;
-
+use crate::audit_support;
 use audit_support::*;
 use ratecal_audit::{self as audit, Change, ChangeKind, render};
 use ratecal_plan::*;

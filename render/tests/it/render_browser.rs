@@ -2,8 +2,7 @@
 //! its plots (inline `<svg>` elements laid out with a non-zero size) and logs no console
 //! error. Without Chromium the test says "skipped: chromium not installed" and passes.
 
-mod render_common;
-
+use crate::render_common;
 use ratecal_render::{Format, Templates, render};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
