@@ -2,8 +2,11 @@
 //! [`Progress`](crate::Progress) hooks, and the table driver's `ask`, which a simulated
 //! operator acts on), and the next `settle` waits for the unit to move, then for the IMU's
 //! rest; a pose whose gravity is not on the face asked for is refused and asked again.
-//! A turn is recorded as a `turn` segment from the end of the last pose to the start of
-//! the rest that follows it; static segments carry the attitude the operator was asked for
+//! A turn is recorded as a `turn` segment from the end of the last pose to the moment the
+//! settle that follows it finds rest, its window included: the settle judges rest on 0.1 s
+//! block means under a fluctuation limit, so the tail of the motion may lie inside that
+//! window, and a turn cut at the window's start loses it (the gyro fit integrates the
+//! turn's samples). Static segments carry the attitude the operator was asked for
 //! (`nominal` with its tolerance, or `unknown`).
 
 use super::{Exec, Res};
@@ -147,7 +150,9 @@ impl Exec<'_> {
         }
         self.manual.check = None;
         if let Some((id, axis, angle, start)) = self.manual.turn.take() {
-            let end = (now - window).max(start);
+            // Up to the rest found now, not the start of its window: the window may still
+            // hold the end of the motion (see the module's comment).
+            let end = now.max(start);
             let mut seg = Segment::new(id.clone(), SegmentKind::Turn, start, end);
             seg.axis = axis;
             seg.angle_deg = angle;
