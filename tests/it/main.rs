@@ -34,6 +34,7 @@ mod import_feedback;
 mod import_mat;
 mod import_real;
 mod manual_real;
+mod manual_resume;
 mod manual_station;
 mod run_cli;
 mod run_folder_lock;

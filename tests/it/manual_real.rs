@@ -63,7 +63,7 @@ fn imu_tk_xsens_poses_read_the_authors_gravity_and_turns_carry_it() {
         return;
     };
     let tmp = tempfile::tempdir().unwrap();
-    let r = calibrate(tmp.path(), &[acc.clone(), gyr], "imu_tk-xsens.yaml");
+    let r = calibrate(tmp.path(), &[acc.clone(), gyr.clone()], "imu_tk-xsens.yaml");
     let man = &r["manual"];
     assert_eq!(man["method"], "multi_pose");
     let poses = man["poses"].as_array().unwrap();
@@ -71,11 +71,7 @@ fn imu_tk_xsens_poses_read_the_authors_gravity_and_turns_carry_it() {
     // The authors' gravity, 9.81744 m/s^2, within 0.005 m/s^2 RMS after calibration.
     let after = man["gravity_rms_calibrated_mps2"].as_f64().unwrap();
     // The same poses through the factory calibration, from the source's raw counts.
-    let rows: Vec<Vec<f64>> = std::fs::read_to_string(&acc)
-        .unwrap()
-        .lines()
-        .map(|l| l.split_whitespace().map(|c| c.parse().unwrap()).collect())
-        .collect();
+    let rows = counts(&acc);
     let offset = [33123.0, 33276.0, 32360.0];
     let kf = [415.0, 413.0, 415.0];
     let m_acc = [[1.00, 0.00, -0.01], [0.01, 1.00, 0.01], [0.02, 0.01, 1.00]];
@@ -125,6 +121,80 @@ fn imu_tk_xsens_poses_read_the_authors_gravity_and_turns_carry_it() {
     assert!(man["turns"].as_array().unwrap().len() + 1 >= poses.len());
     assert!(nom >= 3.0 * cal, "{nom} vs {cal}");
     factory_comparison(&r);
+    gyro_offsets(&r, &counts(&gyr));
+}
+
+/// The rows of one of the session's files: time, then x, y, z in counts.
+fn counts(path: &Path) -> Vec<Vec<f64>> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .map(|l| l.split_whitespace().map(|c| c.parse().unwrap()).collect())
+        .collect()
+}
+
+/// Mean raw counts of each axis over the static segments `segs` of results.json.
+fn mean_counts(rows: &[Vec<f64>], segs: &[&Value]) -> [f64; 3] {
+    let mut sum = [0.0; 3];
+    let mut n = 0.0;
+    for s in segs {
+        let (t0, t1) = (s["t_start"].as_f64().unwrap(), s["t_end"].as_f64().unwrap());
+        for x in rows.iter().filter(|x| x[0] >= t0 && x[0] <= t1) {
+            for j in 0..3 {
+                sum[j] += x[j + 1];
+            }
+            n += 1.0;
+        }
+    }
+    sum.map(|v| v / n)
+}
+
+/// The gyro offsets against the factory's `offset_gyro`. The fitted bias is the initial
+/// rest's mean (imu_tk's choice): it must equal the raw counts of that rest, read here
+/// straight from the source file, so no unit, sign or axis convention stands between our
+/// offset and the factory's. x and y agree within 10 counts; z does not, and no choice of
+/// rest changes that: the initial rest reads about 32512 counts and the mean over the ~38
+/// other poses about 32511, against the factory's 32485 (27 counts, 0.32 deg/s; the
+/// factory's x, exactly 32768, is mid-scale, perhaps only nominal). The session has no
+/// temperature column and the Earth's rate is 0.35 counts at most: the unit's turn-on
+/// bias on the day of the session differs from the factory's, which calibrated it on
+/// another day. Asserted as such: within 10 counts, or the raw rests themselves are not.
+fn gyro_offsets(r: &Value, gyro: &[Vec<f64>]) {
+    let off_g = [32768.0, 32466.0, 32485.0];
+    let statics: Vec<&Value> = r["segments"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|s| s["kind"] == "static")
+        .collect();
+    let rest = mean_counts(gyro, &statics[..1]);
+    let poses = mean_counts(gyro, &statics[1..]);
+    for i in 0..3 {
+        let (b, u) = est(r, &format!("gyro.bias.{}", AX[i])).unwrap();
+        let ours = 32768.0 + b.to_radians() * 4767.0;
+        println!(
+            "xsens: gyro offset {}: {ours:.1} counts, factory {} ({:+.1} counts, {:+.1} u); raw mean of the initial rest {:.1}, of the other poses {:.1}",
+            AX[i],
+            off_g[i],
+            ours - off_g[i],
+            (ours - off_g[i]) / (u.to_radians() * 4767.0),
+            rest[i],
+            poses[i]
+        );
+        assert!(
+            (ours - rest[i]).abs() <= 0.5,
+            "{}: {ours} vs {}",
+            AX[i],
+            rest[i]
+        );
+        let near = |c: f64| (c - off_g[i]).abs() <= 10.0;
+        assert!(
+            near(ours) || (!near(rest[i]) && !near(poses[i])),
+            "{}: {ours} counts, factory {}",
+            AX[i],
+            off_g[i]
+        );
+    }
 }
 
 /// The fitted model against the Xsens factory calibration of the README. The factory's
@@ -133,8 +203,8 @@ fn imu_tk_xsens_poses_read_the_authors_gravity_and_turns_carry_it() {
 /// direction is unknown at the poses, so the body frame is ours by convention: with
 /// `K M / 414 = U Q` (`U` upper triangular), our `K_a` is `U`, and the factory's gyro
 /// matrix in our frame is `(K_g M_g / 4767) Q^T`. The offsets must agree within 10 counts
-/// (accelerometers); the rest is printed in units of u (the factory calibrated it on
-/// another day).
+/// (accelerometers; the gyros' in `gyro_offsets`); the rest is printed in units of u (the
+/// factory calibrated it on another day).
 fn factory_comparison(r: &Value) {
     let offset = [33123.0, 33276.0, 32360.0];
     for i in 0..3 {
@@ -185,18 +255,6 @@ fn factory_comparison(r: &Value) {
                 }
             }
         }
-    }
-    let off_g = [32768.0, 32466.0, 32485.0];
-    for i in 0..3 {
-        let (b, u) = est(r, &format!("gyro.bias.{}", AX[i])).unwrap();
-        let counts = 32768.0 + b.to_radians() * 4767.0;
-        println!(
-            "xsens: gyro offset {}: {counts:.1} counts, factory {} ({:+.1} counts, {:+.1} u)",
-            AX[i],
-            off_g[i],
-            counts - off_g[i],
-            (counts - off_g[i]) / (u.to_radians() * 4767.0)
-        );
     }
 }
 

@@ -6,6 +6,9 @@
 //! prompts, real time, the run waiting for the IMU's rest.
 
 use crate::support;
+use ratecal_drivers::station::Station;
+use ratecal_physics::Mat3;
+use ratecal_physics::effects::ImuModel;
 use ratecal_recording::{Attitude, Manifest, SegmentKind};
 use std::path::Path;
 use support::*;
@@ -40,6 +43,9 @@ fn dry_run(proc_name: &str, dir: &Path) -> String {
     for f in ["report.md", "report.html", "results.json", "seal.json"] {
         assert!(out.join(f).exists(), "{f} missing\n{}", text(&o));
     }
+    // The station's consumer IMU passes the procedure's acceptance checks.
+    let r = json(&out.join("results.json"));
+    assert_eq!(r["verdict"], "pass", "{}", r["acceptance"]);
     text(&o)
 }
 
@@ -125,6 +131,122 @@ fn multi_pose_dry_run_records_unknown_poses_between_free_turns() {
         r["manual"]["gravity_rms_calibrated_mps2"].as_f64().unwrap(),
     );
     assert!(cal < raw / 10.0, "{raw} -> {cal}");
+}
+
+/// A sensor's `K` (`accel`, `gyro`) from the station's model: 1 + its scale terms on the
+/// diagonal, its misalignment terms (`xy_mrad`...) off it.
+fn sensitivity(model: &ImuModel, sensor: &str) -> Mat3 {
+    let mut k = Mat3::identity();
+    let axis = |c: u8| usize::from(c - b'x');
+    for t in &model.terms {
+        let id = t.effect.id();
+        if id == format!("{sensor}_scale") {
+            for i in 0..3 {
+                k[(i, i)] += t.values[i] * 1e-6;
+            }
+        } else if id == format!("{sensor}_misalignment") {
+            for (p, v) in t.effect.params().iter().zip(&t.values) {
+                let b = p.name.as_bytes();
+                k[(axis(b[0]), axis(b[1]))] = v * 1e-3;
+            }
+        }
+    }
+    k
+}
+
+/// The rotation `Q` of `K_a = U Q` (`U` upper triangular; Gram-Schmidt from the last row
+/// up): with unknown attitudes the fitted body frame is the accelerometers' own, so the
+/// station's gyro matrix in that frame is `K_g Q^T`.
+fn accel_frame(k_a: &Mat3) -> Mat3 {
+    let mut q = Mat3::zeros();
+    for i in (0..3).rev() {
+        let mut r = k_a.row(i).into_owned();
+        for j in i + 1..3 {
+            let qj = q.row(j).into_owned();
+            r -= qj * k_a.row(i).dot(&qj);
+        }
+        q.set_row(i, &(r / r.norm()));
+    }
+    q
+}
+
+/// The multi-pose dry run's gyro scales cover the station's truth within 3u, seed after
+/// seed. (A turn segment once ended at the start of the settle window that found rest,
+/// cutting off the end of the hand's move: every scale came out near 5000 ppm low, 3 to
+/// 5 u off.)
+#[test]
+fn multi_pose_dry_runs_recover_the_station_gyro_scales_within_3u() {
+    let yaml = std::fs::read_to_string(manual_station()).unwrap();
+    let model = Station::from_yaml(&yaml, "manual.yaml")
+        .unwrap()
+        .imu_model();
+    let k_g = sensitivity(&model, "gyro") * accel_frame(&sensitivity(&model, "accel")).transpose();
+    for seed in ["1", "2", "3"] {
+        let tmp = tempfile::tempdir().unwrap();
+        let out = tmp.path().join("run");
+        let args = [
+            "run",
+            &procedures("imu-multi-pose"),
+            "--station",
+            &manual_station(),
+            "--dry-run",
+            "--seed",
+            seed,
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        let o = ratecal(&args, tmp.path());
+        assert_eq!(code(&o), 0, "{}", text(&o));
+        let r = json(&out.join("results.json"));
+        for (i, ax) in ["x", "y", "z"].iter().enumerate() {
+            let p = &r["parameters"][format!("gyro.scale.{ax}")];
+            let (v, u) = (p["value"].as_f64().unwrap(), p["u"].as_f64().unwrap());
+            let truth = (k_g[(i, i)] - 1.0) * 1e6;
+            println!(
+                "seed {seed}: gyro.scale.{ax} {v:.0} +- {u:.0} ppm, station {truth:.0} ({:+.1} u)",
+                (v - truth) / u
+            );
+            assert!(
+                (v - truth).abs() <= 3.0 * u,
+                "seed {seed} {ax}: {v} +- {u} vs {truth}"
+            );
+        }
+    }
+}
+
+/// A unit outside the procedure's acceptance limits fails the run: exit 3, the failed
+/// check named.
+#[test]
+fn a_manual_run_outside_the_acceptance_limits_fails_with_exit_3() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let station = std::fs::read_to_string(manual_station()).unwrap();
+    let bad = station.replace(
+        "gyro_bias: [0.8 deg/s, -1.1 deg/s, 0.5 deg/s]",
+        "gyro_bias: [6 deg/s, -1.1 deg/s, 0.5 deg/s]",
+    );
+    assert_ne!(bad, station, "the station file's gyro_bias line changed");
+    std::fs::write(dir.join("station.yaml"), bad).unwrap();
+    let args = [
+        "run",
+        &procedures("imu-six-face"),
+        "--station",
+        "station.yaml",
+        "--dry-run",
+        "--out",
+        "run",
+    ];
+    let o = ratecal(&args, dir);
+    assert_eq!(code(&o), 3, "{}", text(&o));
+    let r = json(&dir.join("run/results.json"));
+    let failed: Vec<&str> = r["acceptance"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|a| a["verdict"] == "fail")
+        .map(|a| a["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(failed, ["norm(gyro.bias) <= 5 deg/s"], "{r}");
 }
 
 /// Two faces, the second one placed wrong once by the simulated hand, then a quarter turn.
