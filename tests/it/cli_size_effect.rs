@@ -3,7 +3,7 @@
 //! of `ratecal analyze` on the same recording, match the station's lever arms; and
 //! `ratecal analyze` of the independent `sway-independent` example matches its truth.
 
-use crate::shared;
+use crate::support::shared;
 use std::process::Command;
 
 /// The embedded swaying station's coordinates (drivers/stations/swaying.yaml), mm.

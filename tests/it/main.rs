@@ -4,8 +4,6 @@
 mod archive_common;
 #[path = "../support/pg.rs"]
 mod pg;
-#[path = "../support/shared.rs"]
-mod shared;
 #[path = "../support/mod.rs"]
 mod support;
 
