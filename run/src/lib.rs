@@ -94,6 +94,9 @@ pub struct RunOptions {
     pub safe_stop_timeout_s: f64,
     /// A stream that delivers nothing for this long aborts the run (dropout), s.
     pub stall_timeout_s: f64,
+    /// When resuming: the last static segment the earlier steps recorded (a manual station
+    /// asks the operator to place the unit in that pose again).
+    pub last_pose: Option<ratecal_recording::Segment>,
 }
 
 impl Default for RunOptions {
@@ -106,6 +109,7 @@ impl Default for RunOptions {
             cancel: None,
             safe_stop_timeout_s: 120.0,
             stall_timeout_s: 1.0,
+            last_pose: None,
         }
     }
 }

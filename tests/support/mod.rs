@@ -2,7 +2,7 @@
 
 #![allow(dead_code)]
 
-mod shared;
+pub(crate) mod shared;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

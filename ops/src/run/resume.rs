@@ -183,6 +183,12 @@ fn continue_run(dir: &Path, stage: Option<PathBuf>) -> Result<Prepared, Report> 
     let cut_tail = writer.cut_tails().clone();
     let m = writer.manifest_mut();
     m.segments.truncate(point.segments);
+    let last_pose = m
+        .segments
+        .iter()
+        .rev()
+        .find(|s| s.kind == ratecal_recording::SegmentKind::Static)
+        .cloned();
     if let Some(run) = m.run.as_mut() {
         let reason = match (&run.abort, &run.failure) {
             (Some(a), _) => Some(format!("{} ({})", a.rule, a.values)),
@@ -226,6 +232,7 @@ fn continue_run(dir: &Path, stage: Option<PathBuf>) -> Result<Prepared, Report> 
         resume_segments: point.segments,
         // Time keeps increasing across the interruption (1 s gap).
         t_offset: last_t.map_or(0.0, |t| t + 1.0),
+        last_pose,
         ..RunOptions::default()
     };
     Ok(Prepared {

@@ -2,15 +2,18 @@
 //! [`Progress`](crate::Progress) hooks, and the table driver's `ask`, which a simulated
 //! operator acts on), and the next `settle` waits for the unit to move, then for the IMU's
 //! rest; a pose whose gravity is not on the face asked for is refused and asked again.
-//! A turn is recorded as a `turn` segment from the end of the last pose to the start of
-//! the rest that follows it; static segments carry the attitude the operator was asked for
+//! A turn is recorded as a `turn` segment from the end of the last pose to the moment the
+//! settle that follows it finds rest, its window included: the settle judges rest on 0.1 s
+//! block means under a fluctuation limit, so the tail of the motion may lie inside that
+//! window, and a turn cut at the window's start loses it (the gyro fit integrates the
+//! turn's samples). Static segments carry the attitude the operator was asked for
 //! (`nominal` with its tolerance, or `unknown`).
 
 use super::{Exec, Res};
 use crate::JournalEvent;
 use crate::command::substitute;
 use ratecal_drivers::OperatorAsk;
-use ratecal_plan::{HandTurn, Pose, Settle};
+use ratecal_plan::{Action, HandTurn, Node, Pose, Settle};
 use ratecal_recording::{Attitude, Segment, SegmentKind};
 
 /// How recent the motion that shows the unit was picked up must be, s.
@@ -29,6 +32,14 @@ pub(super) struct Manual {
     pub(super) need_motion: bool,
     /// End of the last static segment, s.
     last_rest_end: Option<f64>,
+}
+
+/// The first action of `nodes` that `pick` keeps, in the order they run.
+fn first<'a, T>(nodes: &'a [Node], pick: &impl Fn(&'a Action) -> Option<T>) -> Option<T> {
+    nodes.iter().find_map(|n| match n {
+        Node::Do(a) => pick(a),
+        Node::Repeat { count, body, .. } => (*count > 0).then(|| first(body, pick)).flatten(),
+    })
 }
 
 /// A signed body axis (`+x`, `-z`) as a unit vector.
@@ -89,6 +100,54 @@ impl Exec<'_> {
         Ok(())
     }
 
+    /// A resumed run on a manual station: the interruption left the unit anywhere. Unless
+    /// the step begins by asking for a pose, the operator is asked for the last pose the
+    /// earlier steps recorded (`opts.last_pose`) and the step waits for rest (its first
+    /// `settle`), so that its first turn or acquisition starts from that pose. A hand-held
+    /// pose cannot be placed again: the operator puts the unit down anywhere, and the turn
+    /// that follows joins no recorded pose (the analysis leaves it out: the resume is in
+    /// the manifest).
+    pub(super) async fn resume_pose(&mut self, body: &[Node]) -> Res {
+        let Some(last) = self.opts.last_pose.clone().filter(|_| self.operator) else {
+            return Ok(());
+        };
+        let up = last
+            .up
+            .clone()
+            .filter(|_| last.attitude() == Attitude::Nominal);
+        let placed_first = first(body, &|a| match a {
+            Action::Place(_) => Some(true),
+            Action::Turn(_) | Action::Acquire(_) => Some(false),
+            _ => None,
+        });
+        let settle = first(body, &|a| match a {
+            Action::Settle(s) => Some(s.clone()),
+            _ => None,
+        });
+        let (Some(false), Some(settle)) = (placed_first, settle) else {
+            return Ok(());
+        };
+        let message = match &up {
+            Some(face) => format!(
+                "Resuming after the interruption: place the unit with {} up on the fixture again (its last pose, {}), then keep it still",
+                face.to_uppercase(),
+                last.id
+            ),
+            None => format!(
+                "Resuming after the interruption: the last pose ({}, held by hand) cannot be placed again; put the unit down and keep it still (the next turn starts from there and is left out of the gyro fit)",
+                last.id
+            ),
+        };
+        let tolerance_deg = up.as_ref().and(last.tolerance_deg);
+        self.place(&Pose {
+            up,
+            tolerance_deg,
+            message,
+        })
+        .await?;
+        self.settle(&settle).await
+    }
+
     async fn ask(&mut self, ask: OperatorAsk) -> Res {
         self.journal(JournalEvent::Command {
             command: format!("operator: {ask:?}"),
@@ -147,7 +206,9 @@ impl Exec<'_> {
         }
         self.manual.check = None;
         if let Some((id, axis, angle, start)) = self.manual.turn.take() {
-            let end = (now - window).max(start);
+            // Up to the rest found now, not the start of its window: the window may still
+            // hold the end of the motion (see the module's comment).
+            let end = now.max(start);
             let mut seg = Segment::new(id.clone(), SegmentKind::Turn, start, end);
             seg.axis = axis;
             seg.angle_deg = angle;

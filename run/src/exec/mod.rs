@@ -246,6 +246,9 @@ impl Exec<'_> {
             self.progress.step(i, &step.name);
             self.journal(JournalEvent::StepStart { index: i });
             self.monitor.enter_step(&step.aborts);
+            if i > 0 && i == self.opts.start_step {
+                self.resume_pose(&step.body).await?;
+            }
             let mut vars = Vec::new();
             self.nodes(&step.body, &mut vars).await?;
             self.monitor.leave_step();

@@ -110,22 +110,31 @@ pub(crate) fn random_walk_gram(
 ) -> DMatrix<f64> {
     let mut blocks: Vec<&Block> = accs.iter().flat_map(|a| a.blocks.iter()).collect();
     blocks.sort_by(|a, b| a.t.total_cmp(&b.t));
-    let mut m = DMatrix::zeros(p, p);
-    let mut suffix = DVector::zeros(p);
-    // The channel's columns in the model: the model holds few of them.
+    // The channel's columns in the model: the model holds few of them, so the walk is
+    // summed over those alone and scattered into the model's `p x p` at the end.
     let used: Vec<(usize, usize)> = local
         .iter()
         .enumerate()
         .filter_map(|(k, l)| Some((k, (*l)?)))
         .collect();
+    let u = used.len();
+    let mut small = DMatrix::zeros(u, u);
+    let mut suffix = DVector::zeros(u);
     // Walk backwards: suffix sums of the regressors after each gap.
     for w in (1..blocks.len()).rev() {
         let b = blocks[w];
-        for &(k, l) in &used {
-            suffix[l] += b.sx[c][k];
+        for (i, &(k, _)) in used.iter().enumerate() {
+            suffix[i] += b.sx[c][k];
         }
         let gap = b.t - blocks[w - 1].t;
-        m.ger(gap, &suffix, &suffix, 1.0);
+        small.syger(gap, &suffix, &suffix, 1.0);
+    }
+    let mut m = DMatrix::zeros(p, p);
+    for (i, &(_, li)) in used.iter().enumerate() {
+        for (j, &(_, lj)) in used.iter().enumerate() {
+            // `syger` fills the lower triangle only.
+            m[(li, lj)] = if i >= j { small[(i, j)] } else { small[(j, i)] };
+        }
     }
     m
 }

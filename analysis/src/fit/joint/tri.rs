@@ -31,6 +31,8 @@ pub(crate) struct Tri {
     pos: Vec<Option<usize>>,
     /// `(caller column, stack column)` of the columns that have changed.
     moving: Vec<(usize, usize)>,
+    /// Caller columns that have kept their first value so far.
+    still: Vec<usize>,
     /// The first row.
     first: Vec<f64>,
     rows: usize,
@@ -48,6 +50,7 @@ impl Tri {
             active: 1,
             pos: vec![None; cols],
             moving: Vec::with_capacity(cols),
+            still: (0..cols).collect(),
             first: Vec::new(),
             rows: 0,
             n: 0,
@@ -59,19 +62,26 @@ impl Tri {
         debug_assert_eq!(row.len(), self.cols);
         if self.n == 0 {
             self.first = row.to_vec();
-        } else if self.active <= self.cols {
-            for (l, v) in row.iter().enumerate() {
-                // Bits, not values: a NaN that stays is constant, and -0 is not 0.
-                if self.pos[l].is_none() && v.to_bits() != self.first[l].to_bits() {
+        } else if !self.still.is_empty() {
+            // Bits, not values: a NaN that stays is constant, and -0 is not 0.
+            let first = &self.first;
+            let changed = |l: &usize| row[*l].to_bits() != first[*l].to_bits();
+            if self.still.iter().any(changed) {
+                let (now, kept): (Vec<usize>, Vec<usize>) =
+                    self.still.iter().partition(|l| changed(l));
+                self.still = kept;
+                for l in now {
                     self.start_moving(l);
                 }
             }
         }
         let k = self.cols + 1;
         let i = k + self.rows;
-        self.stack[(i, 0)] = 1.0;
+        let ld = self.stack.nrows();
+        let a = self.stack.as_mut_slice();
+        a[i] = 1.0;
         for &(l, p) in &self.moving {
-            self.stack[(i, p)] = row[l];
+            a[p * ld + i] = row[l];
         }
         self.rows += 1;
         self.n += 1;

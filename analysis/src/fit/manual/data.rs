@@ -73,6 +73,11 @@ pub(crate) fn read<S: Source>(src: &S) -> Result<Data, S::Error> {
     let mut d = Data::default();
     let mut last_pose: Option<(usize, usize)> = None; // (manifest index, pose index)
     let mut pending: Vec<usize> = Vec::new(); // turns waiting for their next pose
+    // A run resumed between a pose and the turn after it: the unit lay anywhere meanwhile,
+    // so that turn does not start from that pose.
+    let resumed_at: Vec<f64> = m.run.as_ref().map_or(Vec::new(), |r| {
+        r.resumes.iter().filter_map(|x| x.t).collect()
+    });
     for (i, s) in m.segments.iter().enumerate() {
         match s.kind {
             SegmentKind::Static => {
@@ -94,7 +99,13 @@ pub(crate) fn read<S: Source>(src: &S) -> Result<Data, S::Error> {
                         .collect::<Vec<_>>();
                     (v.t.to_vec(), w)
                 })?;
-                let from = last_pose.filter(|(j, _)| j + 1 == i).map(|p| p.1);
+                let from = last_pose
+                    .filter(|(j, _)| j + 1 == i)
+                    .filter(|(j, _)| {
+                        let end = m.segments[*j].t_end;
+                        !resumed_at.iter().any(|&t| end <= t && t < s.t_start)
+                    })
+                    .map(|p| p.1);
                 d.turns.push(Turn {
                     id: s.id.clone(),
                     axis: s.axis.as_deref().and_then(signed_axis),

@@ -79,30 +79,46 @@ pub(crate) fn rest_bias(p: &Pose) -> (Vector3<f64>, [f64; 3]) {
     (Vector3::from(p.w), u)
 }
 
+/// The miss of every turn (three rows a turn) with the gyro model `x`.
+fn misses(turns: &[Prepared], x: &DVector<f64>) -> DVector<f64> {
+    let k_inv = model(x).try_inverse().unwrap_or_else(Matrix3::identity);
+    let mut r = DVector::zeros(3 * turns.len());
+    for (p, t) in turns.iter().enumerate() {
+        let d = t.to - t.carried(&k_inv);
+        r.rows_mut(3 * p, 3).copy_from(&d);
+    }
+    r
+}
+
 /// The unknown-attitude gyro fit over `turns`, with the bias (and its u) of the rest.
-pub(crate) fn from_turns(turns: &[Prepared], bias: (Vector3<f64>, [f64; 3])) -> Option<Triad> {
+/// `shifted` holds the same turns prepared with one axis's bias moved by its u (one set an
+/// axis): the bias is fixed before the fit, so its error bends every turn alike, which the
+/// residuals' scatter does not show; each set is fitted again and the change of each
+/// parameter adds to its variance.
+pub(crate) fn from_turns(
+    turns: &[Prepared],
+    bias: (Vector3<f64>, [f64; 3]),
+    shifted: &[Vec<Prepared>],
+) -> Option<Triad> {
     if turns.len() < REDUCED_MIN_TURNS {
         return None;
     }
     let full = turns.len() >= FULL_MIN_TURNS;
-    let f = |x: &DVector<f64>| {
-        let k_inv = model(x).try_inverse().unwrap_or_else(Matrix3::identity);
-        let mut r = DVector::zeros(3 * turns.len());
-        for (p, t) in turns.iter().enumerate() {
-            let d = t.to - t.carried(&k_inv);
-            r.rows_mut(3 * p, 3).copy_from(&d);
-        }
-        r
-    };
     let mut x0 = vec![1.0, 1.0, 1.0];
     if full {
         x0.extend([0.0; 6]);
     }
-    let fit = lsq::solve(&f, DVector::from_vec(x0), 2.0 / 3.0)?;
+    let fit = lsq::solve(&|x| misses(turns, x), DVector::from_vec(x0), 2.0 / 3.0)?;
+    let mut var = fit.cov.diagonal();
+    for set in shifted {
+        if let Some(moved) = lsq::solve(&|x| misses(set, x), fit.x.clone(), 2.0 / 3.0) {
+            var += (&moved.x - &fit.x).map(|d| d * d);
+        }
+    }
     let mut t = Triad::new("gyro", model(&fit.x), bias.0, "deg/s");
     for i in 0..3 {
         t.bias(i, bias.0[i], bias.1[i]);
-        t.scale(i, fit.x[i], fit.cov[(i, i)].sqrt());
+        t.scale(i, fit.x[i], var[i].sqrt());
     }
     let few = format!(
         "{} turns between poses: the cross-axis terms need at least {FULL_MIN_TURNS}",
@@ -110,7 +126,7 @@ pub(crate) fn from_turns(turns: &[Prepared], bias: (Vector3<f64>, [f64; 3])) -> 
     );
     for (p, &(i, j)) in OFF.iter().enumerate() {
         if full {
-            t.misalignment(i, j, fit.x[3 + p], fit.cov[(3 + p, 3 + p)].sqrt());
+            t.misalignment(i, j, fit.x[3 + p], var[3 + p].sqrt());
         } else {
             t.unobservable(i, j, &few);
         }

@@ -251,21 +251,26 @@ fn fit(d: &Data, g: f64) -> Fitted {
 /// miss with the nominal and the calibrated gyros.
 fn turn_fit(d: &Data, a: &Triad, rest: &Pose) -> (Option<Triad>, Vec<results::TurnMiss>) {
     let bias = gyro::rest_bias(rest);
-    let mut prepared = Vec::new();
-    let mut ids = Vec::new();
-    for t in &d.turns {
-        if let (Some(f), Some(to)) = (t.from, t.to) {
-            let (pf, pt) = (&d.poses[f], &d.poses[to]);
-            prepared.push(gyro::Prepared::of(
-                t,
-                &bias.0,
-                accel::calibrated(a, pf),
-                accel::calibrated(a, pt),
-            ));
-            ids.push(t.id.clone());
-        }
-    }
-    let fit = gyro::from_turns(&prepared, bias);
+    let joined: Vec<_> = d
+        .turns
+        .iter()
+        .filter_map(|t| Some((t, t.from?, t.to?)))
+        .collect();
+    let prepare = |b: &Vector3<f64>| -> Vec<gyro::Prepared> {
+        joined
+            .iter()
+            .map(|(t, f, to)| {
+                let (pf, pt) = (&d.poses[*f], &d.poses[*to]);
+                gyro::Prepared::of(t, b, accel::calibrated(a, pf), accel::calibrated(a, pt))
+            })
+            .collect()
+    };
+    let prepared = prepare(&bias.0);
+    let ids: Vec<String> = joined.iter().map(|(t, ..)| t.id.clone()).collect();
+    let shifted: Vec<_> = (0..3)
+        .map(|k| prepare(&(bias.0 + Vector3::ith(k, bias.1[k]))))
+        .collect();
+    let fit = gyro::from_turns(&prepared, bias, &shifted);
     let k_inv = fit.as_ref().and_then(|f| f.k.try_inverse());
     let misses = match k_inv {
         Some(k_inv) => prepared

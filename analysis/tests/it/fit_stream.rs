@@ -1,0 +1,141 @@
+//! The analysis read span by span (`fit::Streamed`, what `ratecal analyze` uses) against
+//! the same recording held in memory, and segments cut into windows against one window:
+//! how the samples are held must not change what is found.
+
+use crate::fit_support;
+use fit_support::{SimSpec, standard_windows, write};
+use ratecal_analysis::fit;
+use ratecal_analysis::results::Results;
+use ratecal_plan::Outliers;
+use ratecal_recording as recording;
+
+fn sim(spec: &SimSpec) -> tempfile::TempDir {
+    let tmp = tempfile::tempdir().unwrap();
+    write(tmp.path(), spec, &standard_windows(spec.block_s));
+    tmp
+}
+
+/// Every estimate of `a` and `b` differs by at most `tol` times its uncertainty.
+fn agree(a: &Results, b: &Results, tol: f64) -> f64 {
+    let mut worst = 0.0f64;
+    for name in a.parameters.keys() {
+        match (a.value(name), b.value(name)) {
+            (Some((va, ua)), Some((vb, _))) => {
+                let z = (va - vb).abs() / ua;
+                assert!(z <= tol, "{name}: {va} vs {vb} (u {ua}, {z:.3e} u apart)");
+                worst = worst.max(z);
+            }
+            (None, None) => {}
+            (x, y) => panic!("{name}: {x:?} vs {y:?}"),
+        }
+    }
+    worst
+}
+
+#[test]
+fn read_span_by_span_gives_the_results_of_a_whole_read() {
+    let mut spec = SimSpec::tactical(21);
+    spec.temp = Some((22.0, 3.0));
+    let tmp = sim(&spec);
+    let opts = fit::Options {
+        with: vec!["lever_arm".into(), "gyro_thermal_drift".into()],
+        ..Default::default()
+    };
+    let rec = recording::read(tmp.path()).unwrap();
+    let whole = fit::analyze_with(&rec, None, &opts);
+    let streamed = fit::Streamed::open(tmp.path()).unwrap();
+    let spans = fit::analyze_source(&streamed, None, &opts).unwrap();
+    // The same rows in the same windows in the same order: the same numbers, but for the
+    // last bits of the thermal reference (the recording's mean temperature, summed in
+    // another order).
+    agree(&whole, &spans, 1e-9);
+    assert_eq!(whole.segments, spans.segments);
+    assert_eq!(whole.recording, spans.recording);
+    assert_eq!(whole.warnings, spans.warnings);
+    assert!(whole.parameters.contains_key("lever_arm.rxx_mm"));
+    assert_eq!(whole.recording.imu_rows, rec.imu.t.len());
+}
+
+/// Without an outlier test, windows change nothing but where the samples are cut: the
+/// low-pass, read with margins, filters each window as it filters the whole segment (to
+/// rounding: each window's sampling rate comes from its own stamps; a sample lost or
+/// counted twice at a window's edge would move the gyro bias by about 2e-3 u).
+#[test]
+fn windows_with_margins_filter_as_one_window_does() {
+    let tmp = sim(&SimSpec::tactical(22));
+    let rec = recording::read(tmp.path()).unwrap();
+    let opts = |rows: usize| fit::Options {
+        outliers: None,
+        lowpass: Some((4, 5.0)),
+        window_rows: rows,
+        ..Default::default()
+    };
+    let one = fit::analyze_with(&rec, None, &opts(fit::Options::default().window_rows));
+    // 12,000 rows of gyro block in 2,000-row windows; the 1,000-row rate segments in 250.
+    let many = fit::analyze_with(&rec, None, &opts(2_000));
+    let worst = agree(&one, &many, 1e-8);
+    eprintln!("worst difference {worst:.2e} u");
+    let (a, b) = (one.allan.unwrap(), many.allan.unwrap());
+    let pairs = a.adev_dps.iter().flatten().zip(b.adev_dps.iter().flatten());
+    for (x, y) in a.tau_s.iter().zip(&b.tau_s).chain(pairs) {
+        assert!((x - y).abs() <= 1e-9 * x, "{x} vs {y}");
+    }
+}
+
+/// With the 3-sigma test, each window is judged on its own statistics: a few samples at
+/// the edge of the threshold change sides, and the estimates stay well inside their
+/// uncertainty of each other.
+#[test]
+fn outliers_judged_per_window_move_estimates_by_a_fraction_of_u() {
+    let tmp = sim(&SimSpec::tactical(23));
+    let rec = recording::read(tmp.path()).unwrap();
+    let opts = |rows: usize| fit::Options {
+        outliers: Some(Outliers::Sigma(3.0)),
+        window_rows: rows,
+        ..Default::default()
+    };
+    let one = fit::analyze_with(&rec, None, &opts(fit::Options::default().window_rows));
+    let many = fit::analyze_with(&rec, None, &opts(2_000));
+    let worst = agree(&one, &many, 0.5);
+    eprintln!("worst difference {worst:.2e} u");
+    let removed = |r: &Results| r.segments.iter().map(|s| s.outliers_removed).sum::<usize>();
+    let (a, b) = (removed(&one), removed(&many));
+    assert!(a > 0 && b > 0, "{a} {b}");
+    assert!(a.abs_diff(b) * 10 < a.max(b), "{a} vs {b} samples removed");
+}
+
+/// `Source::windows` hands every row once, in order, however small the windows; the
+/// report's temperature series read span by span keeps the rows a whole read keeps.
+#[test]
+fn windows_hand_every_row_once_and_the_temperature_plot_is_the_same() {
+    use fit::Source;
+    let mut spec = SimSpec::tactical(24);
+    spec.temp = Some((22.0, 3.0));
+    let tmp = sim(&spec);
+    let rec = recording::read(tmp.path()).unwrap();
+    let streamed = fit::Streamed::open(tmp.path()).unwrap();
+    for rows in [1_000, 7_777, 1 << 20] {
+        let mut seen: Vec<(f64, f64)> = Vec::new();
+        streamed
+            .windows(rows, |v| {
+                seen.extend(v.t.iter().zip(v.gyro[2]).map(|(t, g)| (*t, *g)));
+            })
+            .unwrap();
+        let want: Vec<(f64, f64)> = rec
+            .imu
+            .t
+            .iter()
+            .copied()
+            .zip(rec.imu.gyro[2].iter().copied())
+            .collect();
+        assert_eq!(seen, want, "windows of {rows} rows");
+    }
+    let whole = ratecal_render::TemperatureSeries::from_recording(&rec);
+    let spans = ratecal_render::TemperatureSeries::from_source(&streamed).unwrap();
+    assert_eq!(whole, spans);
+    assert!(
+        whole.imu.len() > 1_000 && whole.imu.len() <= 2_000,
+        "{}",
+        whole.imu.len()
+    );
+}
