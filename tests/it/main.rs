@@ -14,6 +14,7 @@ mod archive_pg;
 mod audit_cli;
 mod bounded_cli;
 mod certificate_cli;
+mod certificate_pdf;
 mod cli_analyze;
 mod cli_check;
 mod cli_explain;
