@@ -34,7 +34,8 @@ impl Archive {
             if let Some(parent) = out.parent() {
                 std::fs::create_dir_all(parent).map_err(|e| ArchiveError::io(parent, e))?;
             }
-            std::fs::write(&out, bytes).map_err(|e| ArchiveError::io(&out, e))?;
+            ratecal_recording::commit::write_nofollow(&out, &bytes)
+                .map_err(|e| ArchiveError::io(&out, e))?;
         }
         Ok((id, files.len()))
     }

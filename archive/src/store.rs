@@ -185,7 +185,8 @@ fn put_file(root: &Path, sha: &str, bytes: &[u8]) -> Result<()> {
         return Ok(());
     };
     let io = |p: &Path, e| ArchiveError::io(p, e);
-    let mut f = std::fs::File::create(&tmp).map_err(|e| io(&tmp, e))?;
+    let mut f =
+        ratecal_recording::commit::open_nofollow(&tmp, true, false).map_err(|e| io(&tmp, e))?;
     f.write_all(bytes).map_err(|e| io(&tmp, e))?;
     f.sync_all().map_err(|e| io(&tmp, e))?;
     drop(f);
@@ -203,7 +204,8 @@ fn copy_file(root: &Path, sha: &str, src: &Path) -> Result<bool> {
     let io = |p: &Path, e| ArchiveError::io(p, e);
     ratecal_recording::regular(src).map_err(|e| io(src, e))?;
     let mut from = std::fs::File::open(src).map_err(|e| io(src, e))?;
-    let mut to = std::fs::File::create(&tmp).map_err(|e| io(&tmp, e))?;
+    let mut to =
+        ratecal_recording::commit::open_nofollow(&tmp, true, false).map_err(|e| io(&tmp, e))?;
     let mut hasher = Sha256::new();
     let mut buf = vec![0u8; 256 * 1024];
     let copied = (|| -> std::io::Result<()> {

@@ -11,6 +11,7 @@ pub mod hashes;
 pub mod keys;
 pub mod lock;
 pub mod names;
+pub mod outputs;
 pub mod read;
 pub mod seal;
 pub mod sealing;

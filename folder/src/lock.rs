@@ -61,13 +61,15 @@ pub fn acquire(dir: &Path, command: &str) -> Result<FolderLock, Report> {
         )
     };
     let mut file = loop {
-        let mut file = OpenOptions::new()
-            .read(true)
-            .write(true)
-            .create(true)
-            .truncate(false)
-            .open(&path)
-            .map_err(cannot)?;
+        let mut file = ratecal_recording::commit::open_with_nofollow(
+            OpenOptions::new()
+                .read(true)
+                .write(true)
+                .create(true)
+                .truncate(false),
+            &path,
+        )
+        .map_err(|e| link_or(e, &cannot))?;
         match file.try_lock() {
             Ok(()) if same_file(&file, &path) => break file,
             // The holder let go and removed it meanwhile: open the new one.
@@ -92,6 +94,20 @@ pub fn acquire(dir: &Path, command: &str) -> Result<FolderLock, Report> {
         file: Some(file),
         path,
     })
+}
+
+/// A planted symlink refused as such (named, with its own help); other errors as `cannot`.
+fn link_or(e: std::io::Error, cannot: &dyn Fn(std::io::Error) -> Report) -> Report {
+    if e.kind() == std::io::ErrorKind::InvalidInput {
+        miette!(
+            code = "run_folder::symlink",
+            help = "a run folder holds no symbolic links where ratecal writes: remove the link \
+                    (and check who planted it), then run the command again",
+            "{e}"
+        )
+    } else {
+        cannot(e)
+    }
 }
 
 /// The lock of the run folder `file` is written into, when it lies in one (a folder holding

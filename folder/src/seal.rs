@@ -49,6 +49,10 @@ pub struct Approval {
     pub public_key: String,
     /// Signature of [`Seal::approved_text`], 64 bytes hex.
     pub signature: String,
+    /// How many of the seal's additions it covers (those made before it); later ones are
+    /// listed after it and leave it standing. Absent in an older approval: all of them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub additions: Option<usize>,
 }
 
 /// The fingerprint under which a public key is shown: `SHA256:` and the hex SHA-256 of its
@@ -77,6 +81,10 @@ pub struct Addition {
     pub command: String,
     /// SHA-256 of each file written, by path.
     pub files: BTreeMap<String, String>,
+    /// SHA-256 of each of the folder's files they were computed from, by path, as the seal
+    /// held them when they were written: `verify` checks each against that record.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub inputs: BTreeMap<String, String>,
 }
 
 /// Whether a path names the seal itself (never listed in it).
@@ -168,7 +176,18 @@ impl Seal {
             key_fingerprint: key_fingerprint(&key.verifying_key()),
             public_key: hex::encode(key.verifying_key().as_bytes()),
             signature: hex::encode(sig.to_bytes()),
+            additions: Some(self.added.len()),
         });
+    }
+
+    /// How many additions the approval (if any) covers; the later ones came after it.
+    pub fn approved_additions(&self) -> Option<usize> {
+        let a = self.approval.as_ref()?;
+        Some(
+            a.additions
+                .unwrap_or(self.added.len())
+                .min(self.added.len()),
+        )
     }
 
     /// `None` when the approval (if any) is signed by the key it names, its fingerprint is
@@ -193,6 +212,13 @@ impl Seal {
         };
         let mut before = self.clone();
         before.approval = None;
+        // Additions after the approval are not covered by it, and do not undo it.
+        if let Some(n) = a.additions {
+            if n > before.added.len() {
+                return Some("it counts more additions than the seal lists".into());
+            }
+            before.added.truncate(n);
+        }
         let text = before.approved_text(&a.signer, &a.role, &a.time);
         match key.verify(text.as_bytes(), &Signature::from_bytes(&bytes)) {
             Ok(()) => None,
@@ -220,7 +246,17 @@ impl Seal {
                 .iter()
                 .map(|(p, h)| (p.to_string(), h.to_string()))
                 .collect(),
+            inputs: BTreeMap::new(),
         });
+    }
+
+    /// The SHA-256 the seal holds now for each file (the newest record of it wins).
+    pub fn held(&self) -> BTreeMap<String, String> {
+        let mut held = self.files.clone();
+        for a in &self.added {
+            held.extend(a.files.iter().map(|(p, h)| (p.clone(), h.clone())));
+        }
+        held
     }
 
     /// `seal.json` text.
@@ -301,19 +337,46 @@ pub fn verify_hashes(
         },
     );
     // The newest record of a file wins: a re-rendered report replaces the sealed one.
-    let mut expected: BTreeMap<&str, (&str, Option<&Addition>)> = parsed
+    let approved = parsed.approved_additions();
+    let mut expected: BTreeMap<&str, (&str, Option<(usize, &Addition)>)> = parsed
         .files
         .iter()
         .map(|(p, h)| (p.as_str(), (h.as_str(), None)))
         .collect();
-    for a in &parsed.added {
+    for (i, a) in parsed.added.iter().enumerate() {
         for (p, h) in &a.files {
-            expected.insert(p.as_str(), (h.as_str(), Some(a)));
+            expected.insert(p.as_str(), (h.as_str(), Some((i, a))));
         }
+    }
+    // What each addition was computed from is what the seal held at the time.
+    let mut held: BTreeMap<&str, &str> = parsed
+        .files
+        .iter()
+        .map(|(p, h)| (p.as_str(), h.as_str()))
+        .collect();
+    for a in &parsed.added {
+        for (p, h) in &a.inputs {
+            if let Some(was) = held.get(p.as_str())
+                && !was.eq_ignore_ascii_case(h)
+            {
+                push(
+                    &format!("{p} (as read by `{}` at {})", a.command, a.time),
+                    Status::Altered {
+                        expected: was.to_string(),
+                        actual: h.clone(),
+                    },
+                );
+            }
+        }
+        held.extend(a.files.iter().map(|(p, h)| (p.as_str(), h.as_str())));
     }
     for (path, (sha, added)) in &expected {
         let name = match added {
-            Some(a) => format!("{path} (written by `{}` at {})", a.command, a.time),
+            Some((i, a)) if approved.is_some_and(|n| *i >= n) => format!(
+                "{path} (written by `{}` at {}, after the approval: not approved)",
+                a.command, a.time
+            ),
+            Some((_, a)) => format!("{path} (written by `{}` at {})", a.command, a.time),
             None => path.to_string(),
         };
         let status = match files.get(*path) {
@@ -441,7 +504,7 @@ mod tests {
     }
 
     #[test]
-    fn an_approval_covers_signer_role_time_and_every_file_and_nothing_added_later() {
+    fn an_approval_covers_signer_role_time_and_every_file_not_what_is_added_later() {
         let f = folder(&[("imu.csv", "1"), ("results.json", "{}")]);
         let lab = SigningKey::from_bytes(&[9; 32]);
         let mut seal = Seal::new("t0", f.iter().map(|(p, b)| (p.as_str(), b.as_slice())));
@@ -471,9 +534,23 @@ mod tests {
             r.text()
         );
 
-        // A file added after the approval is not approved.
+        // A file added after the approval is not approved, and leaves it standing.
         let mut later = seal.clone();
         later.add("t2", "ratecal report", &[("report.md", b"x")]);
+        assert_eq!(later.approval_problem(), None);
+        assert_eq!(later.approved_additions(), Some(0));
+        let mut g = f.clone();
+        g.insert("report.md".into(), b"x".to_vec());
+        let json = later.to_json();
+        let r = verify_seal(Some(&json), Some(&Seal::hash_line(&json)), &g, None);
+        assert!(r.intact(), "{}", r.text());
+        assert!(
+            r.text().contains("after the approval: not approved"),
+            "{}",
+            r.text()
+        );
+        // Claiming to cover the later addition breaks it.
+        later.approval.as_mut().unwrap().additions = Some(1);
         assert!(later.approval_problem().is_some());
     }
 }

@@ -93,18 +93,33 @@ fn sealed(dir: &Path) -> Option<Seal> {
 /// Writes `files` (name, bytes) into `dir`. In a sealed run folder they join its seal as one
 /// addition with the time and `command`, files and seal replaced in one committed change;
 /// elsewhere each file is simply written. Returns whether they joined a seal.
+///
+/// `read` names the folder's files the new ones were computed from: a sealed folder is
+/// verified first (refused, [`Refused::Altered`], when it fails its seal) and the addition
+/// records their hashes as the seal holds them.
 pub fn write_files(
     dir: &Path,
     files: &[(String, Vec<u8>)],
     command: &str,
+    read: &[&str],
 ) -> std::io::Result<bool> {
     // A change a crash left unfinished is carried out (or dropped) first: its intent must
     // not be overwritten by this one.
     recover(dir)?;
+    if std::fs::symlink_metadata(dir.join(SEAL_FILE)).is_ok() {
+        let report = crate::verify::verify_folder(dir, None)
+            .map_err(|e| std::io::Error::other(e.to_string()))?;
+        if !report.intact() {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                Refused::Altered(report.altered_names()),
+            ));
+        }
+    }
     let Some(mut seal) = sealed(dir) else {
         std::fs::create_dir_all(dir)?;
         for (name, bytes) in files {
-            std::fs::write(dir.join(name), bytes)?;
+            ratecal_recording::commit::write_nofollow(&dir.join(name), bytes)?;
         }
         return Ok(false);
     };
@@ -117,13 +132,25 @@ pub fn write_files(
         .map(|(n, h)| (n.as_str(), h.as_str()))
         .collect();
     let now = rfc3339(std::time::SystemTime::now());
+    let held = seal.held();
     seal.add_hashes(&now, command, &borrowed);
+    if let Some(a) = seal.added.last_mut() {
+        a.inputs = read
+            .iter()
+            .filter_map(|n| held.get(*n).map(|h| (n.to_string(), h.clone())))
+            .collect();
+    }
     save_with(dir, &seal, files)?;
     Ok(true)
 }
 
 /// [`write_files`] of one file given by its path.
-pub fn write_file(path: &Path, bytes: Vec<u8>, command: &str) -> std::io::Result<bool> {
+pub fn write_file(
+    path: &Path,
+    bytes: Vec<u8>,
+    command: &str,
+    read: &[&str],
+) -> std::io::Result<bool> {
     let dir = match path.parent() {
         Some(p) if p.as_os_str().is_empty() => Path::new("."),
         Some(p) => p,
@@ -133,7 +160,32 @@ pub fn write_file(path: &Path, bytes: Vec<u8>, command: &str) -> std::io::Result
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .ok_or_else(|| std::io::Error::other(format!("{} names no file", path.display())))?;
-    write_files(dir, &[(name, bytes)], command)
+    write_files(dir, &[(name, bytes)], command, read)
+}
+
+/// Why [`write_files`] refused a sealed folder: it fails its seal (the files that do).
+#[derive(Debug)]
+pub enum Refused {
+    /// Altered: the names `verify` gives.
+    Altered(String),
+}
+
+impl std::fmt::Display for Refused {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Refused::Altered(names) => write!(
+                f,
+                "the run folder fails its seal ({names}): nothing was written or added to it"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for Refused {}
+
+/// Whether an error of [`write_files`] is its refusal of an altered sealed folder.
+pub fn is_altered(e: &std::io::Error) -> bool {
+    e.get_ref().is_some_and(|r| r.is::<Refused>())
 }
 
 /// The command line as run, for the seal's record of additions.

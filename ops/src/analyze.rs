@@ -29,6 +29,14 @@ pub struct Request {
 
 /// Analyses the runs; the exit code of spec/cli.md.
 pub fn analyze(args: &Request) -> u8 {
+    // An output never replaces an input (a recording, a seal, a recorded file).
+    if let Some(out) = &args.out {
+        let runs: Vec<&std::path::Path> = args.runs.iter().map(PathBuf::as_path).collect();
+        if let Err(e) = ratecal_folder::outputs::refuse_inputs(out, "--out", &runs) {
+            errln!("{e:?}");
+            return 1;
+        }
+    }
     // Writing into a run folder: its lock first, so a second writer is refused at once.
     let _lock = match args
         .out
@@ -42,6 +50,16 @@ pub fn analyze(args: &Request) -> u8 {
         Some(Ok(l)) => l,
         None => None,
     };
+    // Results written into a sealed folder are computed from what its seal holds: the seal
+    // is verified before anything is read (exit 4 when it fails, nothing written).
+    let out_dir = args.out.as_deref().map(folder_of);
+    if let Some(dir) = &out_dir
+        && dir.join(ratecal_folder::names::SEAL_FILE).exists()
+        && let Err(e) = ratecal_folder::verify::require_intact(dir, "results written into it")
+    {
+        errln!("{e:?}");
+        return 4;
+    }
     let load = |p: &std::path::Path| load_plan(p, args.allow_changed);
     let (plan, sha256) = match args.procedure.as_deref().map(load).transpose() {
         Ok(Some((p, h))) => (Some(p), h),
@@ -87,19 +105,41 @@ pub fn analyze(args: &Request) -> u8 {
             // A file ratecal writes into a sealed run folder joins the seal, with the
             // command, in one committed change.
             let bytes = (json + "\n").into_bytes();
+            // The folder's files the results were computed from, when it is the one read.
+            use ratecal_folder::names::{IMU, MANIFEST, STATION, TABLE};
+            let same = |a: &std::path::Path, b: &std::path::Path| {
+                std::fs::canonicalize(a).ok() == std::fs::canonicalize(b).ok()
+            };
+            let read: &[&str] = match (&out_dir, args.runs.as_slice()) {
+                (Some(d), [run]) if same(d, run) => &[MANIFEST, IMU, TABLE, STATION],
+                _ => &[],
+            };
             if let Err(e) = ratecal_folder::sealing::write_file(
                 path,
                 bytes,
                 &ratecal_folder::sealing::command_line(),
+                read,
             ) {
                 errln!("error: cannot write {}: {e}", path.display());
-                return 1;
+                return if ratecal_folder::sealing::is_altered(&e) {
+                    4
+                } else {
+                    1
+                };
             }
         }
         None => outln!("{json}"),
     }
     summary(&results);
     exit_code(results.verdict)
+}
+
+/// The folder `path` lies in (`.` for a bare name).
+fn folder_of(path: &std::path::Path) -> PathBuf {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
 }
 
 /// 0 for a pass and for nothing judged, 3 for every other verdict (spec/cli.md).

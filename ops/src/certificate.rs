@@ -21,6 +21,14 @@ pub enum Format {
 /// Issues the certificate in `format`, to `out` or standard output; the exit code of
 /// spec/cli.md.
 pub fn certificate(args: &Request, format: Format, out: Option<&Path>) -> u8 {
+    // An output never replaces an input: refused before a number is taken.
+    if let Some(path) = out
+        && let Err(e) =
+            ratecal_folder::outputs::refuse_inputs(path, "--out", &[args.run_dir.as_path()])
+    {
+        errln!("{e:?}");
+        return 1;
+    }
     if let Err(e) = ratecal_folder::verify::require_intact(&args.run_dir, "certificate") {
         errln!("{e:?}");
         return 4;
@@ -96,7 +104,7 @@ fn write_aside(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "certificate".into());
     let aside = path.with_file_name(format!(".{name}.partial"));
-    std::fs::write(&aside, bytes)?;
+    ratecal_recording::commit::write_nofollow(&aside, bytes)?;
     std::fs::rename(&aside, path).inspect_err(|_| {
         let _ = std::fs::remove_file(&aside);
     })

@@ -125,6 +125,14 @@ pub fn explain(args: &Request) -> u8 {
 }
 
 fn explain_or_exit(args: &Request) -> Result<u8, Exit> {
+    // An output never replaces an input (a recording, a seal, a recorded file): exit 2.
+    if let Some(out) = &args.write_twin
+        && let Err(e) =
+            ratecal_folder::outputs::refuse_inputs(out, "--write-twin", &[args.run.as_path()])
+    {
+        errln!("{e:?}");
+        return Err(2);
+    }
     // A folder whose seal fails (or a run never sealed) is not explained, and its seal
     // gains nothing (exit 4, as `report`).
     if let Err(e) = ratecal_folder::verify::require_intact(&args.run, "explanation") {
@@ -298,7 +306,7 @@ fn write_twin(
         errln!("error: cannot correct the twin: {e}");
         2
     })?;
-    std::fs::write(out, &text).map_err(|e| {
+    ratecal_recording::commit::write_nofollow(out, text.as_bytes()).map_err(|e| {
         errln!(
             "error: cannot write the corrected twin {}: {e}",
             out.display()
@@ -425,7 +433,7 @@ fn write(dir: &Path, files: &[(String, String)], seal: bool) -> std::io::Result<
     std::fs::create_dir_all(dir)?;
     if !seal {
         for (name, text) in files {
-            std::fs::write(dir.join(name), text)?;
+            ratecal_recording::commit::write_nofollow(&dir.join(name), text.as_bytes())?;
         }
         return Ok(());
     }
@@ -433,7 +441,13 @@ fn write(dir: &Path, files: &[(String, String)], seal: bool) -> std::io::Result<
         .iter()
         .map(|(n, t)| (n.clone(), t.clone().into_bytes()))
         .collect();
-    ratecal_folder::sealing::write_files(dir, &bytes, &ratecal_folder::sealing::command_line())?;
+    use ratecal_folder::names::{IMU, MANIFEST, STATION, TABLE};
+    ratecal_folder::sealing::write_files(
+        dir,
+        &bytes,
+        &ratecal_folder::sealing::command_line(),
+        &[MANIFEST, IMU, TABLE, STATION],
+    )?;
     Ok(())
 }
 

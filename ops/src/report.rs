@@ -56,6 +56,10 @@ pub fn report(args: &Request) -> u8 {
 }
 
 fn render_report(args: &Request) -> miette::Result<()> {
+    // An output never replaces an input (a recording, a seal, a recorded file).
+    if let Some(out) = &args.out {
+        ratecal_folder::outputs::refuse_inputs(out, "--out", &[args.run_dir.as_path()])?;
+    }
     // Writing into a run folder: its lock first, so a second writer is refused at once.
     let _lock = match &args.out {
         Some(out) => ratecal_folder::lock::for_file(out, &ratecal_folder::sealing::command_line())?,
@@ -80,10 +84,27 @@ fn render_report(args: &Request) -> miette::Result<()> {
         Some(out) => {
             // A report written into a sealed run folder joins the seal, with the command,
             // in one committed change.
+            // Computed from these files of the run folder (when it is written into).
+            use ratecal_folder::names::{MANIFEST, PLAN, RESULTS};
+            let into_run = out.parent().is_some_and(|p| {
+                std::fs::canonicalize(if p.as_os_str().is_empty() {
+                    Path::new(".")
+                } else {
+                    p
+                })
+                .ok()
+                    == std::fs::canonicalize(&args.run_dir).ok()
+            });
+            let read: &[&str] = if into_run {
+                &[RESULTS, MANIFEST, PLAN]
+            } else {
+                &[]
+            };
             ratecal_folder::sealing::write_file(
                 out,
                 text.into_bytes(),
                 &ratecal_folder::sealing::command_line(),
+                read,
             )
             .map_err(|e| io(out, e, "check that the folder exists and is writable"))?;
         }
@@ -108,7 +129,7 @@ pub fn write_reports(
     let mut written = vec![];
     for r in render::render_all(input, &templates)? {
         let path = run_dir.join(&r.file_name);
-        std::fs::write(&path, r.text)
+        ratecal_recording::commit::write_nofollow(&path, r.text.as_bytes())
             .map_err(|e| io(&path, e, "check that the run folder is writable"))?;
         written.push(path);
     }

@@ -228,7 +228,7 @@ pub fn write_drafts(
             continue;
         };
         let path = dir.join(draft::file_name(f));
-        std::fs::write(&path, text)?;
+        ratecal_recording::commit::write_nofollow(&path, text.as_bytes())?;
         for c in changes.iter_mut().filter(|c| c.effect == f.effect) {
             c.defined_in = Some(path.display().to_string());
         }

@@ -31,11 +31,76 @@ pub struct Intent {
     pub removes: Vec<String>,
 }
 
-/// The pending folder of `dir`, created if need be.
+/// The pending folder of `dir`, created if need be; refused when a symlink stands in its
+/// place (files staged there would be written wherever it points).
 pub fn pending_dir(dir: &Path) -> io::Result<PathBuf> {
     let p = dir.join(PENDING_DIR);
-    std::fs::create_dir_all(&p)?;
+    match std::fs::symlink_metadata(&p) {
+        Ok(m) if m.file_type().is_symlink() => return Err(link_refused(&p)),
+        Ok(m) if m.is_dir() => {}
+        Ok(_) => {
+            return Err(io::Error::other(format!(
+                "{} is not a folder: nothing was written",
+                p.display()
+            )));
+        }
+        Err(e) if e.kind() == io::ErrorKind::NotFound => std::fs::create_dir(&p)?,
+        Err(e) => return Err(e),
+    }
     Ok(p)
+}
+
+/// The refusal of a symlink found where ratecal writes a file (docs/run-folders.md):
+/// ratecal never writes through one, so a link planted in a folder cannot redirect a write.
+pub fn link_refused(path: &Path) -> io::Error {
+    io::Error::new(
+        io::ErrorKind::InvalidInput,
+        format!(
+            "\"{}\" is a symbolic link: ratecal never writes through a link, nothing was written \
+             (remove the link, then run the command again)",
+            path.display()
+        ),
+    )
+}
+
+/// Opens `path` for writing without following a symlink in its place: created, or
+/// truncated when `truncate` (else appended to when `append`). A symlink there, dangling or
+/// not, is refused ([`link_refused`]) and nothing is written anywhere.
+pub fn open_nofollow(path: &Path, truncate: bool, append: bool) -> io::Result<File> {
+    let mut o = std::fs::OpenOptions::new();
+    o.create(true);
+    if append {
+        o.append(true);
+    } else {
+        o.write(true).truncate(truncate);
+    }
+    open_with_nofollow(&mut o, path)
+}
+
+/// Opens `path` with the options `o`, never following a symlink in its place (refused,
+/// [`link_refused`]).
+pub fn open_with_nofollow(o: &mut std::fs::OpenOptions, path: &Path) -> io::Result<File> {
+    #[cfg(unix)]
+    std::os::unix::fs::OpenOptionsExt::custom_flags(o, libc::O_NOFOLLOW);
+    #[cfg(not(unix))]
+    if std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink()) {
+        return Err(link_refused(path));
+    }
+    o.open(path).map_err(|e| nofollow_error(path, e))
+}
+
+/// The error of an open with `O_NOFOLLOW`: the link named when there is one.
+pub fn nofollow_error(path: &Path, e: io::Error) -> io::Error {
+    if std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink()) {
+        link_refused(path)
+    } else {
+        e
+    }
+}
+
+/// Writes `bytes` as the whole of `path` (created or truncated), never through a symlink.
+pub fn write_nofollow(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    open_nofollow(path, true, false)?.write_all(bytes)
 }
 
 /// Flushes a folder's entries (a rename is durable once its folder is).
@@ -53,7 +118,7 @@ pub fn sync_dir(dir: &Path) -> io::Result<()> {
 
 /// Writes `bytes` fully into `path` and fsyncs it.
 pub fn write_synced(path: &Path, bytes: &[u8]) -> io::Result<()> {
-    let mut f = File::create(path)?;
+    let mut f = open_nofollow(path, true, false)?;
     f.write_all(bytes)?;
     f.sync_all()
 }
@@ -128,8 +193,10 @@ pub enum Recovered {
 /// folder's lock).
 pub fn recover(dir: &Path) -> io::Result<Recovered> {
     let pending = dir.join(PENDING_DIR);
-    if std::fs::symlink_metadata(&pending).is_err() {
-        return Ok(Recovered::Clean);
+    match std::fs::symlink_metadata(&pending) {
+        Err(_) => return Ok(Recovered::Clean),
+        Ok(m) if m.file_type().is_symlink() => return Err(link_refused(&pending)),
+        Ok(_) => {}
     }
     match pending_intent(dir) {
         Some(intent) => {
@@ -160,7 +227,14 @@ pub fn pending_intent(dir: &Path) -> Option<Intent> {
 
 /// Tests stop the process at named points (`RATECAL_CRASH_AT=after-intent`, or
 /// `after-checkpoint#3` for the third time it is reached): it aborts there at once, as a
-/// kill would, leaving the files as they are. Nothing happens without the variable.
+/// kill would, leaving the files as they are. Nothing happens without the variable, nor in a
+/// build without the `fault-injection` feature (a plain `cargo build --release`: only the
+/// root crate's tests enable it, through its dev-dependencies).
+#[cfg(not(feature = "fault-injection"))]
+pub fn crash_point(_name: &str) {}
+
+/// See above: the hook of a build with the `fault-injection` feature.
+#[cfg(feature = "fault-injection")]
 pub fn crash_point(name: &str) {
     use std::sync::atomic::{AtomicUsize, Ordering};
     static HITS: AtomicUsize = AtomicUsize::new(0);
@@ -180,6 +254,37 @@ pub fn crash_point(name: &str) {
 
 #[cfg(test)]
 mod tests {
+    /// Reaches the crash point `inert-probe` (run alone by the test below, with the
+    /// variable naming it set).
+    #[test]
+    fn crash_point_probe() {
+        crash_point("inert-probe");
+    }
+
+    /// A build without the `fault-injection` feature (a plain `cargo build`, this crate's
+    /// own tests) never stops at a crash point, whatever `RATECAL_CRASH_AT` says: this test
+    /// binary run again with the variable set, the probe reaching the named point.
+    #[cfg(not(feature = "fault-injection"))]
+    #[test]
+    fn crash_points_are_inert_without_the_feature() {
+        let o = std::process::Command::new(std::env::current_exe().unwrap())
+            .args([
+                "--exact",
+                "commit::tests::crash_point_probe",
+                "--test-threads=1",
+            ])
+            .env("RATECAL_CRASH_AT", "inert-probe")
+            .output()
+            .unwrap();
+        let out = String::from_utf8_lossy(&o.stdout);
+        assert!(
+            o.status.success(),
+            "{out}{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(out.contains("1 passed"), "{out}");
+    }
+
     use super::*;
 
     #[test]

@@ -28,6 +28,7 @@ mod cli_report;
 mod cli_size_effect;
 mod crash_cli;
 mod explain_real;
+mod harden_cli;
 mod import_cli;
 mod import_feedback;
 mod import_mat;

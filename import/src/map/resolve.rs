@@ -8,6 +8,12 @@ use ratecal_physics::units::{Dim, parse_quantity};
 use ratecal_recording::yaml_offset;
 use serde_saphyr::{Location, Spanned};
 
+/// The slowest sampling rate an import accepts, Hz: slower, a calibration's static poses
+/// would hold a handful of samples, and the span of a file would be days.
+pub const MIN_RATE_HZ: f64 = 1.0;
+/// The fastest, Hz (1 MHz: beyond any IMU's output data rate).
+pub const MAX_RATE_HZ: f64 = 1.0e6;
+
 pub(super) const HELP: &str = "docs/import.md lists every key of an import map";
 
 /// Reads and checks a map; `file` names it in diagnostics.
@@ -147,9 +153,27 @@ impl Resolver<'_> {
     }
 
     /// `time:` (of the IMU or of the table feedback).
+    ///
+    /// A `rate_hz` is refused outside [`MIN_RATE_HZ`, `MAX_RATE_HZ`].
     pub(super) fn time(&self, t: &Spanned<RawTime>) -> Res<TimeSpec> {
         Ok(match (&t.value.rate_hz, &t.value.column) {
-            (Some(r), None) if r.value.is_finite() && r.value > 0.0 => TimeSpec::Rate(r.value),
+            (Some(r), None) if (MIN_RATE_HZ..=MAX_RATE_HZ).contains(&r.value) => {
+                TimeSpec::Rate(r.value)
+            }
+            (Some(r), None) if r.value.is_finite() && r.value > 0.0 => {
+                // A slip (1e-300, 1e300, a period given for a rate) would make the span of
+                // the recording absurd, and the synthesized table with it.
+                return Err(self.err(
+                    self.at(&r.referenced),
+                    &format!(
+                        "rate_hz {} is no IMU's sampling rate (between {MIN_RATE_HZ} Hz and \
+                         {MAX_RATE_HZ} Hz)",
+                        r.value
+                    ),
+                    "rate_hz is the IMU's output data rate in Hz (e.g. 100, 102.4, 400); \
+                     a period in seconds is its inverse",
+                ));
+            }
             (Some(r), None) => {
                 return Err(self.err(self.at(&r.referenced), "rate_hz must be above 0", HELP));
             }

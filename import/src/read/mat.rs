@@ -37,8 +37,13 @@ const CLASSES: [&str; 16] = [
 ];
 const MI_MATRIX: u32 = 14;
 const MI_COMPRESSED: u32 = 15;
-/// Largest matrix accepted (elements): 2^31, about 16 GiB as f64.
+/// Largest matrix header read (elements): 2^31; beyond it the header is damaged.
 const MAX_ELEMENTS: u64 = 1 << 31;
+/// The memory budget of the matrix read (its values as f64, bytes): 40 MiB, 5,242,880
+/// values (750,000 samples of 7 channels, 2 h at 100 Hz). The matrix is inflated no
+/// further than its declared dimensions allow, so the import stays well under 100 MB
+/// whatever the file claims; a larger session is imported in parts or as CSV (streamed).
+pub const MATRIX_BUDGET_BYTES: u64 = 40 << 20;
 
 fn class_name(c: u32) -> &'static str {
     CLASSES.get(c as usize).copied().unwrap_or("unknown")
@@ -221,6 +226,7 @@ impl Reader<'_> {
                 class: class_name(h.class),
             })));
         }
+        self.within_budget(&h, base, variable)?;
         // Deflate expands at most 1032:1: a stream cannot hold more (a damaged header
         // claiming a huge matrix does not make us allocate it).
         let limit = h
@@ -247,6 +253,7 @@ impl Reader<'_> {
                 class: class_name(h.class),
             })));
         }
+        self.within_budget(&h, base, variable)?;
         if h.complex {
             return Err(bad(
                 self.name,
@@ -288,6 +295,29 @@ impl Reader<'_> {
             data: values,
             class: class_name(h.class),
         })))
+    }
+
+    /// Refuses the variable read when its declared values exceed [`MATRIX_BUDGET_BYTES`]
+    /// as f64: before it is inflated or converted.
+    fn within_budget(&self, h: &Header, base: usize, variable: &str) -> Res<()> {
+        let budget = MATRIX_BUDGET_BYTES / 8;
+        if h.elements <= budget {
+            return Ok(());
+        }
+        let dims: Vec<String> = h.dims.iter().map(u32::to_string).collect();
+        Err(bad(
+            self.name,
+            base,
+            &format!(
+                "variable `{variable}` is {}: {} values, more than the {budget} an import \
+                 of a MATLAB matrix holds in memory ({} MiB)",
+                dims.join(" x "),
+                h.elements,
+                MATRIX_BUDGET_BYTES >> 20
+            ),
+            "import the session in parts (split the matrix by time and import each), or \
+             export it as CSV, which is read a line at a time",
+        ))
     }
 
     /// Array flags, dimensions and name at `at` of `d`.
@@ -393,4 +423,66 @@ struct Header {
     name: String,
     /// Offset of the real part's tag.
     next: usize,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::io::Write;
+
+    fn element(ty: u32, body: &[u8], claimed: Option<u32>) -> Vec<u8> {
+        let mut e = ty.to_le_bytes().to_vec();
+        e.extend(claimed.unwrap_or(body.len() as u32).to_le_bytes());
+        e.extend(body);
+        e.resize(8 + pad8(body.len()).max(body.len()), 0);
+        e
+    }
+
+    /// A compressed `rows x cols` double matrix `cal_data` whose data (of MATLAB type
+    /// `data_ty`) is `zeros` zero bytes while its tag claims them all: a decompression bomb.
+    fn bomb(rows: u32, cols: u32, data_ty: u32, zeros: usize) -> Vec<u8> {
+        let mut m = element(6, &[6, 0, 0, 0, 0, 0, 0, 0], None);
+        let dims: Vec<u8> = [rows, cols].iter().flat_map(|d| d.to_le_bytes()).collect();
+        m.extend(element(5, &dims, None));
+        m.extend(element(1, b"cal_data", None));
+        let mut data = data_ty.to_le_bytes().to_vec();
+        data.extend(u32::MAX.to_le_bytes());
+        data.extend(vec![0u8; zeros]);
+        m.extend(data);
+        let matrix = element(MI_MATRIX, &m, Some(u32::MAX));
+        let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::best());
+        z.write_all(&matrix).unwrap();
+        let packed = z.finish().unwrap();
+        let mut file = b"MATLAB 5.0 MAT-file, bomb".to_vec();
+        file.resize(124, b' ');
+        file.extend([0, 1, b'I', b'M']);
+        file.extend(element(MI_COMPRESSED, &packed, None));
+        file
+    }
+
+    #[test]
+    fn a_matrix_beyond_the_memory_budget_is_refused_before_it_is_inflated() {
+        // 85M x 6 zeros (the probe's 7.98 GB bomb, its data cut to 4 MB of zeros), and
+        // int8 data declared a 4000 x 6000 double matrix.
+        for (rows, cols, ty) in [(85_000_000, 6, 9), (4000, 6000, 1)] {
+            let file = bomb(rows, cols, ty, 4 << 20);
+            assert!(file.len() < 64 << 10, "{} bytes", file.len());
+            let e = read_mat(&file, "bomb.mat", "cal_data")
+                .err()
+                .expect("refused");
+            let text = format!("{e:?}");
+            assert!(text.contains("holds in memory (40 MiB)"), "{text}");
+            assert!(text.contains(&format!("is {rows} x {cols}")), "{text}");
+        }
+    }
+
+    #[test]
+    fn a_matrix_within_the_budget_is_inflated_no_further_than_its_dimensions() {
+        // 10 x 6 declared, 4 MB of zeros behind it: refused as damaged, not read whole.
+        let file = bomb(10, 6, 9, 4 << 20);
+        let e = read_mat(&file, "bomb.mat", "cal_data")
+            .err()
+            .expect("refused");
+        assert!(!format!("{e:?}").contains("memory"), "{e:?}");
+    }
 }

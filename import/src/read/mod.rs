@@ -55,14 +55,27 @@ impl LineSource {
     /// Reads the next line into `buf` (without its line break); `false` at the end.
     fn next_line(&mut self) -> Res<bool> {
         self.buf.clear();
-        let n = self
-            .r
+        let n = (&mut self.r)
+            .take(MAX_LINE as u64 + 1)
             .read_until(b'\n', &mut self.buf)
             .map_err(|e| io_error(&self.name, &e))?;
         if n == 0 {
             return Ok(false);
         }
         self.line += 1;
+        if n > MAX_LINE && self.buf.last() != Some(&b'\n') {
+            return Err(self.error(
+                0..1,
+                ErrorKind::Cell,
+                &format!(
+                    "line {} is longer than {} MiB (no line break): not a table of numbers",
+                    self.line,
+                    MAX_LINE >> 20
+                ),
+                "check the file (a binary file, or one whose line breaks were lost?) and \
+                 source.format",
+            ));
+        }
         while matches!(self.buf.last(), Some(b'\n' | b'\r')) {
             self.buf.pop();
         }
@@ -370,12 +383,29 @@ fn parse_cell(s: &LineSource, r: Range<usize>) -> Res<f64> {
         _ => Err(s.error(
             r,
             ErrorKind::Cell,
-            &format!("`{}` is not a number", String::from_utf8_lossy(raw)),
+            &format!("`{}` is not a number", snippet(raw)),
             "check source.skip_lines and source.header (a header or metadata line read as \
              data?) and source.delimiter",
         )),
     }
 }
+
+/// At most [`SNIPPET`] characters of `raw` for a diagnostic, `...` marking a cut.
+fn snippet(raw: &[u8]) -> String {
+    let text = String::from_utf8_lossy(&raw[..raw.len().min(4 * SNIPPET)]);
+    let mut out: String = text.chars().take(SNIPPET).collect();
+    if out.len() < raw.len() {
+        out.push_str("...");
+    }
+    out
+}
+
+/// The most characters of a cell a diagnostic quotes.
+const SNIPPET: usize = 40;
+
+/// The longest line a source may hold, bytes: a row of numbers is a few hundred; a file
+/// with no line break is refused at this length, never read whole.
+pub const MAX_LINE: usize = 1 << 20;
 
 fn unquote(t: &str) -> &str {
     t.strip_prefix('"')

@@ -244,7 +244,8 @@ pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> 
     };
     let mut text = ratecal_recording::manifest_yaml(&m).map_err(io)?;
     text.push_str(&provenance::yaml(&prov).map_err(|e| out_error(out, &e))?);
-    std::fs::write(stage.join("manifest.yaml"), text).map_err(io)?;
+    ratecal_recording::commit::write_nofollow(&stage.join("manifest.yaml"), text.as_bytes())
+        .map_err(io)?;
     if out.exists() {
         std::fs::remove_dir(out).map_err(io)?;
     }

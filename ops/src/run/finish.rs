@@ -246,7 +246,9 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
         .ok()?;
     let run_warnings = journal_warnings(dir);
     results.warnings.splice(0..0, run_warnings);
-    if let Err(e) = std::fs::write(dir.join(RESULTS), results.to_json()) {
+    if let Err(e) =
+        ratecal_recording::commit::write_nofollow(&dir.join(RESULTS), results.to_json().as_bytes())
+    {
         errln!("cannot write results.json: {e}");
         return None;
     }
@@ -277,7 +279,7 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
     outln!("results: {}", dir.join(RESULTS).display());
     // The checked plan beside the results lets `ratecal report` describe the process later.
     if let Ok(json) = serde_json::to_string_pretty(plan) {
-        let _ = std::fs::write(dir.join(PLAN), json);
+        let _ = ratecal_recording::commit::write_nofollow(&dir.join(PLAN), json.as_bytes());
     }
     let mut input = ratecal_render::ReportInput::from_run(
         &results,

@@ -71,7 +71,7 @@ impl Imports {
             if let Some(parent) = path.parent() {
                 std::fs::create_dir_all(parent)?;
             }
-            std::fs::write(path, text)?;
+            ratecal_recording::commit::write_nofollow(&path, text.as_bytes())?;
         }
         Ok(())
     }

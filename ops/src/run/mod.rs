@@ -299,9 +299,11 @@ fn prepare_new(args: &Request) -> Result<(Prepared, FolderLock), Report> {
             dir.display()
         ));
     }
-    std::fs::write(dir.join(PROCEDURE), &pr.text).map_err(io)?;
+    ratecal_recording::commit::write_nofollow(&dir.join(PROCEDURE), pr.text.as_bytes())
+        .map_err(io)?;
     pr.imports.save(&dir).map_err(io)?;
-    std::fs::write(dir.join(STATION), &st.yaml).map_err(io)?;
+    ratecal_recording::commit::write_nofollow(&dir.join(STATION), st.yaml.as_bytes())
+        .map_err(io)?;
     let facts = setup::RunFacts {
         dir: &dir,
         dry_run: args.dry_run || args.station.is_none(),

@@ -115,8 +115,11 @@ fn stage(dir: &Path) -> std::io::Result<PathBuf> {
     let pending = pending_dir(dir)?;
     for name in STAGED {
         let to = pending.join(name);
-        std::fs::copy(dir.join(name), &to)?;
-        std::fs::File::open(&to)?.sync_all()?;
+        // Streamed, never through a link planted in the pending folder.
+        let mut from = std::fs::File::open(dir.join(name))?;
+        let mut into = ratecal_recording::commit::open_nofollow(&to, true, false)?;
+        std::io::copy(&mut from, &mut into)?;
+        into.sync_all()?;
     }
     sync_dir(&pending)?;
     crash_point("after-stage");
@@ -141,7 +144,10 @@ pub fn commit_staged(dir: &Path) -> std::io::Result<()> {
     };
     let line = serde_json::to_string(&entry).map_err(std::io::Error::other)?;
     let journal = dir.join(PENDING_DIR).join(JOURNAL);
-    let mut f = std::fs::OpenOptions::new().append(true).open(&journal)?;
+    let mut f = ratecal_recording::commit::open_with_nofollow(
+        std::fs::OpenOptions::new().append(true),
+        &journal,
+    )?;
     std::io::Write::write_all(&mut f, format!("{line}\n").as_bytes())?;
     f.sync_all()?;
     commit(dir, &intent)

@@ -16,7 +16,6 @@ use crate::commit::crash_point;
 use crate::{FORMAT, ImuSample, Manifest, TableSample, WriteFailure, WrittenFile};
 use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
-use std::fs::{File, OpenOptions};
 use std::io;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
@@ -189,7 +188,7 @@ impl RecordingWriter {
         let mut table = Stream::create(&dir.join("table.csv"), &columns.table_header())?;
         imu.chained = chained;
         table.chained = chained;
-        let journal = File::create(dir.join("journal.jsonl"))?;
+        let journal = crate::commit::open_nofollow(&dir.join("journal.jsonl"), true, false)?;
         let mut manifest = manifest;
         manifest.format = FORMAT.to_string();
         let streams = Streams {
@@ -225,10 +224,7 @@ impl RecordingWriter {
         let (imu, imu_header, imu_cut) = open("imu.csv")?;
         let (table, table_header, table_cut) = open("table.csv")?;
         let columns = Columns::of_headers(&imu_header, &table_header);
-        let journal = OpenOptions::new()
-            .append(true)
-            .create(true)
-            .open(dir.join("journal.jsonl"))?;
+        let journal = crate::commit::open_nofollow(&dir.join("journal.jsonl"), false, true)?;
         let last = match (imu.last_t, table.last_t) {
             (Some(a), Some(b)) => Some(a.max(b)),
             (a, b) => a.or(b),

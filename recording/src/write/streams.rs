@@ -116,7 +116,7 @@ impl Stream {
     }
 
     pub(crate) fn create(path: &Path, header: &str) -> io::Result<Self> {
-        let file = File::create(path)?;
+        let file = crate::commit::open_nofollow(path, true, false)?;
         let mut s = Self::new(path, file, Sha256::new(), Chain::new(CHAIN_START, 0), 0);
         s.buf.extend_from_slice(header.as_bytes());
         s.buf.push(b'\n');
@@ -136,7 +136,8 @@ impl Stream {
     ) -> io::Result<(Self, String, u64)> {
         let check = check_stream(path, records.unwrap_or_default())?
             .map_err(|why| io::Error::new(io::ErrorKind::InvalidData, why))?;
-        let mut file = OpenOptions::new().read(true).write(true).open(path)?;
+        let mut file =
+            crate::commit::open_with_nofollow(OpenOptions::new().read(true).write(true), path)?;
         let header = first_line(&mut file)?;
         let (keep, cut) = if keep_tail {
             (check.size, 0)
