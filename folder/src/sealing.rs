@@ -109,10 +109,12 @@ pub fn write_files(
     if std::fs::symlink_metadata(dir.join(SEAL_FILE)).is_ok() {
         let report = crate::verify::verify_folder(dir, None)
             .map_err(|e| std::io::Error::other(e.to_string()))?;
-        if !report.intact() {
+        let names: Vec<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
+        let failing = crate::verify::failing_unless_replaced(&report, &names);
+        if report.checks.is_empty() || !failing.is_empty() {
             return Err(std::io::Error::new(
                 std::io::ErrorKind::InvalidData,
-                Refused::Altered(report.altered_names()),
+                Refused::Altered(failing.join(", ")),
             ));
         }
     }

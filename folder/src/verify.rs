@@ -2,7 +2,7 @@
 //! the refusal of a command that would publish from a folder that fails it; and what a
 //! folder that was never sealed is (its streams against the journal's running hash).
 
-use crate::hashes::VerifyReport;
+use crate::hashes::{FileCheck, Status, VerifyReport};
 use crate::names::{IMU, JOURNAL, MANIFEST, TABLE};
 use crate::names::{SEAL_FILE, SEAL_HASH_FILE};
 use crate::read::RunFolder;
@@ -52,6 +52,17 @@ pub fn verify_folder(
 /// its seal fails, or a ratecal run folder was never sealed. `Ok` for an intact folder and
 /// for a recording another system wrote (no seal, no `run` section in its manifest).
 pub fn require_intact(dir: &Path, command: &str) -> Result<(), miette::Report> {
+    require_intact_replacing(dir, command, &[])
+}
+
+/// [`require_intact`] of a folder into which files `replacing` are about to be written:
+/// an earlier addition's copy of one of them (an output, never a recorded input) may be
+/// missing or changed, since it is written again and nothing is computed from it.
+pub fn require_intact_replacing(
+    dir: &Path,
+    command: &str,
+    replacing: &[&str],
+) -> Result<(), miette::Report> {
     let sealed = std::fs::symlink_metadata(dir.join(SEAL_FILE)).is_ok();
     if !sealed {
         let ratecal_run = RunFolder::new(dir)
@@ -71,7 +82,8 @@ pub fn require_intact(dir: &Path, command: &str) -> Result<(), miette::Report> {
         ));
     }
     let report = verify_folder(dir, None)?;
-    if report.intact() {
+    let failing = failing_unless_replaced(&report, replacing);
+    if !report.checks.is_empty() && failing.is_empty() {
         return Ok(());
     }
     Err(miette::miette!(
@@ -82,8 +94,25 @@ pub fn require_intact(dir: &Path, command: &str) -> Result<(), miette::Report> {
         ),
         "{} fails its seal ({}): no {command} from it",
         dir.display(),
-        report.altered_names()
+        failing.join(", ")
     ))
+}
+
+/// The names of the checks of `report` that fail, but for an earlier addition's copy of a
+/// file in `replacing` that is missing or changed.
+pub fn failing_unless_replaced<'a>(report: &'a VerifyReport, replacing: &[&str]) -> Vec<&'a str> {
+    report
+        .altered()
+        .filter(|c| !replaced_now(c, replacing))
+        .map(|c| c.file.as_str())
+        .collect()
+}
+
+fn replaced_now(c: &FileCheck, names: &[&str]) -> bool {
+    let name = c.file.split(" (").next().unwrap_or(&c.file);
+    names.contains(&name)
+        && c.file.contains("(written by `")
+        && matches!(c.status, Status::Missing | Status::Altered { .. })
 }
 
 /// What a ratecal run folder without a seal is (docs/run-folders.md).

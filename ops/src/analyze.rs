@@ -55,7 +55,11 @@ pub fn analyze(args: &Request) -> u8 {
     let out_dir = args.out.as_deref().map(folder_of);
     if let Some(dir) = &out_dir
         && dir.join(ratecal_folder::names::SEAL_FILE).exists()
-        && let Err(e) = ratecal_folder::verify::require_intact(dir, "results written into it")
+        && let Err(e) = ratecal_folder::verify::require_intact_replacing(
+            dir,
+            "results written into it",
+            &[out_name(args.out.as_deref()).as_str()],
+        )
     {
         errln!("{e:?}");
         return 4;
@@ -255,4 +259,12 @@ pub fn verdict_lines(r: &Results) -> Vec<String> {
         .unwrap_or_default();
     out.push(format!("verdict: {}{why}", r.verdict.label()));
     out
+}
+
+/// The file name of an output path (empty without one): an earlier copy of it in a sealed
+/// folder is replaced, not read.
+pub(crate) fn out_name(out: Option<&std::path::Path>) -> String {
+    out.and_then(|p| p.file_name())
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default()
 }

@@ -41,7 +41,11 @@ pub fn report(args: &Request) -> u8 {
     // A folder whose seal fails (or a run never sealed) gets no report, and its seal no
     // addition (spec/cli.md: exit 4).
     if args.run_dir.is_dir()
-        && let Err(e) = ratecal_folder::verify::require_intact(&args.run_dir, "report")
+        && let Err(e) = ratecal_folder::verify::require_intact_replacing(
+            &args.run_dir,
+            "report",
+            &[crate::analyze::out_name(args.out.as_deref()).as_str()],
+        )
     {
         errln!("{e:?}");
         return 4;
