@@ -16,6 +16,9 @@ pub struct CheckReport {
     pub corrupted: Vec<String>,
     /// Index rows naming a file the store does not hold: `run_id path sha256`.
     pub missing: Vec<String>,
+    /// Index rows whose path leaves the run's folder (absolute, `..`, or empty): an export
+    /// or restore would write outside it. `run_id path`.
+    pub outside: Vec<String>,
     /// Stored files no run names (left by an interrupted add; harmless).
     pub unreferenced: usize,
     /// Unfinished writes left by an interrupted add (harmless).
@@ -27,7 +30,7 @@ pub struct CheckReport {
 impl CheckReport {
     /// Whether the archive is consistent.
     pub fn ok(&self) -> bool {
-        self.corrupted.is_empty() && self.missing.is_empty()
+        self.corrupted.is_empty() && self.missing.is_empty() && self.outside.is_empty()
     }
 
     /// A report for people.
@@ -38,6 +41,9 @@ impl CheckReport {
         }
         for m in &self.missing {
             s.push_str(&format!("! MISSING    {m}\n"));
+        }
+        for o in &self.outside {
+            s.push_str(&format!("! OUTSIDE    {o}: the path leaves the run's folder\n"));
         }
         s.push_str(&format!(
             "{} run(s), {} stored file(s) rehashed, {} unreferenced, {} unfinished write(s)\n",
@@ -91,6 +97,9 @@ impl Archive {
         let mut referenced = std::collections::HashSet::new();
         for (run, path, sha) in &rows {
             referenced.insert(sha.clone());
+            if leaves_folder(path) {
+                report.outside.push(format!("{run} {path:?}"));
+            }
             if !intact.contains(sha) && !corrupted.contains(sha) {
                 report.missing.push(format!("{run} {path} {sha}"));
             }
@@ -113,5 +122,27 @@ impl Archive {
             .await?;
         report.runs = n.0 as usize;
         Ok(report)
+    }
+}
+
+/// Whether an index row's `path` leaves its run's folder: only plain names below it stay.
+pub(crate) fn leaves_folder(path: &str) -> bool {
+    use std::path::Component;
+    let p = std::path::Path::new(path);
+    path.is_empty() || !p.components().all(|c| matches!(c, Component::Normal(_) | Component::CurDir))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::leaves_folder;
+
+    #[test]
+    fn only_plain_relative_paths_stay_in_the_folder() {
+        for ok in ["imu.csv", "figures/a.svg", "./imu.csv"] {
+            assert!(!leaves_folder(ok), "{ok}");
+        }
+        for bad in ["", "/etc/passwd", "../x", "a/../../b", "a/.."] {
+            assert!(leaves_folder(bad), "{bad}");
+        }
     }
 }

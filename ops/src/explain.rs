@@ -157,7 +157,7 @@ fn explain_or_exit(args: &Request) -> Result<u8, Exit> {
         ),
         false => None,
     };
-    let (mut x, twin) = compute(args, &rec)?;
+    let (mut x, twin, twin_failed) = compute(args, &rec)?;
     adopt(args, &mut x);
     let drafts = drafts(args, in_run, &mut x);
     let mut value = serde_json::to_value(&x).expect("plain data serializes");
@@ -205,6 +205,19 @@ fn explain_or_exit(args: &Request) -> Result<u8, Exit> {
         }
     };
     crate::console::out(format_args!("{out}"), false);
+    // The explanation is shown even when the corrected twin could not be written.
+    if let Some(why) = twin_failed {
+        let out = args.write_twin.as_deref().unwrap_or(Path::new(""));
+        let e = miette::miette!(
+            code = "explain::twin_not_written",
+            help = "the explanation above stands; fix what is named and run explain again \
+                    with --write-twin (or write the changes listed above by hand)",
+            "the corrected twin \"{}\" was not written: {why}",
+            out.display()
+        );
+        errln!("{e:?}");
+        return Err(2);
+    }
     Ok(match &twin {
         Some(r) => u8::from(r.needs_change),
         None => u8::from(!(x.findings.is_empty() && x.unexplained.is_empty())),
@@ -220,6 +233,7 @@ fn compute(
     (
         explain::Explanation,
         Option<ratecal_analysis::twin::TwinReport>,
+        Option<String>,
     ),
     Exit,
 > {
@@ -253,6 +267,7 @@ fn compute(
         errln!("{:?}", miette::Report::new(e));
         2
     })?;
+    let mut failed = None;
     if let (Some(f), Some(r)) = (&twin_file, &mut twin) {
         r.station = args
             .twin
@@ -260,10 +275,10 @@ fn compute(
             .map(|p| p.display().to_string())
             .unwrap_or_default();
         if let Some(out) = &args.write_twin {
-            write_twin(f, &x, r, out, &args.run)?;
+            failed = write_twin(f, &x, r, out, &args.run).err();
         }
     }
-    Ok((x, twin))
+    Ok((x, twin, failed))
 }
 
 /// The twin's station file, read and held against the manifest; its user effects join
@@ -287,32 +302,43 @@ fn twin_file(
 }
 
 /// Writes the corrected twin at `out` with the draft effects of discovered physics beside
-/// it (referenced from it), and records both in the report.
+/// it (referenced from it), and records both in the report; else why not (the draft
+/// effects it wrote are removed again, and the report names no file it did not write).
 fn write_twin(
     f: &crate::twin::TwinFile,
     x: &explain::Explanation,
     r: &mut ratecal_analysis::twin::TwinReport,
     out: &Path,
     run: &Path,
-) -> Result<(), Exit> {
+) -> Result<(), String> {
+    let before = r.changes.clone();
+    let undo = |r: &mut ratecal_analysis::twin::TwinReport| {
+        for c in &r.changes {
+            let new = before.iter().all(|b| b.defined_in != c.defined_in);
+            if let (true, Some(d)) = (new, &c.defined_in) {
+                std::fs::remove_file(d).ok();
+            }
+        }
+        r.changes = before.clone();
+    };
     if let Err(e) = crate::twin::write_drafts(x, &mut r.changes, out, run) {
-        errln!(
-            "error: cannot write the draft effect beside {}: {e}",
-            out.display()
-        );
-        return Err(2);
+        undo(r);
+        return Err(format!("the draft effect beside it cannot be written: {e}"));
     }
-    let (text, diff) = crate::twin::corrected(f, &r.changes, out).map_err(|e| {
-        errln!("error: cannot correct the twin: {e}");
-        2
-    })?;
-    ratecal_recording::commit::write_nofollow(out, text.as_bytes()).map_err(|e| {
-        errln!(
-            "error: cannot write the corrected twin {}: {e}",
-            out.display()
-        );
-        2
-    })?;
+    let corrected = crate::twin::corrected(f, &r.changes, out)
+        .map_err(|e| format!("the twin cannot be corrected: {e}"))
+        .and_then(|(text, diff)| {
+            ratecal_recording::commit::write_nofollow(out, text.as_bytes())
+                .map(|()| diff)
+                .map_err(|e| format!("{e}"))
+        });
+    let diff = match corrected {
+        Ok(d) => d,
+        Err(e) => {
+            undo(r);
+            return Err(e);
+        }
+    };
     r.written = Some(out.display().to_string());
     r.diff = Some(diff);
     Ok(())

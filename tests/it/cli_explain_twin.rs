@@ -550,3 +550,39 @@ fn twin_series_follow_the_recording(dir: &Path, v: &serde_json::Value) {
         }
     }
 }
+
+/// A corrected twin that cannot be written (here: its folder does not exist) costs the
+/// explanation nothing: it is printed whole, says nothing was written, and the command
+/// exits 2 naming why (issue 38: the report was suppressed).
+#[test]
+fn a_twin_that_cannot_be_written_leaves_the_explanation_shown() {
+    let Some(ex) = shared_example("standard-with-lever-arm") else {
+        return;
+    };
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    std::fs::write(
+        dir.join("twin.yaml"),
+        example_twin("effects: {}", "[-900 ppm, 700 ppm, 1100 ppm]"),
+    )
+    .unwrap();
+    let args = [
+        "explain",
+        ex.to_str().unwrap(),
+        "--twin",
+        "twin.yaml",
+        "--format",
+        "json",
+        "--write-twin",
+        "no-such-folder/fixed.yaml",
+    ];
+    let o = ratecal(&args, dir);
+    assert_eq!(code(&o), 2, "{}", text(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("the explanation");
+    assert!(!twin_changes(&v).is_empty(), "{v}");
+    assert!(v["twin"]["written"].is_null(), "{v}");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("was not written"), "{err}");
+    assert!(err.contains("help:"), "{err}");
+    assert!(!dir.join("no-such-folder").exists());
+}

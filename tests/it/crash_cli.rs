@@ -331,6 +331,9 @@ fn analyze_out_and_archive_add_stopped_leave_a_named_state() {
         );
         let o = ratecal(&["run", "--resume", "r"], tmp.path());
         assert!(text(&o).contains("nothing to resume"), "{}", text(&o));
+        // Finishing the interrupted change is a resume that succeeded (issue 38).
+        let want = if point == "before-seal-intent" { 1 } else { 0 };
+        assert_eq!(code(&o), want, "{point}: {}", text(&o));
         let o = ratecal(&["verify", "r"], tmp.path());
         assert_eq!(code(&o), 0, "{point}: {}", text(&o));
         assert_eq!(

@@ -360,6 +360,26 @@ fn map_mistakes_are_located_in_the_map() {
         "map.yaml:5:",
         &["is a unit of acceleration"],
     );
+    // A header name that names two columns is not guessed at (issue 38).
+    let data = session(|_, _| {}).replacen("gyr_z", "acc_y", 1);
+    refused(
+        &data,
+        MAP,
+        "map.yaml:4:",
+        &["column `acc_y` names 2 columns", "1, 5)", "index instead (e.g. `1`)"],
+    );
+    // A row with a cell no header column names is refused at that cell (issue 38); a
+    // trailing delimiter is not a cell.
+    let mut lines: Vec<String> = session(|_, _| {}).lines().map(String::from).collect();
+    lines[11].push_str(",7.5");
+    refused(
+        &(lines.join("\n") + "\n"),
+        MAP,
+        "data.csv:12:",
+        &["this row has 7 cells; the header names 6 columns"],
+    );
+    let trailing: String = session(|_, _| {}).lines().map(|l| format!("{l},\n")).collect();
+    assert_eq!(import(&trailing, MAP).0, 0);
     let m = MAP.replace("az: acc_z", "az: acc_zz");
     refused(
         &session(|_, _| {}),
@@ -429,4 +449,28 @@ fn turns_and_attitudes_are_written_to_the_manifest() {
     assert_eq!(s[2]["angle_deg"], -360.0);
     // No segment of a recording without a table is held by feedback.
     assert!(!text.contains("attitude: feedback"), "{text}");
+}
+
+/// A killed import's staging folder (`.OUT.import-PID`, its process gone) is removed by the
+/// next import into OUT; a live process's, and another output's, are left (issue 38).
+#[test]
+fn a_killed_imports_staging_folder_is_removed_by_the_next() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(tmp.path().join("data.csv"), session(|_, _| {})).unwrap();
+    std::fs::write(tmp.path().join("map.yaml"), MAP).unwrap();
+    // Above the kernel's largest pid: never a running process.
+    let dead = tmp.path().join(".run.import-4294967");
+    let live = tmp.path().join(".run.import-1");
+    let other = tmp.path().join(".other.import-4294967");
+    for d in [&dead, &live, &other] {
+        std::fs::create_dir_all(d).unwrap();
+        std::fs::write(d.join("imu.csv"), "t,ax\n").unwrap();
+    }
+    let o = ratecal(
+        &["import", "data.csv", "--map", "map.yaml", "--out", "run"],
+        tmp.path(),
+    );
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    assert!(!dead.exists(), "the dead import's staging folder is gone");
+    assert!(live.exists() && other.exists());
 }

@@ -217,6 +217,9 @@ impl Rows {
         }
         let mut slots = Vec::with_capacity(cols.len());
         for c in cols {
+            if let ColRef::Name(n) = &c.col {
+                ambiguous(&names, n, map, &c.at)?;
+            }
             let g = match &c.col {
                 ColRef::Index(i) => *i,
                 ColRef::Name(n) => names.iter().position(|h| h == n.trim()).ok_or_else(|| {
@@ -285,6 +288,9 @@ impl Rows {
         }
         if ended == Some(true) {
             return Ok(None);
+        }
+        for s in &self.sources {
+            extra_cells(s)?;
         }
         for (slot, &(k, c)) in self.local.iter().enumerate() {
             let s = &self.sources[k];
@@ -406,6 +412,61 @@ const SNIPPET: usize = 40;
 /// The longest line a source may hold, bytes: a row of numbers is a few hundred; a file
 /// with no line break is refused at this length, never read whole.
 pub const MAX_LINE: usize = 1 << 20;
+
+/// Refuses a row with more cells than its source's header names (empty ones from a
+/// trailing delimiter aside): its values belong to no column, and the row may be two run
+/// together or shifted.
+fn extra_cells(s: &LineSource) -> Res<()> {
+    let Some(w) = s.width else {
+        return Ok(());
+    };
+    let Some(first) = (s.cells.iter().skip(w)).find(|r| !s.buf[(*r).clone()].trim_ascii().is_empty())
+    else {
+        return Ok(());
+    };
+    let what = format!(
+        "this row has {} cells; the header names {w} columns",
+        s.cells.len()
+    );
+    Err(s.error(
+        first.clone(),
+        ErrorKind::Cell,
+        &what,
+        "every row has one cell per header column; check source.delimiter, or the line \
+         for two rows run together",
+    ))
+}
+
+/// Refuses a header name `n` that names more than one column: which one is meant is not
+/// the map's to guess.
+fn ambiguous(names: &[String], n: &str, map: &ImportMap, at: &Range<usize>) -> Res<()> {
+    let hits: Vec<String> = (names.iter().enumerate())
+        .filter(|(_, h)| *h == n.trim())
+        .map(|(i, _)| i.to_string())
+        .collect();
+    if hits.len() < 2 {
+        return Ok(());
+    }
+    Err(ImportError::in_text(
+        ErrorKind::Map,
+        &map.file,
+        &map.text,
+        at.clone(),
+        Say {
+            what: &format!(
+                "column `{n}` names {} columns of the sources' header (0-based {})",
+                hits.len(),
+                hits.join(", ")
+            ),
+            label: "more than one column",
+            help: &format!(
+                "name the column by its 0-based index instead (e.g. `{}`), or rename one in \
+                 the header",
+                hits[0]
+            ),
+        },
+    ))
+}
 
 fn unquote(t: &str) -> &str {
     t.strip_prefix('"')

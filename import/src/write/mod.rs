@@ -68,6 +68,32 @@ pub(crate) fn out_error(out: &Path, what: &str) -> Box<ImportError> {
     )
 }
 
+/// Removes the staging folders `.NAME.import-PID` that killed imports into `NAME` left in
+/// `parent` (their process gone): up to gigabytes no later import would otherwise remove.
+fn sweep_stale(parent: &Path, name: &str) {
+    let prefix = format!(".{name}.import-");
+    let Ok(entries) = std::fs::read_dir(parent) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let file = e.file_name();
+        let Some(pid) = file.to_str().and_then(|f| f.strip_prefix(&prefix)) else {
+            continue;
+        };
+        let is_dir = e.file_type().is_ok_and(|t| t.is_dir());
+        if is_dir && pid.parse::<u32>().is_ok() && !alive(pid) {
+            let _ = std::fs::remove_dir_all(e.path());
+        }
+    }
+}
+
+/// Whether process `pid` still runs (where the system says; elsewhere assumed so, and its
+/// staging folder kept).
+fn alive(pid: &str) -> bool {
+    let proc = Path::new("/proc");
+    !proc.join("self").exists() || proc.join(pid).exists()
+}
+
 /// Imports `sources` with `map` into the new recording folder `out`.
 pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> {
     if out.exists() {
@@ -83,6 +109,7 @@ pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> 
     let name = out
         .file_name()
         .map_or("import".into(), |n| n.to_string_lossy().into_owned());
+    sweep_stale(parent, &name);
     let stage = parent.join(format!(".{name}.import-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&stage);
     let mut guard = Staging(Some(stage.clone()));

@@ -135,6 +135,7 @@ fn run_or_resume(args: Request, display: Display) -> Result<u8, Report> {
                 crate::archive::after_run(args.archive.as_deref(), dir);
                 return Ok(code);
             }
+            (resume::Resume::Finished, _lock) => return Ok(0),
         },
         None => prepare_new(&args)?,
     };

@@ -37,6 +37,8 @@ pub enum Resume {
         /// Its status (`completed`, `aborted`, `failed`).
         status: String,
     },
+    /// An interrupted change was carried out and left the run sealed: nothing more to do.
+    Finished,
 }
 
 /// Finishes an interrupted change, then says what to do with the folder, holding its lock.
@@ -53,7 +55,9 @@ pub fn prepare(dir: &Path) -> Result<(Resume, FolderLock), Report> {
     }
     // Taken before the folder's state is read: a second resume is refused, not interleaved.
     let lock = ratecal_folder::lock::acquire(dir, &ratecal_folder::sealing::command_line())?;
-    match recover(dir).map_err(io)? {
+    let recovered = recover(dir).map_err(io)?;
+    let finished = matches!(recovered, Recovered::RolledForward(_));
+    match recovered {
         Recovered::Clean => {}
         Recovered::RolledBack => outln!(
             "{}: an interrupted resume left staged files; dropped (the sealed run is as it was)",
@@ -67,6 +71,13 @@ pub fn prepare(dir: &Path) -> Result<(Resume, FolderLock), Report> {
     }
     let state = state_of(dir);
     let resume = match state {
+        State::Sealed if finished => {
+            outln!(
+                "{}: the interrupted change is finished and the run is sealed: nothing to resume",
+                dir.display()
+            );
+            Resume::Finished
+        }
         State::Sealed => {
             return Err(miette!(
                 help = format!("`ratecal verify {}` checks it", dir.display()),
