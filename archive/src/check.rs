@@ -43,7 +43,9 @@ impl CheckReport {
             s.push_str(&format!("! MISSING    {m}\n"));
         }
         for o in &self.outside {
-            s.push_str(&format!("! OUTSIDE    {o}: the path leaves the run's folder\n"));
+            s.push_str(&format!(
+                "! OUTSIDE    {o}: the path leaves the run's folder\n"
+            ));
         }
         s.push_str(&format!(
             "{} run(s), {} stored file(s) rehashed, {} unreferenced, {} unfinished write(s)\n",
@@ -129,7 +131,10 @@ impl Archive {
 pub(crate) fn leaves_folder(path: &str) -> bool {
     use std::path::Component;
     let p = std::path::Path::new(path);
-    path.is_empty() || !p.components().all(|c| matches!(c, Component::Normal(_) | Component::CurDir))
+    path.is_empty()
+        || !p
+            .components()
+            .all(|c| matches!(c, Component::Normal(_) | Component::CurDir))
 }
 
 #[cfg(test)]

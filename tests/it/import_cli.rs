@@ -366,7 +366,11 @@ fn map_mistakes_are_located_in_the_map() {
         &data,
         MAP,
         "map.yaml:4:",
-        &["column `acc_y` names 2 columns", "1, 5)", "index instead (e.g. `1`)"],
+        &[
+            "column `acc_y` names 2 columns",
+            "1, 5)",
+            "index instead (e.g. `1`)",
+        ],
     );
     // A row with a cell no header column names is refused at that cell (issue 38); a
     // trailing delimiter is not a cell.
@@ -378,7 +382,10 @@ fn map_mistakes_are_located_in_the_map() {
         "data.csv:12:",
         &["this row has 7 cells; the header names 6 columns"],
     );
-    let trailing: String = session(|_, _| {}).lines().map(|l| format!("{l},\n")).collect();
+    let trailing: String = session(|_, _| {})
+        .lines()
+        .map(|l| format!("{l},\n"))
+        .collect();
     assert_eq!(import(&trailing, MAP).0, 0);
     let m = MAP.replace("az: acc_z", "az: acc_zz");
     refused(

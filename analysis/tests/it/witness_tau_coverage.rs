@@ -6,7 +6,7 @@
 //! `coverage_sweep` (ignored) is the full sweep of docs/validation.md:
 //! `cargo test --release -p ratecal-analysis --test it witness_tau_coverage:: -- --ignored
 //! --nocapture` (`TAU_SWEEP_SEEDS` seeds per case, 6 by default; `TAU_SWEEP_TAUS` and
-//! `TAU_SWEEP_BLOCKS`, comma-separated, to run a part).
+//! `TAU_SWEEP_BLOCKS`, comma-separated, to run a part; `TAU_SWEEP_VERBOSE` prints each run).
 
 use ratecal_analysis::explain::{self, Explanation, NominalModel, Options, Parameter};
 use ratecal_recording as recording;
@@ -29,6 +29,8 @@ struct Outcome {
     tau_z: f64,
     /// The largest |amplitude - truth| / u over the kept channels.
     amp_z: f64,
+    /// The reported tau_s and its u, s.
+    tau: (f64, f64),
 }
 
 fn explain_case(seed: u64, (tau, a): Case, block: Block) -> Explanation {
@@ -79,6 +81,7 @@ fn outcome(x: &Explanation, (tau, a): Case) -> Outcome {
         refined: true,
         tau_z: (value - tau).abs() / u,
         amp_z,
+        tau: (*value, *u),
     }
 }
 
@@ -132,10 +135,18 @@ fn sweep(
         let mut t = Tally::default();
         for amp in amplitudes {
             for seed in seeds.clone() {
-                t.add(outcome(
-                    &explain_case(seed, (tau, *amp), block),
-                    (tau, *amp),
-                ));
+                let o = outcome(&explain_case(seed, (tau, *amp), block), (tau, *amp));
+                if std::env::var_os("TAU_SWEEP_VERBOSE").is_some() {
+                    eprintln!(
+                        "  seed {seed} amplitude {:.3}: tau {:.1} ± {:.1} (z {:+.2}), amplitude z {:.2}",
+                        amp[0],
+                        o.tau.0,
+                        o.tau.1,
+                        (o.tau.0 - tau) / o.tau.1,
+                        o.amp_z
+                    );
+                }
+                t.add(o);
             }
         }
         let runs = amplitudes.len() * seeds.clone().count();
@@ -163,7 +174,10 @@ fn coverage_sweep() {
         "| gyro-bias block s | tau s | runs | decay found | with tau_s | tau within 3u \
          | amplitudes within 3u | worst tau z |"
     );
-    let taus = list("TAU_SWEEP_TAUS", &[100.0, 150.0, 200.0, 300.0, 450.0, 600.0, 900.0]);
+    let taus = list(
+        "TAU_SWEEP_TAUS",
+        &[100.0, 150.0, 200.0, 300.0, 450.0, 600.0, 900.0],
+    );
     for block in list("TAU_SWEEP_BLOCKS", &[300.0, 1200.0]) {
         sweep(block, &taus, &AMPLITUDES, 1..seeds + 1);
     }

@@ -420,7 +420,8 @@ fn extra_cells(s: &LineSource) -> Res<()> {
     let Some(w) = s.width else {
         return Ok(());
     };
-    let Some(first) = (s.cells.iter().skip(w)).find(|r| !s.buf[(*r).clone()].trim_ascii().is_empty())
+    let Some(first) =
+        (s.cells.iter().skip(w)).find(|r| !s.buf[(*r).clone()].trim_ascii().is_empty())
     else {
         return Ok(());
     };
