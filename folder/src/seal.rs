@@ -87,6 +87,9 @@ pub struct Addition {
     pub inputs: BTreeMap<String, String>,
 }
 
+/// An addition of a seal and its index among the additions.
+type Added<'a> = (usize, &'a Addition);
+
 /// Whether a path names the seal itself (never listed in it).
 pub fn is_seal_file(path: &str) -> bool {
     path == SEAL_FILE || path == SEAL_HASH_FILE
@@ -338,7 +341,7 @@ pub fn verify_hashes(
     );
     // The newest record of a file wins: a re-rendered report replaces the sealed one.
     let approved = parsed.approved_additions();
-    let mut expected: BTreeMap<&str, (&str, Option<(usize, &Addition)>)> = parsed
+    let mut expected: BTreeMap<&str, (&str, Option<Added>)> = parsed
         .files
         .iter()
         .map(|(p, h)| (p.as_str(), (h.as_str(), None)))
