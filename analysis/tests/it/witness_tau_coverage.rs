@@ -135,8 +135,14 @@ fn sweep(
         let mut t = Tally::default();
         for amp in amplitudes {
             for seed in seeds.clone() {
-                let o = outcome(&explain_case(seed, (tau, *amp), block), (tau, *amp));
+                let x = explain_case(seed, (tau, *amp), block);
+                let o = outcome(&x, (tau, *amp));
                 if std::env::var_os("TAU_SWEEP_VERBOSE").is_some() {
+                    let names: Vec<&str> = x.findings.iter().map(|f| f.effect.as_str()).collect();
+                    eprintln!(
+                        "  findings: {names:?}; unexplained: {}",
+                        x.unexplained.len()
+                    );
                     eprintln!(
                         "  seed {seed} amplitude {:.3}: tau {:.1} ± {:.1} (z {:+.2}), amplitude z {:.2}",
                         amp[0],
