@@ -5,7 +5,8 @@
 //!
 //! `coverage_sweep` (ignored) is the full sweep of docs/validation.md:
 //! `cargo test --release -p ratecal-analysis --test it witness_tau_coverage:: -- --ignored
-//! --nocapture` (`TAU_SWEEP_SEEDS` seeds per case, 6 by default).
+//! --nocapture` (`TAU_SWEEP_SEEDS` seeds per case, 6 by default; `TAU_SWEEP_TAUS` and
+//! `TAU_SWEEP_BLOCKS`, comma-separated, to run a part).
 
 use ratecal_analysis::explain::{self, Explanation, NominalModel, Options, Parameter};
 use ratecal_recording as recording;
@@ -162,10 +163,18 @@ fn coverage_sweep() {
         "| gyro-bias block s | tau s | runs | decay found | with tau_s | tau within 3u \
          | amplitudes within 3u | worst tau z |"
     );
-    let taus = [100.0, 150.0, 200.0, 300.0, 450.0, 600.0, 900.0];
-    for block in [300.0, 1200.0] {
+    let taus = list("TAU_SWEEP_TAUS", &[100.0, 150.0, 200.0, 300.0, 450.0, 600.0, 900.0]);
+    for block in list("TAU_SWEEP_BLOCKS", &[300.0, 1200.0]) {
         sweep(block, &taus, &AMPLITUDES, 1..seeds + 1);
     }
+}
+
+/// A comma-separated list of numbers from the environment variable `var`, else `default`.
+fn list(var: &str, default: &[f64]) -> Vec<f64> {
+    std::env::var(var)
+        .ok()
+        .map(|s| s.split(',').filter_map(|v| v.trim().parse().ok()).collect())
+        .unwrap_or_else(|| default.to_vec())
 }
 
 /// A debug-build share of the sweep: the standard recording, time constants from 150 s to
