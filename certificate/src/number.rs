@@ -205,11 +205,10 @@ pub(crate) async fn issue(
                         rec.number,
                         differs.join(", ")
                     ),
-                    format!(
-                        "a number stays bound to what was issued under it: reissue it with the \
-                         same options, or issue an amendment that replaces it: `--amend \
-                         --reason \"...\"`"
-                    ),
+                    "a number stays bound to what was issued under it: reissue it with the \
+                     same options, or issue an amendment that replaces it: `--amend \
+                     --reason \"...\"`"
+                        .into(),
                 ));
             }
             if rec.json_sha256.is_none() {

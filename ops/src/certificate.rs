@@ -62,7 +62,8 @@ pub fn certificate(args: &Request, format: Format, out: Option<&Path>) -> u8 {
 }
 
 /// `ratecal certificate verify FILE.pdf [--archive A]`: 0 when the archive issued exactly
-/// this PDF, 1 when not (never issued, or altered), 2 when the file cannot be read.
+/// this PDF, 1 when not (never issued, or altered) or when the file or the archive
+/// cannot be read.
 pub fn verify(pdf: &Path, archive: Option<&str>) -> u8 {
     let bytes = match std::fs::read(pdf) {
         Ok(b) => b,

@@ -163,7 +163,10 @@ fn coverage_sweep() {
         "| gyro-bias block s | tau s | runs | decay found | with tau_s | tau within 3u \
          | amplitudes within 3u | worst tau z |"
     );
-    let taus = list("TAU_SWEEP_TAUS", &[100.0, 150.0, 200.0, 300.0, 450.0, 600.0, 900.0]);
+    let taus = list(
+        "TAU_SWEEP_TAUS",
+        &[100.0, 150.0, 200.0, 300.0, 450.0, 600.0, 900.0],
+    );
     for block in list("TAU_SWEEP_BLOCKS", &[300.0, 1200.0]) {
         sweep(block, &taus, &AMPLITUDES, 1..seeds + 1);
     }
