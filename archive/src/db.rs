@@ -41,6 +41,13 @@ fn migrator() -> Migrator {
             include_str!("../migrations/0002_certificates.sql").into_sql_str(),
             false,
         ),
+        Migration::new(
+            3,
+            "certificate content".into(),
+            MigrationType::Simple,
+            include_str!("../migrations/0003_certificate_content.sql").into_sql_str(),
+            false,
+        ),
     ])
 }
 

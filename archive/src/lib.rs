@@ -28,7 +28,7 @@ mod text;
 pub mod trend;
 
 pub use add::Added;
-pub use certificate::Issued;
+pub use certificate::{Content, Issued, Reservation};
 pub use check::CheckReport;
 pub use dates::{days_from_iso, iso_date};
 pub use db::{Archive, Backend};

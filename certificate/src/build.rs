@@ -15,10 +15,12 @@ use ratecal_recording::Manifest;
 
 /// Everything a certificate is made of.
 pub struct Input<'a> {
-    /// The number issued (`PREFIX-YYYY-NNNNNN`) and the one it replaces.
-    pub number: String,
+    /// The number issued (`PREFIX-YYYY-NNNNNN`); `None` for a draft or a specimen.
+    pub number: Option<String>,
     /// The certificate it amends, if any.
     pub replaces: Option<String>,
+    /// Why it amends it.
+    pub amend_reason: Option<String>,
     /// Date of issue, YYYY-MM-DD.
     pub issue_date: String,
     /// The laboratory.
@@ -108,7 +110,8 @@ pub fn build(input: Input<'_>) -> Certificate {
     }
     if m.run.as_ref().is_some_and(|run| run.dry_run) {
         notes.push(
-            "Measured on the simulated station (a dry run): not a calibration of a real item."
+            "Measured on the simulated station (a dry run): a specimen, not a calibration of a \
+             real item; it takes no certificate number."
                 .into(),
         );
     }
@@ -170,7 +173,9 @@ pub fn build(input: Input<'_>) -> Certificate {
         format: FORMAT.into(),
         number: input.number,
         replaces: input.replaces,
+        amend_reason: input.amend_reason,
         draft: input.approval.is_none(),
+        specimen: m.run.as_ref().is_some_and(|run| run.dry_run),
         identification: Identification {
             customer: input.customer,
             order: input.order,

@@ -5,6 +5,8 @@
 //! the number taken from the archive's sequence (the same on reissue, the next with
 //! `amend`) and the approval taken from the seal.
 
+use crate::number::{self, Doc};
+pub use crate::number::{Format, Issued};
 use crate::{ApprovalBlock, Certificate, Input, Lab, StationId, render};
 use miette::{Diagnostic, NamedSource, SourceSpan};
 use ratecal_analysis::results::Results;
@@ -28,6 +30,8 @@ pub struct Request {
     pub archive: Option<String>,
     /// An amended certificate: a new number that names the one it replaces.
     pub amend: bool,
+    /// Why it is amended (required with `amend`), printed beside the replaced number.
+    pub reason: Option<String>,
     /// Issue although the table's calibration had expired (printed).
     pub allow_expired: bool,
     /// Issue although the station states no calibration of the table (printed).
@@ -182,7 +186,16 @@ pub fn lab_logo(lab_file: &Path, lab: &Lab) -> Option<render::Logo> {
     logo_kind(&lab_file.parent().unwrap_or(Path::new(".")).join(logo)).ok()
 }
 
-pub async fn issue(args: &Request) -> miette::Result<Certificate> {
+/// Issues the certificate of `args.run_dir` in `format`: a draft or a dry run's specimen
+/// without a number; otherwise the run's number when the content is the one issued under
+/// it, a new number (in the transaction that records the document) for a first issue or an
+/// amendment. `deliver` is handed the document before its number is recorded (to write it
+/// aside); an error from it releases the number.
+pub async fn issue(
+    args: &Request,
+    format: Format,
+    deliver: &mut dyn FnMut(&Certificate, &[u8]) -> miette::Result<()>,
+) -> miette::Result<Issued> {
     let dir = &args.run_dir;
     let lab = read_lab(&args.lab)?;
     let run = RunFolder::new(dir);
@@ -271,18 +284,6 @@ pub async fn issue(args: &Request) -> miette::Result<Certificate> {
             archive.location()
         ));
     }
-    let now = ratecal_recording::rfc3339(std::time::SystemTime::now());
-    let year: i32 = now[..4].parse().unwrap_or(1970);
-    let issued = archive
-        .certificate_number(
-            &folder.facts.id,
-            &lab.certificate_prefix,
-            year,
-            args.amend,
-            &now,
-        )
-        .await?;
-    archive.close().await;
     let approval = run.seal().and_then(|s| s.approval).map(|a| ApprovalBlock {
         signer: a.signer,
         role: a.role,
@@ -290,10 +291,13 @@ pub async fn issue(args: &Request) -> miette::Result<Certificate> {
         key_fingerprint: a.key_fingerprint,
     });
     let t = &station.table;
+    let template = lab_template(&args.lab, &lab)?;
+    let logo = lab_logo(&args.lab, &lab);
     let input = Input {
-        number: issued.number,
-        replaces: issued.replaces,
-        issue_date: issued.issued.chars().take(10).collect(),
+        number: None,
+        replaces: None,
+        amend_reason: None,
+        issue_date: String::new(),
         lab,
         customer: args.customer.clone(),
         order: args.order.clone(),
@@ -316,5 +320,13 @@ pub async fn issue(args: &Request) -> miette::Result<Certificate> {
         notes,
         approval,
     };
-    Ok(crate::build(input))
+    let doc = Doc {
+        base: crate::build(input),
+        template,
+        logo,
+        format,
+    };
+    let issued = number::issue(&archive, args, &folder.facts.id, &doc, deliver).await;
+    archive.close().await;
+    issued
 }

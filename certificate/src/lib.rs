@@ -15,6 +15,7 @@ mod build;
 mod conformity;
 pub mod issue;
 mod model;
+mod number;
 pub mod render;
 mod stated;
 pub mod units;
@@ -22,8 +23,9 @@ pub mod units;
 pub use build::{Input, build, gum_text};
 pub use model::{
     ApprovalBlock, Certificate, Conformity, ConformityCheck, END_MARK, FORMAT, Identification, Lab,
-    Method, ProcedureId, REPRODUCTION, ResultLine, StationId, Traceability,
+    Method, ProcedureId, REPRODUCTION, ResultLine, SPECIMEN, StationId, Traceability,
 };
+pub use number::{json, verify};
 /// The GUM budget, computed by the analysis (results.json `budgets`).
 pub use ratecal_analysis::budget;
 pub use ratecal_analysis::budget::{terms, type_a_dof};

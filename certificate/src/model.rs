@@ -35,12 +35,18 @@ pub struct Lab {
 pub struct Certificate {
     /// `ratecal-certificate/1`.
     pub format: String,
-    /// `PREFIX-YYYY-NNNNNN`.
-    pub number: String,
+    /// `PREFIX-YYYY-NNNNNN`; `None` for a draft or a dry run's specimen, which take no
+    /// number.
+    pub number: Option<String>,
     /// The number of the certificate this one amends and replaces.
     pub replaces: Option<String>,
+    /// Why it amends the one it replaces.
+    pub amend_reason: Option<String>,
     /// True until the run is approved (`ratecal approve`): every page says DRAFT.
     pub draft: bool,
+    /// True for a dry run (a simulated station): a specimen, "DRY RUN - SPECIMEN" on every
+    /// page.
+    pub specimen: bool,
     /// The laboratory.
     pub lab: Lab,
     /// Identification of the calibration.
@@ -222,6 +228,32 @@ pub struct ApprovalBlock {
     /// The approver's key fingerprint.
     pub key_fingerprint: String,
 }
+
+impl Certificate {
+    /// The number as printed: `DRAFT` or `SPECIMEN` when it has none.
+    pub fn number_text(&self) -> &str {
+        match &self.number {
+            Some(n) => n,
+            None if self.draft => "DRAFT",
+            None => "SPECIMEN",
+        }
+    }
+
+    /// The markings every page carries: `DRY RUN - SPECIMEN`, `DRAFT - not approved`.
+    pub fn markings(&self) -> Vec<&'static str> {
+        let mut m = Vec::new();
+        if self.specimen {
+            m.push(SPECIMEN);
+        }
+        if self.draft {
+            m.push("DRAFT - not approved");
+        }
+        m
+    }
+}
+
+/// The marking of a dry run's certificate.
+pub const SPECIMEN: &str = "DRY RUN - SPECIMEN";
 
 /// The sentence every certificate ends with.
 pub const REPRODUCTION: &str = "This certificate shall not be reproduced except in full \

@@ -60,10 +60,18 @@ fn flat(s: &str) -> String {
 }
 
 /// A MINI run in `dir/name` on `station`, approved (or not) and archived in `dir/archive`.
+/// Not a dry run: `station`'s drivers are the simulator's (virtual time, well under a
+/// second), but the run is recorded as a real one, so its certificate takes a number.
 fn mini(dir: &Path, name: &str, station: &str, approve: bool) -> PathBuf {
     std::fs::write(dir.join("s.yaml"), station).unwrap();
-    let o = mini_run(dir, name, &["--station", "s.yaml"]);
+    std::fs::write(dir.join("p.rcal"), support::MINI).unwrap();
+    let o = ratecal(
+        &["run", "p.rcal", "--station", "s.yaml", "--out", name],
+        dir,
+    );
     assert!(matches!(code(&o), 0 | 3), "{}", text(&o));
+    let manifest = std::fs::read_to_string(dir.join(name).join("manifest.yaml")).unwrap();
+    assert!(manifest.contains("dry_run: false"), "{manifest}");
     if approve {
         if !dir.join("keys/lab.key").exists() {
             let o = ratecal(&["key", "new", "keys"], dir);
@@ -107,7 +115,8 @@ fn json_of(o: &Output) -> serde_json::Value {
     serde_json::from_slice(&o.stdout).unwrap_or_else(|e| panic!("{e}: {}", text(o)))
 }
 
-/// The issue's proof: a dry run of `procedures/imu-2d-standard`, approved, archived, certified.
+/// The issue's proof: a run of `procedures/imu-2d-standard` on the simulated station (not a
+/// dry run: its certificate takes a number), approved, archived, certified.
 #[test]
 fn the_standard_procedure_gives_a_signed_certificate_whose_pdf_holds_every_element() {
     let procedure = support::procedures("imu-2d-standard");
@@ -146,15 +155,7 @@ fn full_flow(procedure: &str, text_of: Option<&str>, label: &str, step: &str, gy
         std::fs::write(dir.join(procedure), t).unwrap();
     }
     let o = ratecal(
-        &[
-            "run",
-            procedure,
-            "--dry-run",
-            "--station",
-            "s.yaml",
-            "--out",
-            "cal",
-        ],
+        &["run", procedure, "--station", "s.yaml", "--out", "cal"],
         dir,
     );
     assert!(matches!(code(&o), 0 | 3), "{}", text(&o));
@@ -218,11 +219,23 @@ fn full_flow(procedure: &str, text_of: Option<&str>, label: &str, step: &str, gy
             .all(|d| d.has(b"FontFile2") || d.has(b"FontFile3") || d.has(b"FontFile"))
     );
 
-    // Reissued: the same number; the JSON holds the stable keys.
+    // Reissued (the same customer and order: the content bound to the number): the same
+    // number; the JSON holds the stable keys.
     let year = &ratecal_recording::rfc3339(std::time::SystemTime::now())[..4];
     let number = format!("EICL-{year}-000001");
     let results = support::json(&dir.join("cal/results.json"));
-    let o = certificate(dir, "cal", &["--format", "json"]);
+    let o = certificate(
+        dir,
+        "cal",
+        &[
+            "--customer",
+            "ACME Avionics",
+            "--order",
+            "PO-4711",
+            "--format",
+            "json",
+        ],
+    );
     assert_eq!(code(&o), 0, "{}", text(&o));
     let j = json_of(&o);
     assert_eq!(j["number"], number.as_str());
@@ -689,11 +702,18 @@ fn concurrent_numbering(dir: &Path, archive: &str) {
         args.extend_from_slice(extra);
         ratecal(&args, dir)
     };
-    let o = cert(&["--format", "json", "--amend"]);
+    let o = cert(&[
+        "--format",
+        "json",
+        "--amend",
+        "--reason",
+        "the serial was misprinted",
+    ]);
     assert_eq!(code(&o), 0, "{}", text(&o));
     let j = json_of(&o);
     assert_eq!(j["number"], format!("EICL-{year}-000005").as_str());
     assert_eq!(j["replaces"], old.as_str());
+    assert_eq!(j["amend_reason"], "the serial was misprinted");
     let o = cert(&["--format", "md"]);
     let md = String::from_utf8_lossy(&o.stdout).to_string();
     assert!(
@@ -837,4 +857,291 @@ fn a_logo_that_cannot_be_read_is_refused_at_its_key() {
         let content = String::from_utf8_lossy(&doc.get_page_content(page).unwrap()).into_owned();
         assert!(content.contains("Do"), "page {n} never draws the logo");
     }
+}
+
+// -- issue 37 item 2: the number bound to its content ------------------------------------
+
+/// `PREFIX-YYYY-NNNNNN` of the example lab for sequence number `n`, this year.
+fn numbered(n: u32) -> String {
+    let year = &ratecal_recording::rfc3339(std::time::SystemTime::now())[..4];
+    format!("EICL-{year}-{n:06}")
+}
+
+/// `args` then `more`.
+fn with<'a>(args: &[&'a str], more: &[&'a str]) -> Vec<&'a str> {
+    [args, more].concat()
+}
+
+/// `ratecal certificate verify PDF --archive archive` in `dir`.
+fn verify_pdf(dir: &Path, pdf: &str) -> Output {
+    ratecal(&["certificate", "verify", pdf, "--archive", "archive"], dir)
+}
+
+/// The help of a diagnostic, read unwrapped (miette wraps long help lines).
+fn unwrapped(o: &Output) -> String {
+    flat(&text(o)).replace("- ", "-")
+}
+
+/// Approves `name` in `dir` with the key `keys/lab.key` (made when missing).
+fn approve(dir: &Path, name: &str) {
+    if !dir.join("keys/lab.key").exists() {
+        let o = ratecal(&["key", "new", "keys"], dir);
+        assert_eq!(code(&o), 0, "{}", text(&o));
+    }
+    let o = ratecal(
+        &[
+            "approve",
+            name,
+            "--signer",
+            "A. Metrologist",
+            "--role",
+            "Head of laboratory",
+            "--key",
+            "keys/lab.key",
+        ],
+        dir,
+    );
+    assert_eq!(code(&o), 0, "{}", text(&o));
+}
+
+#[test]
+fn an_identical_reissue_gets_the_same_number_and_a_byte_identical_pdf() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    mini(dir, "run", &certified_station("2099-12-31"), true);
+    let who = ["--customer", "ACME Avionics", "--order", "PO-4711"];
+    let o = certificate(dir, "run", &with(&who, &["--out", "first.pdf"]));
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    // Another format first, then the PDF again: the number and the bytes are the same.
+    let o = certificate(dir, "run", &with(&who, &["--format", "json"]));
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    assert_eq!(json_of(&o)["number"], numbered(1).as_str());
+    let o = certificate(dir, "run", &with(&who, &["--out", "again.pdf"]));
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    assert!(text(&o).contains("reissued"), "{}", text(&o));
+    let first = std::fs::read(dir.join("first.pdf")).unwrap();
+    let again = std::fs::read(dir.join("again.pdf")).unwrap();
+    assert!(first == again, "a reissue is not byte-identical");
+    // And it is the document the archive recorded under the number.
+    let o = verify_pdf(dir, "again.pdf");
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    assert!(text(&o).contains(&numbered(1)), "{}", text(&o));
+}
+
+#[test]
+fn other_content_under_an_issued_number_is_refused_with_help_naming_amend_and_reason() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    mini(dir, "run", &certified_station("2099-12-31"), true);
+    let who = ["--customer", "ACME Avionics", "--order", "PO-4711"];
+    let o = certificate(dir, "run", &with(&who, &["--out", "c.pdf"]));
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let others: [&[&str]; 3] = [
+        &["--customer", "Other Corp", "--order", "PO-4711"],
+        &["--customer", "ACME Avionics", "--order", "PO-9999"],
+        &[],
+    ];
+    for other in others {
+        let o = certificate(dir, "run", &with(other, &["--out", "other.pdf"]));
+        assert_eq!(code(&o), 1, "{other:?}: {}", text(&o));
+        let t = unwrapped(&o);
+        assert!(t.contains(&numbered(1)), "{t}");
+        assert!(t.contains("help"), "{t}");
+        assert!(t.contains("--amend --reason"), "{t}");
+        assert!(!dir.join("other.pdf").exists(), "{other:?} wrote a PDF");
+        assert!(!dir.join(".other.pdf.partial").exists());
+    }
+    // The number still belongs to what was issued under it.
+    let o = certificate(dir, "run", &with(&who, &["--format", "json"]));
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let j = json_of(&o);
+    assert_eq!(j["number"], numbered(1).as_str());
+    assert_eq!(j["identification"]["customer"], "ACME Avionics");
+}
+
+#[test]
+fn an_amendment_needs_a_reason_takes_a_new_number_and_names_the_one_it_replaces() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    mini(dir, "run", &certified_station("2099-12-31"), true);
+    let o = certificate(
+        dir,
+        "run",
+        &[
+            "--customer",
+            "ACME",
+            "--order",
+            "PO-1",
+            "--out",
+            "first.pdf",
+        ],
+    );
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let amended = ["--customer", "ACME Avionics", "--order", "PO-1"];
+    // No reason: refused, with help; nothing taken.
+    let o = certificate(
+        dir,
+        "run",
+        &with(&amended, &["--amend", "--format", "json"]),
+    );
+    assert_eq!(code(&o), 1, "{}", text(&o));
+    assert!(unwrapped(&o).contains("--amend --reason"), "{}", text(&o));
+    // A reason without --amend: a usage error.
+    let o = certificate(dir, "run", &with(&amended, &["--reason", "why"]));
+    assert_eq!(code(&o), 2, "{}", text(&o));
+    let reason = "customer name incomplete";
+    let o = certificate(
+        dir,
+        "run",
+        &with(
+            &amended,
+            &["--amend", "--reason", reason, "--out", "amended.pdf"],
+        ),
+    );
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    assert!(text(&o).contains(&numbered(2)), "{}", text(&o));
+    // Reissued: the amendment keeps its number, the one it replaces and its reason.
+    let o = certificate(dir, "run", &with(&amended, &["--format", "json"]));
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let j = json_of(&o);
+    assert_eq!(
+        j["number"],
+        numbered(2).as_str(),
+        "the refusal burned a number"
+    );
+    assert_eq!(j["replaces"], numbered(1).as_str());
+    assert_eq!(j["amend_reason"], reason);
+    let md = certificate(dir, "run", &with(&amended, &["--format", "md"]));
+    assert_eq!(code(&md), 0, "{}", text(&md));
+    let md = flat(&String::from_utf8_lossy(&md.stdout));
+    assert!(
+        md.contains(&format!(
+            "replaces certificate No. {} (reason: {reason})",
+            numbered(1)
+        )),
+        "{md}"
+    );
+    if let Some(pages) = pdf_pages(&std::fs::read(dir.join("amended.pdf")).unwrap()) {
+        let all = flat(&pages.join("\n"));
+        assert!(
+            all.contains(&format!("Certificate No. {}", numbered(2))),
+            "{all}"
+        );
+        assert!(all.contains(&numbered(1)) && all.contains(reason), "{all}");
+    }
+    // Both PDFs are the archive's; the first says it was replaced.
+    let o = verify_pdf(dir, "amended.pdf");
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let o = verify_pdf(dir, "first.pdf");
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    assert!(
+        text(&o).contains(&format!("replaced by certificate No. {}", numbered(2))),
+        "{}",
+        text(&o)
+    );
+}
+
+#[test]
+fn a_draft_and_a_dry_run_specimen_take_no_number() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let station = certified_station("2099-12-31");
+    // A draft: not approved.
+    mini(dir, "draft", &station, false);
+    let o = certificate(dir, "draft", &["--format", "json"]);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let j = json_of(&o);
+    assert!(j["number"].is_null(), "a draft took {}", j["number"]);
+    assert_eq!(j["draft"], true);
+    assert_eq!(j["specimen"], false);
+    let o = certificate(dir, "draft", &["--out", "draft.pdf"]);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    if let Some(pages) = pdf_pages(&std::fs::read(dir.join("draft.pdf")).unwrap()) {
+        for p in &pages {
+            assert!(flat(p).contains("Certificate No. DRAFT"), "{p}");
+        }
+    }
+    // A draft amends nothing.
+    let o = certificate(dir, "draft", &["--amend", "--reason", "why"]);
+    assert_eq!(code(&o), 1, "{}", text(&o));
+    assert!(unwrapped(&o).contains("help"), "{}", text(&o));
+
+    // A dry run, approved: a specimen, marked on every page, the first included.
+    let o = mini_run(dir, "dry", &["--station", "s.yaml"]);
+    assert!(matches!(code(&o), 0 | 3), "{}", text(&o));
+    approve(dir, "dry");
+    let o = ratecal(&["archive", "add", "dry", "--archive", "archive"], dir);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let o = certificate(dir, "dry", &["--format", "json"]);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let j = json_of(&o);
+    assert!(j["number"].is_null(), "a dry run took {}", j["number"]);
+    assert_eq!(j["specimen"], true);
+    assert_eq!(j["draft"], false);
+    let o = certificate(dir, "dry", &["--out", "dry.pdf"]);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    if let Some(pages) = pdf_pages(&std::fs::read(dir.join("dry.pdf")).unwrap()) {
+        for p in &pages {
+            assert!(flat(p).contains("DRY RUN - SPECIMEN"), "{p}");
+            assert!(!flat(p).contains("DRAFT"), "{p}");
+        }
+    }
+    // A dry run not approved carries both markings.
+    let o = mini_run(dir, "dry2", &["--station", "s.yaml"]);
+    assert!(matches!(code(&o), 0 | 3), "{}", text(&o));
+    let o = ratecal(&["archive", "add", "dry2", "--archive", "archive"], dir);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let o = certificate(dir, "dry2", &["--format", "md"]);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let md = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(
+        md.contains("DRY RUN - SPECIMEN") && md.contains("DRAFT - not approved"),
+        "{md}"
+    );
+
+    // Neither burned a number: the first approved real run takes the first.
+    mini(dir, "real", &station, true);
+    let o = certificate(dir, "real", &["--format", "json"]);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    assert_eq!(json_of(&o)["number"], numbered(1).as_str());
+}
+
+#[test]
+fn certificate_verify_accepts_an_issued_pdf_and_refuses_an_altered_copy() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    mini(dir, "run", &certified_station("2099-12-31"), true);
+    let o = certificate(dir, "run", &["--customer", "ACME", "--out", "c.pdf"]);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let o = verify_pdf(dir, "c.pdf");
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    assert!(text(&o).contains(&numbered(1)), "{}", text(&o));
+    assert!(text(&o).contains("unaltered"), "{}", text(&o));
+
+    let bytes = std::fs::read(dir.join("c.pdf")).unwrap();
+    // One byte changed in the middle of the file.
+    let mut altered = bytes.clone();
+    let mid = altered.len() / 2;
+    altered[mid] ^= 0x01;
+    std::fs::write(dir.join("altered.pdf"), &altered).unwrap();
+    // A line appended (as an incremental update would).
+    let mut appended = bytes.clone();
+    appended.extend_from_slice(b"\n% edited\n");
+    std::fs::write(dir.join("appended.pdf"), &appended).unwrap();
+    for name in ["altered.pdf", "appended.pdf"] {
+        let o = verify_pdf(dir, name);
+        assert_eq!(code(&o), 1, "{name}: {}", text(&o));
+        let t = unwrapped(&o);
+        assert!(t.contains("altered") && t.contains("help"), "{t}");
+    }
+    // A draft was never issued under a number: not the archive's.
+    mini(dir, "draft", &certified_station("2099-12-31"), false);
+    let o = certificate(dir, "draft", &["--out", "d.pdf"]);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let o = verify_pdf(dir, "d.pdf");
+    assert_eq!(code(&o), 1, "{}", text(&o));
+    // A file that is not there: exit 1 with help, no panic.
+    let o = verify_pdf(dir, "missing.pdf");
+    assert_eq!(code(&o), 1, "{}", text(&o));
+    assert!(unwrapped(&o).contains("help"), "{}", text(&o));
 }

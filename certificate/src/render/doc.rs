@@ -25,7 +25,7 @@ pub fn header(c: &Certificate) -> Vec<String> {
         c.lab.name.clone(),
         c.lab.address.replace('\n', ", ").trim().to_string(),
         c.lab.accreditation.clone(),
-        format!("Certificate No. {}", c.number),
+        format!("Certificate No. {}", c.number_text()),
     ]
 }
 
@@ -58,11 +58,22 @@ fn or_not_stated(v: &Option<String>) -> String {
 pub fn blocks(c: &Certificate) -> Vec<Block> {
     let id = &c.identification;
     let mut b = vec![Block::Heading("Calibration certificate".into())];
-    b.push(Block::Para(format!("Certificate No. {}", c.number)));
+    b.push(Block::Para(format!("Certificate No. {}", c.number_text())));
     if let Some(r) = &c.replaces {
         b.push(Block::Para(format!(
-            "This certificate amends and replaces certificate No. {r}."
+            "This certificate amends and replaces certificate No. {r}{}.",
+            c.amend_reason
+                .as_ref()
+                .map(|why| format!(" (reason: {why})"))
+                .unwrap_or_default()
         )));
+    }
+    if c.specimen {
+        b.push(Block::Para(
+            "DRY RUN - SPECIMEN: measured on a simulated station; not a calibration of a real \
+             item and not a valid certificate."
+                .into(),
+        ));
     }
     if c.draft {
         b.push(Block::Para(
@@ -282,6 +293,6 @@ pub fn blocks(c: &Certificate) -> Vec<Block> {
         ));
     }
     b.push(Block::Para(REPRODUCTION.into()));
-    b.push(Block::Para(format!("{END_MARK} {}", c.number)));
+    b.push(Block::Para(format!("{END_MARK} {}", c.number_text())));
     b
 }

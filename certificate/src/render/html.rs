@@ -23,10 +23,10 @@ dt{font-weight:bold;float:left;clear:left;width:12em}dd{margin-left:13em}";
 pub fn html(c: &Certificate) -> String {
     let mut s = format!(
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>Certificate No. {}</title><style>{CSS}</style></head><body>\n<header>",
-        esc(&c.number)
+        esc(c.number_text())
     );
-    if c.draft {
-        s.push_str("<div class=\"draft\">DRAFT</div>");
+    for m in c.markings() {
+        s.push_str(&format!("<div class=\"draft\">{m}</div>"));
     }
     for line in header(c) {
         s.push_str(&format!("<div>{}</div>", esc(&line)));

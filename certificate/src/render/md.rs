@@ -31,8 +31,8 @@ fn cell(s: &str) -> String {
 /// Renders Markdown: the page header once at the top, then the blocks.
 pub fn markdown(c: &Certificate) -> String {
     let mut s = String::new();
-    if c.draft {
-        s.push_str("**DRAFT**\n\n");
+    for m in c.markings() {
+        s.push_str(&format!("**{m}**\n\n"));
     }
     for line in header(c) {
         s.push_str(&format!("{}  \n", esc(&line)));

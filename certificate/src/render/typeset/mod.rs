@@ -94,7 +94,11 @@ fn typeset(
     let standards = PdfStandards::new(&[PdfStandard::A_2b])
         .map_err(|e| TemplateError::internal(format!("{e:?}")))?;
     let options = PdfOptions {
-        ident: Smart::Custom(format!("{}/{}", c.identification.archive_id, c.number)),
+        ident: Smart::Custom(format!(
+            "{}/{}",
+            c.identification.archive_id,
+            c.number_text()
+        )),
         creator: Smart::Custom(Some("ratecal".into())),
         timestamp: Some(Timestamp::new_utc(date)),
         standards,
