@@ -322,6 +322,23 @@ site: { latitude_deg: 49.57, gravity_mps2: 9.8096 }
         &["time goes backwards"],
     );
     refused(&timed(100, 1.0), map, "data.csv:102:1", &["time repeats"]);
+    // Microseconds declared as milliseconds: 100 Hz becomes 0.1 Hz, refused after the
+    // first 64 samples, at the 64th (issue 38).
+    let us: String = timed(usize::MAX, 0.0)
+        .lines()
+        .enumerate()
+        .map(|(i, l)| match i {
+            0 => format!("{l}\n"),
+            _ => format!("{}{}\n", (i - 1) * 10_000, &l[l.find(',').unwrap()..]),
+        })
+        .collect();
+    let ms = map.replace("unit: s", "unit: ms");
+    refused(
+        &us,
+        &ms,
+        "data.csv:65:1",
+        &["0.1000 Hz over the first 64 samples", "imu.time's unit"],
+    );
 }
 
 #[test]

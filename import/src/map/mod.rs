@@ -9,7 +9,7 @@ mod segments;
 mod table;
 mod units;
 
-pub use resolve::load_map;
+pub use resolve::{MAX_RATE_HZ, MIN_RATE_HZ, load_map};
 pub use table::TableFeed;
 pub use units::{scale_of, seconds_per};
 

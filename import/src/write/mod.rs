@@ -94,6 +94,30 @@ fn alive(pid: &str) -> bool {
     !proc.join("self").exists() || proc.join(pid).exists()
 }
 
+/// Samples after which a time column's implied sampling rate is checked.
+const RATE_PROBE: u64 = 64;
+
+/// Refuses a time column whose first [`RATE_PROBE`] samples (from `t0` to `t`, s) imply no
+/// IMU's sampling rate: a unit slip (microseconds declared as milliseconds makes a pose
+/// held for hours), caught before more rows are written.
+fn implied_rate(rows: &Rows, t0: f64, t: f64) -> Res<()> {
+    use crate::map::{MAX_RATE_HZ, MIN_RATE_HZ};
+    let rate = (RATE_PROBE - 1) as f64 / (t - t0);
+    if (MIN_RATE_HZ..=MAX_RATE_HZ).contains(&rate) {
+        return Ok(());
+    }
+    Err(rows.cell_error(
+        6,
+        ErrorKind::Time,
+        &format!(
+            "the time column gives {rate:.4} Hz over the first {RATE_PROBE} samples: no \
+             IMU's sampling rate (between {MIN_RATE_HZ} Hz and {MAX_RATE_HZ} Hz)"
+        ),
+        "check imu.time's unit (s, ms or us): a unit 1000 times too large or too small \
+         makes the span of the recording absurd",
+    ))
+}
+
 /// Imports `sources` with `map` into the new recording folder `out`.
 pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> {
     if out.exists() {
@@ -131,6 +155,7 @@ pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> 
     let mut all = Stretch::default();
     let mut cells = [0f64; 7];
     let mut last_t: Option<f64> = None;
+    let mut first_t: Option<f64> = None;
     let (a, g) = (&map.accel, &map.gyro);
     while let Some(at) = rows.next(&mut cells)? {
         let t = match &map.time {
@@ -156,6 +181,12 @@ pub fn import(sources: &[PathBuf], map: &ImportMap, out: &Path) -> Res<Summary> 
             }
         };
         last_t = Some(t);
+        if let TimeSpec::Column { .. } = &map.time {
+            first_t.get_or_insert(t);
+            if at.sample + 1 == RATE_PROBE {
+                implied_rate(&rows, first_t.unwrap_or(t), t)?;
+            }
+        }
         let s_f: [f64; 3] = std::array::from_fn(|k| (cells[k] - a.zero[k]) * a.factor);
         let s_w: [f64; 3] = std::array::from_fn(|k| (cells[3 + k] - g.zero[k]) * g.factor);
         let f: [f64; 3] = std::array::from_fn(|b| map.axes[b].1 * s_f[map.axes[b].0]);
