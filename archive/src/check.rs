@@ -16,8 +16,8 @@ pub struct CheckReport {
     pub corrupted: Vec<String>,
     /// Index rows naming a file the store does not hold: `run_id path sha256`.
     pub missing: Vec<String>,
-    /// Index rows whose path leaves the run's folder (absolute, `..`, or empty): an export
-    /// or restore would write outside it. `run_id path`.
+    /// Index rows whose path is not a plain relative path in the run's folder (absolute,
+    /// `..`, `.` or empty): an export would write outside it, or refuses it. `run_id path`.
     pub outside: Vec<String>,
     /// Stored files no run names (left by an interrupted add; harmless).
     pub unreferenced: usize,
@@ -127,14 +127,12 @@ impl Archive {
     }
 }
 
-/// Whether an index row's `path` leaves its run's folder: only plain names below it stay.
+/// Whether an index row's `path` is not a plain relative path inside its run's folder
+/// (empty, absolute, `.` or `..` in it): `check` names it and `export` never writes it.
 pub(crate) fn leaves_folder(path: &str) -> bool {
     use std::path::Component;
     let p = std::path::Path::new(path);
-    path.is_empty()
-        || !p
-            .components()
-            .all(|c| matches!(c, Component::Normal(_) | Component::CurDir))
+    path.is_empty() || p.components().any(|c| !matches!(c, Component::Normal(_)))
 }
 
 #[cfg(test)]
@@ -143,10 +141,12 @@ mod tests {
 
     #[test]
     fn only_plain_relative_paths_stay_in_the_folder() {
-        for ok in ["imu.csv", "figures/a.svg", "./imu.csv"] {
+        for ok in ["imu.csv", "figures/a.svg"] {
             assert!(!leaves_folder(ok), "{ok}");
         }
-        for bad in ["", "/etc/passwd", "../x", "a/../../b", "a/.."] {
+        // `./imu.csv` stays in the folder, but no index row ratecal writes has it: export
+        // has always refused it, and check names it with the others.
+        for bad in ["", "/etc/passwd", "../x", "a/../../b", "a/..", "./imu.csv"] {
             assert!(leaves_folder(bad), "{bad}");
         }
     }

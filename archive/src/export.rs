@@ -2,7 +2,7 @@
 
 use crate::{Archive, ArchiveError, Result};
 use ratecal_folder::hashes::sha256_hex;
-use std::path::{Component, Path};
+use std::path::Path;
 
 impl Archive {
     /// Writes run `key`'s files into `dest` (new or empty); returns the id and file count.
@@ -18,7 +18,7 @@ impl Archive {
         for f in &files {
             let rel = Path::new(&f.path);
             // Paths come from the index; never write outside the destination.
-            if rel.components().any(|c| !matches!(c, Component::Normal(_))) {
+            if crate::check::leaves_folder(&f.path) {
                 return Err(ArchiveError::Io {
                     path: rel.to_path_buf(),
                     message: "stored path leaves the run folder".into(),

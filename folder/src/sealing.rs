@@ -110,11 +110,10 @@ pub fn write_files(
         let report = crate::verify::verify_folder(dir, None)
             .map_err(|e| std::io::Error::other(e.to_string()))?;
         let names: Vec<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
-        let failing = crate::verify::failing_unless_replaced(&report, &names);
-        if report.checks.is_empty() || !failing.is_empty() {
+        if let Some(failing) = crate::verify::fails_seal(&report, &names) {
             return Err(std::io::Error::new(
                 std::io::ErrorKind::InvalidData,
-                Refused::Altered(failing.join(", ")),
+                Refused::Altered(failing),
             ));
         }
     }

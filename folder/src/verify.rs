@@ -82,10 +82,9 @@ pub fn require_intact_replacing(
         ));
     }
     let report = verify_folder(dir, None)?;
-    let failing = failing_unless_replaced(&report, replacing);
-    if !report.checks.is_empty() && failing.is_empty() {
+    let Some(failing) = fails_seal(&report, replacing) else {
         return Ok(());
-    }
+    };
     Err(miette::miette!(
         code = "verify::altered",
         help = format!(
@@ -94,18 +93,19 @@ pub fn require_intact_replacing(
         ),
         "{} fails its seal ({}): no {command} from it",
         dir.display(),
-        failing.join(", ")
+        failing
     ))
 }
 
-/// The names of the checks of `report` that fail, but for an earlier addition's copy of a
-/// file in `replacing` that is missing or changed.
-pub fn failing_unless_replaced<'a>(report: &'a VerifyReport, replacing: &[&str]) -> Vec<&'a str> {
-    report
-        .altered()
+/// What fails the seal in `report` (the files, comma-separated), but for an earlier
+/// addition's copy of a file in `replacing` that is missing or changed; `None` when the
+/// folder is intact (and something was checked).
+pub fn fails_seal(report: &VerifyReport, replacing: &[&str]) -> Option<String> {
+    let failing: Vec<&str> = (report.altered())
         .filter(|c| !replaced_now(c, replacing))
         .map(|c| c.file.as_str())
-        .collect()
+        .collect();
+    (report.checks.is_empty() || !failing.is_empty()).then(|| failing.join(", "))
 }
 
 fn replaced_now(c: &FileCheck, names: &[&str]) -> bool {

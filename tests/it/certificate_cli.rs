@@ -62,7 +62,7 @@ fn flat(s: &str) -> String {
 /// A MINI run in `dir/name` on `station`, approved (or not) and archived in `dir/archive`.
 /// Not a dry run: `station`'s drivers are the simulator's (virtual time, well under a
 /// second), but the run is recorded as a real one, so its certificate takes a number.
-fn mini(dir: &Path, name: &str, station: &str, approve: bool) -> PathBuf {
+fn mini(dir: &Path, name: &str, station: &str, approved: bool) -> PathBuf {
     std::fs::write(dir.join("s.yaml"), station).unwrap();
     std::fs::write(dir.join("p.rcal"), support::MINI).unwrap();
     let o = ratecal(
@@ -72,25 +72,8 @@ fn mini(dir: &Path, name: &str, station: &str, approve: bool) -> PathBuf {
     assert!(matches!(code(&o), 0 | 3), "{}", text(&o));
     let manifest = std::fs::read_to_string(dir.join(name).join("manifest.yaml")).unwrap();
     assert!(manifest.contains("dry_run: false"), "{manifest}");
-    if approve {
-        if !dir.join("keys/lab.key").exists() {
-            let o = ratecal(&["key", "new", "keys"], dir);
-            assert_eq!(code(&o), 0, "{}", text(&o));
-        }
-        let o = ratecal(
-            &[
-                "approve",
-                name,
-                "--signer",
-                "A. Metrologist",
-                "--role",
-                "Head of laboratory",
-                "--key",
-                "keys/lab.key",
-            ],
-            dir,
-        );
-        assert_eq!(code(&o), 0, "{}", text(&o));
+    if approved {
+        approve(dir, name);
     }
     let o = ratecal(&["archive", "add", name, "--archive", "archive"], dir);
     assert_eq!(code(&o), 0, "{}", text(&o));
@@ -159,22 +142,7 @@ fn full_flow(procedure: &str, text_of: Option<&str>, label: &str, step: &str, gy
         dir,
     );
     assert!(matches!(code(&o), 0 | 3), "{}", text(&o));
-    let o = ratecal(&["key", "new", "keys"], dir);
-    assert_eq!(code(&o), 0, "{}", text(&o));
-    let o = ratecal(
-        &[
-            "approve",
-            "cal",
-            "--signer",
-            "A. Metrologist",
-            "--role",
-            "Head of laboratory",
-            "--key",
-            "keys/lab.key",
-        ],
-        dir,
-    );
-    assert_eq!(code(&o), 0, "{}", text(&o));
+    approve(dir, "cal");
     let o = ratecal(&["verify", "cal"], dir);
     assert_eq!(code(&o), 0, "{}", text(&o));
     assert!(

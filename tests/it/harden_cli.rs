@@ -6,6 +6,18 @@ use crate::support;
 use std::path::Path;
 use support::*;
 
+/// `approve r` with the key `keys/lab.key`.
+const APPROVE: &[&str] = &[
+    "approve",
+    "r",
+    "--signer",
+    "A. M",
+    "--role",
+    "Head",
+    "--key",
+    "keys/lab.key",
+];
+
 /// A sealed MINI run in `tmp/r`.
 fn sealed_run(tmp: &Path) -> std::path::PathBuf {
     let o = mini_run(tmp, "r", &[]);
@@ -35,16 +47,7 @@ fn planted_links_in_a_run_folder_are_never_written_through() {
         &["analyze", "r", "--out", "r/results.json"],
         &["report", "r", "--out", "r/again.md"],
         &["explain", "r"],
-        &[
-            "approve",
-            "r",
-            "--signer",
-            "A. M",
-            "--role",
-            "Head",
-            "--key",
-            "keys/lab.key",
-        ],
+        APPROVE,
     ];
     for args in commands {
         // The lock a link to an existing file, then a dangling one.
@@ -245,21 +248,7 @@ fn results_written_into_a_sealed_folder_are_bound_to_what_the_seal_holds() {
 fn an_approval_survives_later_additions() {
     let tmp = tempfile::tempdir().unwrap();
     sealed_run(tmp.path());
-    let approve = |t: &Path| {
-        ratecal(
-            &[
-                "approve",
-                "r",
-                "--signer",
-                "A. M",
-                "--role",
-                "Head",
-                "--key",
-                "keys/lab.key",
-            ],
-            t,
-        )
-    };
+    let approve = |t: &Path| ratecal(APPROVE, t);
     let o = ratecal(&["key", "new", "keys"], tmp.path());
     assert_eq!(code(&o), 0, "{}", text(&o));
     let o = approve(tmp.path());
