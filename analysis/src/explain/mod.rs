@@ -224,7 +224,14 @@ pub(crate) fn explain_fitted(
     // What the registry left: forms of the probe library, found one at a time.
     let registry_terms = terms.clone();
     let mut lib_refused = Vec::new();
-    let mut discoveries = discover::discover(data, &mut terms, opts.alpha, &mut lib_refused);
+    let mut discoveries = Vec::new();
+    discover::discover(
+        data,
+        &mut terms,
+        opts.alpha,
+        &mut lib_refused,
+        &mut discoveries,
+    );
     if !discoveries.is_empty() {
         // The registry's selection again beside what was found: a strong unlisted form can
         // hide the Earth's rate (or a registry effect) from the held-out segments, and a
@@ -248,12 +255,14 @@ pub(crate) fn explain_fitted(
             again.effects.push(step.effect);
         }
         held = earth::hold(data, &mut again, latitude);
-        discoveries.extend(discover::discover(
+        discover::discover(
             data,
             &mut again,
             opts.alpha,
             &mut lib_refused,
-        ));
+            &mut discoveries,
+        );
+        discover::refine_again(data, &again, &mut discoveries);
         terms = again;
     }
     refused.extend(lib_refused);

@@ -6,7 +6,7 @@
 //! `coverage_sweep` (ignored) is the full sweep of docs/validation.md:
 //! `cargo test --release -p ratecal-analysis --test it witness_tau_coverage:: -- --ignored
 //! --nocapture` (`TAU_SWEEP_SEEDS` seeds per case, 6 by default; `TAU_SWEEP_TAUS` and
-//! `TAU_SWEEP_BLOCKS`, comma-separated, to run a part; `TAU_SWEEP_VERBOSE` prints each run).
+//! `TAU_SWEEP_BLOCKS`, comma-separated, to run a part; `TAU_SWEEP_VERBOSE` prints each run, `TAU_SWEEP_DUMP=DIR` writes each explanation there).
 
 use ratecal_analysis::explain::{self, Explanation, NominalModel, Options, Parameter};
 use ratecal_recording as recording;
@@ -42,8 +42,12 @@ fn explain_case(seed: u64, (tau, a): Case, block: Block) -> Explanation {
     });
     s.thermal.rise_c = 0.0;
     let dir = tempfile::tempdir().unwrap();
-    write(dir.path(), &s).unwrap();
-    let rec = recording::read(dir.path()).unwrap();
+    let path = match std::env::var_os("TAU_SWEEP_DUMP") {
+        Some(d) => std::path::Path::new(&d).join(format!("tau{tau:.0}-a{:.3}-seed{seed}", a[0])),
+        None => dir.path().to_path_buf(),
+    };
+    write(&path, &s).unwrap();
+    let rec = recording::read(&path).unwrap();
     explain::explain(&rec, &NominalModel::seed(), &Options::default())
 }
 
@@ -73,6 +77,12 @@ fn outcome(x: &Explanation, (tau, a): Case) -> Outcome {
         .map(|t| {
             let i = ["gx", "gy", "gz"].iter().position(|c| *c == t.channel);
             let truth = a[i.unwrap()] * 3600.0 * (-t0_of(&t.expression) / tau).exp();
+            if std::env::var_os("TAU_SWEEP_VERBOSE").is_some() {
+                eprintln!(
+                    "    {}: amplitude {:.2} ± {:.2}, truth {truth:.2}",
+                    t.channel, t.value, t.u
+                );
+            }
             (t.value - truth).abs() / t.u
         })
         .fold(0.0, f64::max);
@@ -137,6 +147,11 @@ fn sweep(
             for seed in seeds.clone() {
                 let x = explain_case(seed, (tau, *amp), block);
                 let o = outcome(&x, (tau, *amp));
+                if let Some(dir) = std::env::var_os("TAU_SWEEP_DUMP") {
+                    let path = std::path::Path::new(&dir)
+                        .join(format!("tau{tau:.0}-a{:.3}-seed{seed}.json", amp[0]));
+                    std::fs::write(path, serde_json::to_string_pretty(&x).unwrap()).unwrap();
+                }
                 if std::env::var_os("TAU_SWEEP_VERBOSE").is_some() {
                     let names: Vec<&str> = x.findings.iter().map(|f| f.effect.as_str()).collect();
                     eprintln!(

@@ -159,15 +159,16 @@ pub(crate) fn discover(
     terms: &mut Terms,
     alpha: f64,
     refused: &mut Vec<Refused>,
-) -> Vec<Discovery> {
+    out: &mut Vec<Discovery>,
+) {
     use rayon::prelude::*;
     let work = data.working();
     let n: usize = work.iter().map(|&i| 6 * data.accs[i].n).sum();
     let m = live_columns(data, terms) as f64;
     let a = alpha / m;
     let debug = std::env::var_os("RATECAL_EXPLAIN_DEBUG").is_some();
-    let mut out: Vec<Discovery> = Vec::new();
-    while out.len() < MOST {
+    let first = out.len();
+    while out.len() - first < MOST {
         let (base, _) = fit(data, terms, &work, &work);
         let short = super::select::screen(data, terms, &work, SHORTLIST);
         let tries: Vec<Try> = short
@@ -175,6 +176,7 @@ pub(crate) fn discover(
             .map(|&e| try_probe(data, terms, e, &base))
             .collect();
         let sig = |chi2: f64| p_value(chi2, 1) < a;
+        let sig_dof = |chi2: f64, dof: usize| p_value(chi2, dof) < a;
         // Each channel's largest misfit drop by a significant column.
         let mut best_of = [0.0f64; 6];
         for t in &tries {
@@ -251,6 +253,25 @@ pub(crate) fn discover(
             if !data.held.is_empty() && hold >= base_hold {
                 continue;
             }
+            if let Some(prev) = refined_beside(data, out, &chans) {
+                let gain = tau::beyond(data, terms, &tt, prev);
+                if debug {
+                    eprintln!(
+                        "  beyond the refined decay {}: chi2 {gain:.1}",
+                        prev.step.effect
+                    );
+                }
+                let shared = (keep.iter())
+                    .filter(|&&g| {
+                        prev.columns
+                            .iter()
+                            .any(|&h| channel_of(data, h) == channel_of(data, g))
+                    })
+                    .count();
+                if !sig_dof(gain, shared) {
+                    continue;
+                }
+            }
             if let Some(why) = implausible(data, t.e, &f, &keep) {
                 if !refused.iter().any(|r: &Refused| r.reason == why) {
                     refused.push(Refused {
@@ -297,7 +318,29 @@ pub(crate) fn discover(
             tau,
         });
     }
-    out
+}
+
+/// Each discovered decay's time constant profiled again in the final model `terms`: a
+/// decay found before the registry's second selection (the Earth's rate hidden behind a
+/// strong warm-up, say) was refined without what joined the model after it.
+pub(crate) fn refine_again(data: &Data, terms: &Terms, found: &mut [Discovery]) {
+    for d in found.iter_mut().filter(|d| d.tau.is_some()) {
+        d.tau = tau::refine(data, terms, d.step.effect, &d.columns, d.probe);
+    }
+}
+
+/// The latest decay found earlier with a time constant of its own on any of `channels`.
+fn refined_beside<'d>(
+    data: &Data,
+    out: &'d [Discovery],
+    channels: &[usize],
+) -> Option<&'d Discovery> {
+    out.iter().rev().find(|d| {
+        d.tau.is_some()
+            && d.columns
+                .iter()
+                .any(|&g| channels.contains(&channel_of(data, g)))
+    })
 }
 
 /// The axis (0..3) of a probe column's channel.

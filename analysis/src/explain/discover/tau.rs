@@ -39,6 +39,8 @@ struct Channel {
     basis: Vec<Vec<f64>>,
     /// The whitened output, the rest of the model projected out.
     y: Vec<f64>,
+    /// Its sum of squares: the misfit with no decay.
+    yy: f64,
 }
 
 /// What one channel's decay at a time constant does: (drop of the misfit, amplitude, its u
@@ -47,8 +49,16 @@ type At = (f64, f64, f64);
 
 impl Channel {
     /// The channel of decay column `g` (of effect `best`, time constant `tau_grid`) over
-    /// the working segments `work`, the rest of `center`'s model around it.
-    fn new(data: &Data, center: &Fit, work: &[usize], best: usize, g: usize, t0: f64) -> Self {
+    /// the working segments `work`, the rest of `center`'s model around it, whitened by
+    /// `noise`'s honest noise.
+    fn new(
+        data: &Data,
+        (center, noise): (&Fit, &Fit),
+        work: &[usize],
+        best: usize,
+        g: usize,
+        t0: f64,
+    ) -> Self {
         let lay = &data.layout;
         let c = channel_of(data, g);
         let cols = &lay.by_channel[c];
@@ -72,7 +82,7 @@ impl Channel {
         let mean = |sx: &[f64], n: usize, k: usize| sx[k] / n.max(1) as f64;
         let ts: Vec<f64> = blocks.iter().map(|b| b.t).collect();
         let ns: Vec<usize> = blocks.iter().map(|b| b.n).collect();
-        let whiten = Whitener::new(&ts, &ns, &center.noise[c]);
+        let whiten = Whitener::new(&ts, &ns, &noise.noise[c]);
         let mut basis: Vec<Vec<f64>> = Vec::new();
         for &k in &free {
             let x: Vec<f64> = blocks.iter().map(|b| mean(&b.sx[c], b.n, k)).collect();
@@ -85,6 +95,7 @@ impl Channel {
             .map(|(s, &n)| s / n.max(1) as f64)
             .collect();
         let y = project(&basis, whiten.apply(&y));
+        let yy = y.iter().map(|v| v * v).sum();
         let tau_grid = match data.probe(best).map(|p| p.form) {
             Some(Form::Decay { tau, .. }) => tau,
             _ => f64::INFINITY,
@@ -96,6 +107,7 @@ impl Channel {
             tau_grid,
             basis,
             y,
+            yy,
         }
     }
 
@@ -206,9 +218,18 @@ pub(super) fn refine(
     };
     let work = data.working();
     let (center, _) = fit(data, terms, &work, &work);
+    if std::env::var_os("RATECAL_EXPLAIN_DEBUG").is_some() {
+        for &g in keep {
+            let c = channel_of(data, g);
+            eprintln!(
+                "refine: column {g} channel {c}: grid amplitude {:.4e}, noise {:?}",
+                center.theta[g], center.noise[c]
+            );
+        }
+    }
     let channels: Vec<Channel> = keep
         .iter()
-        .map(|&g| Channel::new(data, &center, &work, best, g, t0))
+        .map(|&g| Channel::new(data, (&center, &center), &work, best, g, t0))
         .collect();
     let (shortest, span) = limits(data, probe, &channels);
     let profile = Profile::new(&channels, (SHORTEST * shortest).ln(), (LONGEST * span).ln());
@@ -233,6 +254,30 @@ pub(super) fn refine(
         u_s,
         amplitudes,
     })
+}
+
+/// How much misfit (chi2, in units of the honest noise) the terms `with` remove beyond
+/// `without` on the channels of decay `d` (found earlier, at a grid time constant), its
+/// time constant profiled afresh in each: a later term must pay beyond the refinement of
+/// the decay already held, or it is only the mismatch of the decay's grid time constant
+/// (a sum of exponentials standing in for one).
+pub(super) fn beyond(data: &Data, without: &Terms, with: &Terms, d: &super::Discovery) -> f64 {
+    let Form::Decay { t0, .. } = d.probe.form else {
+        return f64::INFINITY;
+    };
+    let work = data.working();
+    let (base, _) = fit(data, without, &work, &work);
+    let least = |terms: &Terms| {
+        let (center, _) = fit(data, terms, &work, &work);
+        let channels: Vec<Channel> = (d.columns.iter())
+            .map(|&g| Channel::new(data, (&center, &base), &work, d.step.effect, g, t0))
+            .collect();
+        let (shortest, span) = limits(data, d.probe, &channels);
+        let profile = Profile::new(&channels, (SHORTEST * shortest).ln(), (LONGEST * span).ln());
+        let (i, _) = profile.least();
+        channels.iter().map(|ch| ch.yy).sum::<f64>() + profile.misfit[i]
+    };
+    least(without) - least(with)
 }
 
 /// The library's shortest time constant on the probe's sensor, and the recording's span

@@ -29,6 +29,9 @@ fn block_mean(b: &Block, c: usize, nonzero: &[(usize, f64)]) -> f64 {
     s / b.n as f64
 }
 
+/// One-second blocks from which a segment's own white level is taken for its wander.
+const OWN_WHITE_BLOCKS: usize = 60;
+
 /// Estimates the noise of channel `c` over the fitted segments; the wander only when
 /// `wander` (a white-noise covariance has no use for it).
 pub(crate) fn estimate(
@@ -42,6 +45,7 @@ pub(crate) fn estimate(
     let (mut num, mut den) = (0.0, 0.0);
     // Random walk from ten-second groups.
     let mut groups: Vec<(f64, f64, usize, f64)> = Vec::new(); // (span in blocks, t, n, mean)
+    // Pairs of groups, with their segment's own white level (None: the channel's).
     let mut pairs = Vec::new();
     let nonzero: Vec<(usize, f64)> = theta_c
         .iter()
@@ -55,14 +59,21 @@ pub(crate) fn estimate(
             .iter()
             .map(|b| (b.t, b.n, block_mean(b, c, &nonzero)))
             .collect();
+        let (mut seg_num, mut seg_den) = (0.0, 0.0);
         for w in means.windows(2) {
             let (n1, n2) = (w[0].1 as f64, w[1].1 as f64);
-            num += (w[1].2 - w[0].2).powi(2);
-            den += 1.0 / n1 + 1.0 / n2;
+            seg_num += (w[1].2 - w[0].2).powi(2);
+            seg_den += 1.0 / n1 + 1.0 / n2;
         }
+        num += seg_num;
+        den += seg_den;
         if !wander {
             continue;
         }
+        // The white level the segment's own block means show (a long segment's is
+        // precise), so that a misfit of the motion elsewhere, which raises the channel's,
+        // does not hide the wander here.
+        let own = (means.len() >= OWN_WHITE_BLOCKS).then(|| (seg_num / seg_den).max(sigma * sigma));
         groups.clear();
         for chunk in means.chunks(10) {
             let n: usize = chunk.iter().map(|m| m.1).sum();
@@ -75,7 +86,7 @@ pub(crate) fn estimate(
         // carry the wander the segments' spacing exposes the fit to.
         for lag in [1usize, 2, 4, 8, 16] {
             for i in lag..groups.len() {
-                pairs.push((groups[i - lag], groups[i]));
+                pairs.push((groups[i - lag], groups[i], own));
             }
         }
     }
@@ -87,9 +98,9 @@ pub(crate) fn estimate(
     };
     let a = sigma * sigma * phi;
     let (mut qn, mut qd) = (0.0, 0.0);
-    for (g1, g2) in pairs {
+    for (g1, g2, own) in pairs {
         let d2 = (g2.3 - g1.3).powi(2);
-        let white = a * (1.0 / g1.2 as f64 + 1.0 / g2.2 as f64);
+        let white = own.unwrap_or(a) * (1.0 / g1.2 as f64 + 1.0 / g2.2 as f64);
         let lag = (g2.1 - g1.1) - (g1.0 + g2.0) / 6.0;
         if lag > 0.0 {
             qn += d2 - white;
