@@ -2,7 +2,7 @@
 //! effects at once (the correlated ones among them), a navigation-grade IMU whose largest
 //! unmodelled signal is the Earth's rotation, and effects far below the per-sample noise
 //! (the Earth's rate in a 30-minute tactical recording with 0.005 deg/s of noise; a thermal
-//! drift worth half the noise). Each on several seeds: explain names exactly the effects
+//! drift worth two thirds of the noise). Each on several seeds: explain names exactly the effects
 //! present (and the Earth's rate, which every recording holds), recovers their parameters
 //! within their uncertainty, and reaches the noise floor.
 
@@ -221,13 +221,15 @@ fn earth_rate_below_the_noise_in_thirty_minutes() {
     }
 }
 
-/// A gyro thermal drift worth half the per-sample noise through the warm-up (0.0004 deg/s
-/// per degC over the 4 degC warm-up: 0.0016 deg/s against 0.003 deg/s of noise) is found,
-/// judged against the wandering bias, and measured.
+/// A gyro thermal drift worth two thirds of the per-sample noise through the warm-up
+/// (0.0005 deg/s per degC over the 4 degC warm-up: 0.002 deg/s against 0.003 deg/s of
+/// noise) is found, judged against the wandering bias (its estimate plus one standard
+/// error: half the noise was found before the wander's own uncertainty was counted), and
+/// measured.
 #[test]
-fn thermal_drift_at_half_the_noise() {
+fn thermal_drift_at_two_thirds_of_the_noise() {
     let st = station(
-        "{ gyro_thermal_drift: { x: 0.0004 } }",
+        "{ gyro_thermal_drift: { x: 0.0005 } }",
         &[(
             "gyro_bias_instability: 2 deg/h",
             "gyro_bias_instability: 0.3 deg/h",
@@ -241,6 +243,6 @@ fn thermal_drift_at_half_the_noise() {
             "seed {seed}: {:?}",
             x.rejected
         );
-        within(&x, "gyro_thermal_drift", &[("x", 0.0004)], 3.0);
+        within(&x, "gyro_thermal_drift", &[("x", 0.0005)], 3.0);
     }
 }

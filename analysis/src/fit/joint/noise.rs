@@ -29,6 +29,29 @@ fn block_mean(b: &Block, c: usize, nonzero: &[(usize, f64)]) -> f64 {
     s / b.n as f64
 }
 
+/// Lags of the wander's pairs, in ten-second groups (10 s to about 3 min): the longer lags
+/// carry the wander the segments' spacing exposes the fit to.
+const LAGS: [usize; 5] = [1, 2, 4, 8, 16];
+
+/// Standard errors added to the wander's estimate: a recording with one static of a few
+/// minutes tells the wander only roughly, and a test judged against an estimate that came
+/// out low would see slow forms in it (a wander that returns, Gauss-Markov, most of all).
+const WANDER_SE: f64 = 1.0;
+
+/// The wander's intensity from its pairs `(d^2 - white, lag)`: the pooled estimate plus
+/// [`WANDER_SE`] of its standard error (from the pairs' scatter about it).
+fn wander_of(pairs: &[(f64, f64)]) -> f64 {
+    let (n, d) = pairs
+        .iter()
+        .fold((0.0, 0.0), |(n, d), p| (n + p.0, d + p.1));
+    if d <= 0.0 {
+        return 0.0;
+    }
+    let q = n / d;
+    let scatter: f64 = pairs.iter().map(|p| (p.0 - q * p.1).powi(2)).sum();
+    (q + WANDER_SE * scatter.sqrt() / d).max(0.0)
+}
+
 /// One-second blocks from which a segment's own white level is taken for its wander.
 const OWN_WHITE_BLOCKS: usize = 60;
 
@@ -82,9 +105,7 @@ pub(crate) fn estimate(
             let span = chunk.len() as f64;
             groups.push((span, t, n, m));
         }
-        // Pairs at lags of 1, 2, 4, 8 and 16 groups (10 s to about 3 min): the longer lags
-        // carry the wander the segments' spacing exposes the fit to.
-        for lag in [1usize, 2, 4, 8, 16] {
+        for lag in LAGS {
             for i in lag..groups.len() {
                 pairs.push((groups[i - lag], groups[i], own));
             }
@@ -97,18 +118,19 @@ pub(crate) fn estimate(
         1.0
     };
     let a = sigma * sigma * phi;
-    let (mut qn, mut qd) = (0.0, 0.0);
-    for (g1, g2, own) in pairs {
-        let d2 = (g2.3 - g1.3).powi(2);
-        let white = own.unwrap_or(a) * (1.0 / g1.2 as f64 + 1.0 / g2.2 as f64);
-        let lag = (g2.1 - g1.1) - (g1.0 + g2.0) / 6.0;
-        if lag > 0.0 {
-            qn += d2 - white;
-            qd += lag;
-        }
+    let excess: Vec<(f64, f64)> = (pairs.into_iter())
+        .filter_map(|(g1, g2, own)| {
+            let d2 = (g2.3 - g1.3).powi(2);
+            let white = own.unwrap_or(a) * (1.0 / g1.2 as f64 + 1.0 / g2.2 as f64);
+            let lag = (g2.1 - g1.1) - (g1.0 + g2.0) / 6.0;
+            (lag > 0.0).then_some((d2 - white, lag))
+        })
+        .collect();
+    ChannelNoise {
+        sigma,
+        phi,
+        q: wander_of(&excess),
     }
-    let q = if qd > 0.0 { (qn / qd).max(0.0) } else { 0.0 };
-    ChannelNoise { sigma, phi, q }
 }
 
 /// `X^T Sigma_rw X / q` for a random walk starting at the first block: sums over the
