@@ -188,3 +188,54 @@ fn shared_ferraris_example_is_sound() {
     let x: Value = serde_json::from_slice(&o.stdout).unwrap();
     sound(&x, "real-ferraris-session");
 }
+
+/// Issue 35 item 8: the same session with its faces declared exact (`tolerance_deg:
+/// 0.001`, a fixture known far better than the misalignment): the misalignment is then
+/// determined beyond the tilts, explain names it, and it agrees with imucal's own
+/// calibration of the session (`1000 K_a[i][i] R_a[i][j]`) within 1.5 mrad.
+#[test]
+fn imucal_ferraris_session_on_exact_faces_names_imucals_misalignment() {
+    let (Some(csv), Some(cal)) = (
+        shared_path("real/imucal/example_ferraris_session.csv"),
+        shared_path("real/imucal/imucal_calibration.json"),
+    ) else {
+        return;
+    };
+    let tmp = tempfile::tempdir().unwrap();
+    let map = std::fs::read_to_string(import_map("ferraris.yaml"))
+        .unwrap()
+        .replace("tolerance_deg: 0.5", "tolerance_deg: 0.001");
+    let map_path = tmp.path().join("exact.yaml");
+    std::fs::write(&map_path, map).unwrap();
+    let args = [
+        "import",
+        csv.to_str().unwrap(),
+        "--map",
+        map_path.to_str().unwrap(),
+        "--out",
+        "run",
+    ];
+    let o = ratecal(&args, tmp.path());
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let o = ratecal(&["explain", "run", "--format", "json"], tmp.path());
+    let x: Value =
+        serde_json::from_slice(&o.stdout).unwrap_or_else(|e| panic!("{e}: {}", text(&o)));
+    sound(&x, "imucal exact faces");
+    let f = x["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|f| f["effect"] == "accel_misalignment")
+        .unwrap_or_else(|| panic!("{:#?}", x["findings"]));
+    let cal: Value = serde_json::from_str(&std::fs::read_to_string(cal).unwrap()).unwrap();
+    let (k, r) = (&cal["K_a"], &cal["R_a"]);
+    for (i, j) in [(0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1)] {
+        let name = format!("{}{}_mrad", ["x", "y", "z"][i], ["x", "y", "z"][j]);
+        let theirs = 1000.0 * k[i][i].as_f64().unwrap() * r[i][j].as_f64().unwrap();
+        let (ours, _) = estimate(&f["parameters"][&name]).unwrap_or_else(|| panic!("{name}: {f}"));
+        assert!(
+            (ours - theirs).abs() <= 1.5,
+            "{name}: ours {ours}, imucal {theirs}"
+        );
+    }
+}

@@ -179,7 +179,7 @@ pub(crate) fn explain_fitted(
             data.left_out.join(", ")
         ));
     }
-    let tilt = observe::tilt_in_start(data, &mut start);
+    let tilt = observe::tilt_in_start(data, &mut start, opts.alpha);
     // What this recording cannot determine is not fitted: its columns are skipped in
     // every model grown from `start`.
     let mut observed = observe::observe(data, &start);

@@ -77,7 +77,12 @@ pub(crate) fn observe(data: &Data, start: &Terms) -> Observability {
 /// misalignment cannot be told apart from it. The misalignment joins the starting model
 /// (so that what the two leave in the residuals is credited to neither, nor called
 /// unexplained) and is listed as not observable, with what would tell them apart.
-pub(crate) fn tilt_in_start(data: &Data, start: &mut Terms) -> Vec<NotObservable> {
+///
+/// Unless the faces are known better than the misalignment: when the misalignment, its
+/// variance holding the tilts', passes the selection's threshold (`alpha` over the
+/// candidates) beside the starting model, it stays a candidate like any other (faces
+/// declared within a thousandth of a degree, say).
+pub(crate) fn tilt_in_start(data: &Data, start: &mut Terms, alpha: f64) -> Vec<NotObservable> {
     if data.tilt_rad <= 0.0 {
         return Vec::new();
     }
@@ -108,6 +113,9 @@ pub(crate) fn tilt_in_start(data: &Data, start: &mut Terms) -> Vec<NotObservable
     let Some(e) = data.layout.index("accel_misalignment") else {
         return out;
     };
+    if beyond_the_tilts(data, start, e, alpha) {
+        return out;
+    }
     if !start.effects.contains(&e) {
         start.effects.push(e);
     }
@@ -124,6 +132,21 @@ pub(crate) fn tilt_in_start(data: &Data, start: &mut Terms) -> Vec<NotObservable
             .into(),
     });
     out
+}
+
+/// Whether misalignment `e` beside `start` passes the selection's threshold with the
+/// faces' tilts in its variance: the faces are then known better than it is large.
+fn beyond_the_tilts(data: &Data, start: &Terms, e: usize, alpha: f64) -> bool {
+    let mut t = start.clone();
+    if !t.effects.contains(&e) {
+        t.effects.push(e);
+    }
+    let work = data.working();
+    let (f, _) = super::model::fit(data, &t, &work, &work);
+    let cols: Vec<usize> = data.layout.columns_of(e).collect();
+    let (chi2, dof) = super::stats::wald(&f, &cols);
+    let m = data.candidates.len().max(1) as f64;
+    dof > 0 && super::stats::p_value(chi2, dof) < alpha / m
 }
 
 /// The columns of candidate `e` that the recording cannot determine, with why.
