@@ -7,7 +7,6 @@ use crate::certificate_cli::{
     approve, certificate, certified_station, flat, json_of, lab_in, mini, numbered, pdf_pages,
     unwrapped, with,
 };
-use crate::import_cli::{MAP, session};
 use crate::support::{self, code, ratecal, text};
 use std::path::Path;
 use std::process::Output;
@@ -410,11 +409,49 @@ fn with_allow_expired_no_traceability_is_claimed_through_an_expired_reference() 
 
 // -- item 7: imported recordings -----------------------------------------------------------
 
+/// A generated session at 100 Hz: six faces of 3 s each (+z, -z, +x, -x, +y, -y up), then
+/// 3 s turning about z at 100 deg/s; accelerometers in g (a small bias and scale error),
+/// gyros in deg/s.
+fn six_faces() -> (String, String) {
+    let faces = ["+z", "-z", "+x", "-x", "+y", "-y"];
+    let mut data = String::from("acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z\n");
+    let mut map = String::from(
+        "source: { format: csv }\nimu:\n  time: { rate_hz: 100 }\n  columns: { ax: acc_x, ay: \
+         acc_y, az: acc_z, gx: gyr_x, gy: gyr_y, gz: gyr_z }\n  units: { accel: g, gyro: \
+         deg/s }\nsegments:\n",
+    );
+    for (f, up) in faces.iter().enumerate() {
+        let k = usize::from(up.as_bytes()[1] - b'x');
+        let sign = if up.starts_with('-') { -1.0 } else { 1.0 };
+        for i in 0..300 {
+            let n = ((i * 7919) % 13) as f64 * 1e-5;
+            let mut a = [0.002 + n, -0.001, 0.003 - n];
+            a[k] += sign * (1.0 + 3e-4 * k as f64);
+            data.push_str(&format!("{},{},{},0.3,-0.2,0.1\n", a[0], a[1], a[2]));
+        }
+        map.push_str(&format!(
+            "  - {{ id: face{f}, kind: static, samples: [{}, {}], up: {up} }}\n",
+            f * 300 + 20,
+            f * 300 + 280
+        ));
+    }
+    for i in 0..300 {
+        let n = ((i * 7919) % 13) as f64 * 1e-4;
+        data.push_str(&format!("0.002,-0.001,1.003,0.3,-0.2,{}\n", 100.0 + n));
+    }
+    map.push_str(
+        "  - { id: turn, kind: rate, samples: [1820, 2080], axis: z, rate_dps: 100 }\nsite: \
+         { latitude_deg: 55.7, gravity_mps2: 9.8156 }\n",
+    );
+    (data, map)
+}
+
 /// Imports the generated session into `dir/name` (with `extra` options), analyses it into
 /// the folder, approves and archives it.
 fn imported(dir: &Path, name: &str, extra: &[&str]) {
-    std::fs::write(dir.join("data.csv"), session(|_, _| {})).unwrap();
-    std::fs::write(dir.join("map.yaml"), MAP).unwrap();
+    let (data, map) = six_faces();
+    std::fs::write(dir.join("data.csv"), data).unwrap();
+    std::fs::write(dir.join("map.yaml"), map).unwrap();
     let mut args = vec!["import", "data.csv", "--map", "map.yaml", "--out", name];
     args.extend_from_slice(extra);
     let o = ratecal(&args, dir);

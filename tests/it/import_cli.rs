@@ -158,7 +158,7 @@ fn ferraris_session_is_the_hand_converted_example() {
 
 /// A generated session at 100 Hz: 3 s with +z up, 3 s with +x up, 3 s turning about z at
 /// 100 deg/s; accelerometers in g, gyros in deg/s (before `edit`).
-pub(crate) fn session(edit: impl Fn(usize, &mut [f64; 6])) -> String {
+fn session(edit: impl Fn(usize, &mut [f64; 6])) -> String {
     let mut s = String::from("acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z\n");
     for i in 0..900 {
         let n = ((i * 7919) % 13) as f64 * 1e-4;
@@ -175,7 +175,7 @@ pub(crate) fn session(edit: impl Fn(usize, &mut [f64; 6])) -> String {
     s
 }
 
-pub(crate) const MAP: &str = "source: { format: csv }
+const MAP: &str = "source: { format: csv }
 imu:
   time: { rate_hz: 100 }
   columns: { ax: acc_x, ay: acc_y, az: acc_z, gx: gyr_x, gy: gyr_y, gz: gyr_z }
