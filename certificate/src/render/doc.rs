@@ -278,7 +278,7 @@ pub fn blocks(c: &Certificate) -> Vec<Block> {
             "Certificate",
             "Issued by",
             "Due",
-            "On the date of calibration",
+            "Status",
         ]
         .map(String::from)
         .to_vec(),
