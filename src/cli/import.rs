@@ -71,7 +71,13 @@ pub fn main(args: Args) -> ExitCode {
                 let path = s.out.join(ratecal_folder::names::STATION);
                 if let Err(e) = ratecal_recording::commit::write_nofollow(&path, text.as_bytes()) {
                     let _ = std::fs::remove_dir_all(&s.out);
-                    errln!("error: cannot write {}: {e}", path.display());
+                    let e = miette::miette!(
+                        code = "import::io",
+                        help = "check the space and permissions where --out points",
+                        "cannot write {}: {e}",
+                        path.display()
+                    );
+                    errln!("{e:?}");
                     errln!("nothing was written to {}", args.out.display());
                     return ExitCode::from(1);
                 }
