@@ -1,9 +1,17 @@
 //! Adding a run: its files first (each stored whole under its hash), then its index rows in
 //! one transaction, so a run is either wholly visible or not at all.
+//!
+//! One calibration, one entry: a run's archive id is the hash of its files, so approving
+//! an archived run (which rewrites its seal) gives the folder another id. Adding the
+//! approved folder replaces the unapproved entry of the same recording (the same
+//! `manifest.yaml` and `imu.csv`) in the transaction that indexes it, and an unapproved
+//! folder whose recording the archive holds already is not added again.
 
 use crate::ingest::{self, Folder};
 use crate::store::Store;
 use crate::{Archive, ArchiveError, Result};
+use ratecal_folder::names::{IMU, MANIFEST, SEAL_FILE};
+use ratecal_folder::seal::Seal;
 use std::path::Path;
 
 /// What adding a run did.
@@ -15,6 +23,11 @@ pub struct Added {
     pub new: bool,
     /// Files stored (new and already present).
     pub files: usize,
+    /// The unapproved entries of the same recording this approved folder replaced.
+    pub replaced: Vec<String>,
+    /// An unapproved folder not added because the archive holds its recording already
+    /// (as `id`): true.
+    pub same_recording: bool,
 }
 
 impl Archive {
@@ -35,6 +48,25 @@ impl Archive {
                 id,
                 new: false,
                 files,
+                replaced: Vec::new(),
+                same_recording: false,
+            });
+        }
+        let same = self.same_recording(folder).await?;
+        let mut replaced = Vec::new();
+        if approved(&std::fs::read(folder.dir.join(SEAL_FILE)).unwrap_or_default()) {
+            for (other, approved) in same {
+                if !approved && !self.has_certificate(&other).await? {
+                    replaced.push(other);
+                }
+            }
+        } else if let Some((other, _)) = same.into_iter().next() {
+            return Ok(Added {
+                id: other,
+                new: false,
+                files,
+                replaced: Vec::new(),
+                same_recording: true,
             });
         }
         for (path, sha, _) in &folder.files {
@@ -52,8 +84,80 @@ impl Archive {
             }
         }
         ratecal_recording::commit::crash_point("archive-after-files");
-        let new = self.insert_index(folder).await?;
-        Ok(Added { id, new, files })
+        let new = if replaced.is_empty() {
+            self.insert_index(folder).await?
+        } else {
+            let mut tx = self.pool.begin().await?;
+            for other in &replaced {
+                for sql in [
+                    "DELETE FROM run_files WHERE run_id = $1",
+                    "DELETE FROM parameters WHERE run_id = $1",
+                    "DELETE FROM limits WHERE run_id = $1",
+                    "DELETE FROM runs WHERE id = $1",
+                ] {
+                    sqlx::query(sql).bind(other).execute(&mut *tx).await?;
+                }
+            }
+            let new = insert_rows(&mut tx, folder).await?;
+            tx.commit().await?;
+            new
+        };
+        Ok(Added {
+            id,
+            new,
+            files,
+            replaced,
+            same_recording: false,
+        })
+    }
+
+    /// The entries holding the same recording as `folder` (its `manifest.yaml` and
+    /// `imu.csv`), other than itself, each with whether its seal holds an approval.
+    async fn same_recording(&self, folder: &Folder) -> Result<Vec<(String, bool)>> {
+        let sha = |name: &str| {
+            folder
+                .files
+                .iter()
+                .find(|(p, _, _)| p == name)
+                .map(|(_, s, _)| s.clone())
+        };
+        let (Some(manifest), Some(imu)) = (sha(MANIFEST), sha(IMU)) else {
+            return Ok(Vec::new());
+        };
+        let rows: Vec<(String, Option<String>)> = sqlx::query_as(
+            "SELECT m.run_id, s.sha256 FROM run_files m \
+             JOIN run_files i ON i.run_id = m.run_id AND i.path = $4 \
+             LEFT JOIN run_files s ON s.run_id = m.run_id AND s.path = $5 \
+             WHERE m.path = $6 AND m.sha256 = $1 AND i.sha256 = $2 \
+             AND m.run_id <> $3 ORDER BY m.run_id",
+        )
+        .bind(&manifest)
+        .bind(&imu)
+        .bind(&folder.facts.id)
+        .bind(IMU)
+        .bind(SEAL_FILE)
+        .bind(MANIFEST)
+        .fetch_all(&self.pool)
+        .await?;
+        let mut out = Vec::with_capacity(rows.len());
+        for (id, seal) in rows {
+            let bytes = match seal {
+                Some(sha) => self.store.get(&self.pool, &sha).await?.unwrap_or_default(),
+                None => Vec::new(),
+            };
+            out.push((id, approved(&bytes)));
+        }
+        Ok(out)
+    }
+
+    /// Whether a certificate was issued from entry `id` (it is then never replaced).
+    async fn has_certificate(&self, id: &str) -> Result<bool> {
+        let row: Option<(String,)> =
+            sqlx::query_as("SELECT number FROM certificates WHERE run_id = $1")
+                .bind(id)
+                .fetch_optional(&self.pool)
+                .await?;
+        Ok(row.is_some())
     }
 
     /// Whether the archive holds run `id`.
@@ -97,6 +201,11 @@ impl Archive {
             Store::Database => None,
         }
     }
+}
+
+/// Whether the seal `bytes` (`seal.json`) holds an approval (`ratecal approve`).
+fn approved(bytes: &[u8]) -> bool {
+    serde_json::from_slice::<Seal>(bytes).is_ok_and(|s| s.approval.is_some())
 }
 
 /// Inserts one run's rows; false when the run is already indexed (nothing written).

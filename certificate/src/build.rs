@@ -4,8 +4,8 @@
 use crate::budget::{Budget, COVERAGE};
 use crate::conformity::conformity;
 use crate::model::{
-    ApprovalBlock, Certificate, FORMAT, Identification, Lab, Method, ProcedureId, ResultLine,
-    StationId, Traceability,
+    ApprovalBlock, Certificate, FORMAT, Identification, Lab, MeasurementPoint, Method, ProcedureId,
+    ReferenceStandard, ResultLine, StationId, Traceability,
 };
 use crate::terms::Stated;
 use ratecal_analysis::budget::budgets;
@@ -23,12 +23,20 @@ pub struct Input<'a> {
     pub amend_reason: Option<String>,
     /// Date of issue, YYYY-MM-DD.
     pub issue_date: String,
+    /// Date of calibration, YYYY-MM-DD: the run's start (an import's: the date of import).
+    pub calibration_date: String,
     /// The laboratory.
     pub lab: Lab,
     /// Customer and order reference.
     pub customer: Option<String>,
     /// The customer's order.
     pub order: Option<String>,
+    /// The customer's address.
+    pub customer_address: Option<String>,
+    /// Date of receipt of the item, YYYY-MM-DD.
+    pub received: Option<String>,
+    /// Condition of the item on receipt.
+    pub condition: Option<String>,
     /// The run's results.json.
     pub results: &'a Results,
     /// The run's manifest.
@@ -41,10 +49,14 @@ pub struct Input<'a> {
     pub station: StationId,
     /// The budget's Type B figures.
     pub stated: Stated,
-    /// The table's calibration (certificate, issued by, due).
-    pub reference: [Option<String>; 3],
+    /// The reference standards, the table first.
+    pub references: Vec<ReferenceStandard>,
+    /// The measurement points.
+    pub points: Vec<MeasurementPoint>,
     /// Notes from refusals overridden (`--allow-expired`, `--allow-untraceable`).
     pub notes: Vec<String>,
+    /// The refusals overridden (`--allow-*`), as deviations; the run's warnings join them.
+    pub deviations: Vec<String>,
     /// The approval, `None` for a draft.
     pub approval: Option<ApprovalBlock>,
 }
@@ -116,9 +128,7 @@ pub fn build(input: Input<'_>) -> Certificate {
         );
     }
     let run = m.run.as_ref();
-    let calibration_date = run
-        .map(|r| r.started.chars().take(10).collect())
-        .unwrap_or_default();
+    let calibration_date = input.calibration_date;
     let procedure = m.procedure.as_ref().map(|p| ProcedureId {
         name: p.name.clone(),
         version: p.version.clone(),
@@ -146,29 +156,32 @@ pub fn build(input: Input<'_>) -> Certificate {
             .ambient
             .as_ref()
             .map(|a| [a.mean_c, a.min_c, a.max_c]),
+        imu_temperature_c: r.environment.imu_temp_range_c,
         gravity_mps2: site.gravity_mps2,
         gravity_u_mps2: input.stated.gravity_u_mps2,
         gravity_source: "the station file (site.gravity_mps2)".into(),
         latitude_deg: site.latitude_deg,
         latitude_source: "the station file (site.latitude_deg)".into(),
     };
-    let [certificate, issued_by, due] = input.reference;
-    let statement = match (&certificate, &issued_by) {
-        (Some(c), Some(by)) => format!(
-            "The results are traceable to the SI through the rate table's calibration, \
-             certificate {c} issued by {by}{}.",
-            due.as_deref()
-                .map(|d| format!(", due {d}"))
-                .unwrap_or_default()
-        ),
-        (Some(c), None) => format!(
-            "The results are traceable to the SI through the rate table's calibration, \
-             certificate {c}."
-        ),
-        _ => "No reference calibration is stated for the rate table: the results are not \
-              shown to be traceable."
-            .into(),
-    };
+    let statement = statement(&input.references);
+    let table = input.references.first();
+    let (certificate, issued_by, due) = (
+        table.and_then(|t| t.certificate.clone()),
+        table.and_then(|t| t.issued_by.clone()),
+        table.and_then(|t| t.due.clone()),
+    );
+    let mut deviations = input.deviations;
+    deviations.extend(
+        r.warnings
+            .iter()
+            .map(|w| format!("Warning of the run: {w}")),
+    );
+    deviations.extend(
+        r.sanity
+            .iter()
+            .filter(|c| c.status == ratecal_analysis::results::SanityStatus::Fail)
+            .map(|c| format!("Sanity check {} failed: {}", c.check, c.detail)),
+    );
     Certificate {
         format: FORMAT.into(),
         number: input.number,
@@ -179,6 +192,9 @@ pub fn build(input: Input<'_>) -> Certificate {
         identification: Identification {
             customer: input.customer,
             order: input.order,
+            customer_address: input.customer_address,
+            item_received: input.received,
+            item_condition: input.condition,
             item_model: m.imu.get("model").cloned().unwrap_or_default(),
             item_serial: m.imu.get("serial").cloned().unwrap_or_default(),
             item_grade: m.imu.get("grade").cloned().unwrap_or_default(),
@@ -198,6 +214,7 @@ pub fn build(input: Input<'_>) -> Certificate {
         method,
         model_equation: equation(r),
         results,
+        measurement_points: input.points,
         budget: budgets,
         conformity: statements,
         traceability: Traceability {
@@ -205,10 +222,66 @@ pub fn build(input: Input<'_>) -> Certificate {
             issued_by,
             due,
             statement,
+            references: input.references,
         },
         approval: input.approval,
         notes,
+        deviations,
     }
+}
+
+/// The traceability statement: a claim only through the references in date on the date
+/// of calibration, the table's first (without it nothing is claimed).
+fn statement(refs: &[ReferenceStandard]) -> String {
+    let cite = |r: &ReferenceStandard| {
+        format!(
+            "the {}'s calibration, certificate {}{}{}",
+            r.standard,
+            r.certificate.as_deref().unwrap_or_default(),
+            r.issued_by
+                .as_deref()
+                .map(|b| format!(" issued by {b}"))
+                .unwrap_or_default(),
+            r.due
+                .as_deref()
+                .map(|d| format!(", due {d}"))
+                .unwrap_or_default()
+        )
+    };
+    let Some(table) = refs.first().filter(|t| t.certificate.is_some()) else {
+        return "No reference calibration is stated for the rate table: the results are not \
+                shown to be traceable."
+            .into();
+    };
+    let expired: Vec<&ReferenceStandard> = refs.iter().filter(|r| r.valid == Some(false)).collect();
+    let mut s = if table.valid == Some(false) {
+        format!(
+            "The rate table's calibration, certificate {}, was due {} before the date of \
+             calibration: the results are not shown to be traceable to the SI.",
+            table.certificate.as_deref().unwrap_or_default(),
+            table.due.as_deref().unwrap_or("not stated")
+        )
+    } else {
+        let through: Vec<String> = refs
+            .iter()
+            .filter(|r| r.valid == Some(true))
+            .map(cite)
+            .collect();
+        format!(
+            "The results are traceable to the SI through {}.",
+            through.join("; and through ")
+        )
+    };
+    for r in expired.iter().filter(|r| r.standard != table.standard) {
+        s.push_str(&format!(
+            " The {}'s calibration, certificate {}, was due {} before the date of \
+             calibration: the traceability does not extend through it.",
+            r.standard,
+            r.certificate.as_deref().unwrap_or_default(),
+            r.due.as_deref().unwrap_or("not stated")
+        ));
+    }
+    s
 }
 
 /// The model equation the parameters belong to (spec/physics.md).

@@ -7,7 +7,7 @@
 
 use crate::number::{self, Doc};
 pub use crate::number::{Format, Issued};
-use crate::{ApprovalBlock, Certificate, Input, Lab, StationId, render};
+use crate::{ApprovalBlock, Certificate, Input, Lab, ReferenceStandard, StationId, render};
 use miette::{Diagnostic, NamedSource, SourceSpan};
 use ratecal_analysis::results::Results;
 use ratecal_archive::{Archive, Location, days_from_iso};
@@ -26,6 +26,12 @@ pub struct Request {
     pub customer: Option<String>,
     /// The customer's order reference.
     pub order: Option<String>,
+    /// The customer's address.
+    pub customer_address: Option<String>,
+    /// Date of receipt of the item, YYYY-MM-DD.
+    pub received: Option<String>,
+    /// Condition of the item on receipt.
+    pub condition: Option<String>,
     /// The archive holding the run and the number sequence.
     pub archive: Option<String>,
     /// An amended certificate: a new number that names the one it replaces.
@@ -94,7 +100,7 @@ fn read_text(path: &Path, help: &str) -> miette::Result<String> {
     std::fs::read_to_string(path).map_err(|e| io(path, e, help))
 }
 
-fn read_lab(path: &Path) -> miette::Result<Lab> {
+fn read_lab(path: &Path) -> miette::Result<(Lab, String)> {
     let text = read_text(
         path,
         "give the laboratory's file (docs/examples/lab.yaml shows one)",
@@ -111,8 +117,8 @@ fn read_lab(path: &Path) -> miette::Result<Lab> {
             src: NamedSource::new(name.clone(), text.clone()),
             span: (span, 0).into(),
             label: e.to_string().lines().next().unwrap_or("here").to_string(),
-            help: "keys: name, address, accreditation, certificate_prefix, optional logo \
-                   and template (docs/certificate.md)"
+            help: "keys: name, address, accreditation, certificate_prefix, signers, \
+                   optional logo and template (docs/certificate.md)"
                 .into(),
         }
     })?;
@@ -157,7 +163,7 @@ fn read_lab(path: &Path) -> miette::Result<Lab> {
             .into());
         }
     }
-    Ok(lab)
+    Ok((lab, text))
 }
 
 /// The template `LAB.yaml` names (its path as the name diagnostics show), else the
@@ -186,6 +192,24 @@ pub fn lab_logo(lab_file: &Path, lab: &Lab) -> Option<render::Logo> {
     logo_kind(&lab_file.parent().unwrap_or(Path::new(".")).join(logo)).ok()
 }
 
+/// The date (YYYY-MM-DD) of an import, from its manifest's `provenance.imported` (empty
+/// when the manifest has none).
+fn imported_on(manifest_text: &str) -> String {
+    #[derive(serde::Deserialize)]
+    struct Provenance {
+        imported: String,
+    }
+    #[derive(serde::Deserialize)]
+    struct Imported {
+        provenance: Option<Provenance>,
+    }
+    serde_saphyr::from_str::<Imported>(manifest_text)
+        .ok()
+        .and_then(|m| m.provenance)
+        .map(|p| p.imported.chars().take(10).collect())
+        .unwrap_or_default()
+}
+
 /// Issues the certificate of `args.run_dir` in `format`: a draft or a dry run's specimen
 /// without a number; otherwise the run's number when the content is the one issued under
 /// it, a new number (in the transaction that records the document) for a first issue or an
@@ -197,20 +221,53 @@ pub async fn issue(
     deliver: &mut dyn FnMut(&Certificate, &[u8]) -> miette::Result<()>,
 ) -> miette::Result<Issued> {
     let dir = &args.run_dir;
-    let lab = read_lab(&args.lab)?;
+    if let Some(d) = &args.received
+        && days_from_iso(d).is_none()
+    {
+        return Err(miette::miette!(
+            code = "certificate::received",
+            help = "give the date the item was received as YYYY-MM-DD: --received 2026-11-20",
+            "--received `{d}` is not a date"
+        ));
+    }
+    let (lab, lab_text) = read_lab(&args.lab)?;
     let run = RunFolder::new(dir);
     let results: Results = run.results()?;
-    let (_, manifest) = run.manifest("give the folder `ratecal run` wrote")?;
+    let (manifest_text, manifest) = run.manifest("give the folder `ratecal run` wrote")?;
     let plan = run.plan();
+    // An imported recording (no `run` in its manifest) has a station file only when
+    // `ratecal import --station` copied one in.
+    let imported = manifest.run.is_none();
+    if imported && !run.path(ratecal_folder::names::STATION).exists() {
+        return Err(miette::miette!(
+            code = "certificate::no_station",
+            help = format!(
+                "import the recording again with the station it was measured on: `ratecal \
+                 import ... --station S.yaml --out {}` copies the station file into the \
+                 folder and seals it (its table's calibration and Type B figures); then \
+                 analyze, approve and archive it",
+                dir.display()
+            ),
+            "{} is an imported recording without a station file: its traceability and \
+             uncertainty budget cannot be stated",
+            dir.display()
+        ));
+    }
     let (station_name, station_text) = run.station_text()?;
     let station =
         Station::from_yaml(&station_text, &station_name).map_err(|e| miette::Report::new(*e))?;
-    let calibration_date: String = manifest
-        .run
-        .as_ref()
-        .map(|r| r.started.chars().take(10).collect())
-        .unwrap_or_default();
     let mut notes = Vec::new();
+    let calibration_date: String = match &manifest.run {
+        Some(r) => r.started.chars().take(10).collect(),
+        None => {
+            let date = imported_on(&manifest_text);
+            notes.push(format!(
+                "An imported recording (ratecal import): it states no date of measurement, so \
+                 the date of calibration is the date of its import, {date}."
+            ));
+            date
+        }
+    };
     let located =
         |message: String, after: Option<&str>, key: &str, label: &str, help: &str| Located {
             message,
@@ -220,8 +277,9 @@ pub async fn issue(
             help: help.into(),
         };
     let cal = station.table.calibration.clone();
-    match &cal {
-        None if !args.allow_untraceable => {
+    let mut deviations = Vec::new();
+    if cal.is_none() {
+        if !args.allow_untraceable {
             return Err(located(
                 "the station states no calibration of the rate table: the results would not be traceable".into(),
                 None,
@@ -232,40 +290,68 @@ pub async fn issue(
             )
             .into());
         }
-        None => notes.push(
-            "Issued with --allow-untraceable: the station states no calibration of the rate \
-             table; the results are not shown to be traceable."
-                .into(),
-        ),
-        Some(c) => {
-            let due = days_from_iso(&c.due);
-            let on = days_from_iso(&calibration_date);
-            let expired = match (due, on) {
-                (Some(d), Some(o)) => o > d,
-                _ => true,
-            };
-            if expired && !args.allow_expired {
-                return Err(located(
-                    format!(
-                        "the rate table's calibration ({}) was due {}, before the calibration date {calibration_date}",
-                        c.certificate, c.due
-                    ),
-                    Some("calibration"),
-                    "due",
-                    "expired on the date of calibration",
-                    "recalibrate the table and state its new certificate, or give \
-                     --allow-expired (printed on the certificate)",
-                )
-                .into());
-            }
-            if expired {
-                notes.push(format!(
-                    "Issued with --allow-expired: the rate table's calibration {} was due {}, \
-                     before the date of calibration.",
+        let note = "Issued with --allow-untraceable: the station states no calibration of the \
+                    rate table; the results are not shown to be traceable.";
+        notes.push(note.to_string());
+        deviations.push(note.to_string());
+    }
+    // Every reference standard, the table first: its calibration in date on the date of
+    // calibration, unless the issuer allows it (printed, and no claim through it).
+    let r = &station.references;
+    let stated = [
+        ("rate table", "calibration", cal),
+        ("DAQ timebase", "daq_timebase", r.daq_timebase.clone()),
+        ("gravity survey", "gravity_survey", r.gravity_survey.clone()),
+        ("thermometer", "thermometer", r.thermometer.clone()),
+    ];
+    let mut references = Vec::new();
+    for (standard, key, c) in stated {
+        let Some(c) = c else {
+            references.push(ReferenceStandard {
+                standard: standard.into(),
+                certificate: None,
+                issued_by: None,
+                due: None,
+                valid: None,
+            });
+            continue;
+        };
+        let expired = match (days_from_iso(&c.due), days_from_iso(&calibration_date)) {
+            (Some(d), Some(o)) => o > d,
+            _ => true,
+        };
+        if expired && !args.allow_expired {
+            return Err(located(
+                format!(
+                    "the {standard}'s calibration ({}) was due {}, before the calibration date {calibration_date}",
                     c.certificate, c.due
-                ));
-            }
+                ),
+                Some(key),
+                "due",
+                "expired on the date of calibration",
+                &format!(
+                    "recalibrate the {standard} and state its new certificate, or give \
+                     --allow-expired (printed on the certificate)"
+                ),
+            )
+            .into());
         }
+        if expired {
+            let note = format!(
+                "Issued with --allow-expired: the {standard}'s calibration {} was due {}, \
+                 before the date of calibration.",
+                c.certificate, c.due
+            );
+            notes.push(note.clone());
+            deviations.push(note);
+        }
+        references.push(ReferenceStandard {
+            standard: standard.into(),
+            certificate: Some(c.certificate),
+            issued_by: Some(c.issued_by),
+            due: Some(c.due),
+            valid: Some(!expired),
+        });
     }
     // The archive must hold this very folder (its content address).
     let folder = ratecal_archive::read_folder(dir)?;
@@ -290,17 +376,25 @@ pub async fn issue(
         time: a.time,
         key_fingerprint: a.key_fingerprint,
     });
+    if let Some(a) = &approval {
+        crate::signers::authorised(&args.lab, &lab_text, &lab, a)?;
+    }
     let t = &station.table;
     let template = lab_template(&args.lab, &lab)?;
     let logo = lab_logo(&args.lab, &lab);
+    let stated = crate::stated(&station, manifest.station.site.gravity_mps2);
     let input = Input {
         number: None,
         replaces: None,
         amend_reason: None,
         issue_date: String::new(),
+        calibration_date: calibration_date.clone(),
         lab,
         customer: args.customer.clone(),
         order: args.order.clone(),
+        customer_address: args.customer_address.clone(),
+        received: args.received.clone(),
+        condition: args.condition.clone(),
         results: &results,
         manifest: &manifest,
         plan: plan.as_ref(),
@@ -312,12 +406,11 @@ pub async fn issue(
             serial: t.serial.clone(),
             accuracy_class: t.accuracy_class.clone(),
         },
-        stated: crate::stated(&station, manifest.station.site.gravity_mps2),
-        reference: match cal {
-            Some(c) => [Some(c.certificate), Some(c.issued_by), Some(c.due)],
-            None => [None, None, None],
-        },
+        points: crate::points::points(dir, &manifest, &results, &stated),
+        stated,
+        references,
         notes,
+        deviations,
         approval,
     };
     let doc = Doc {

@@ -16,14 +16,17 @@ mod conformity;
 pub mod issue;
 mod model;
 mod number;
+mod points;
 pub mod render;
+mod signers;
 mod stated;
 pub mod units;
 
 pub use build::{Input, build, gum_text};
 pub use model::{
-    ApprovalBlock, Certificate, Conformity, ConformityCheck, END_MARK, FORMAT, Identification, Lab,
-    Method, ProcedureId, REPRODUCTION, ResultLine, SPECIMEN, StationId, Traceability,
+    ApprovalBlock, Certificate, Conformity, ConformityCheck, END_MARK, FORMAT, ITEM_ONLY,
+    Identification, Lab, MeasurementPoint, Method, ProcedureId, REPRODUCTION, ReferenceStandard,
+    ResultLine, SPECIMEN, Signer, StationId, Traceability,
 };
 pub use number::{json, verify};
 /// The GUM budget, computed by the analysis (results.json `budgets`).

@@ -28,6 +28,22 @@ pub struct Lab {
     /// default one (`certificate/templates/certificate.typ` is the default, to copy).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub template: Option<String>,
+    /// The authorised signers: an approved run's certificate is issued only when its
+    /// approval key is one of theirs (not written into the certificate's JSON).
+    #[serde(default, skip_serializing)]
+    pub signers: Vec<Signer>,
+}
+
+/// An authorised signer (`LAB.yaml` `signers`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Signer {
+    /// Their name.
+    pub name: String,
+    /// Their role.
+    pub role: String,
+    /// The `.pub` file `ratecal key new` wrote, relative to `LAB.yaml`.
+    pub public_key: String,
 }
 
 /// A calibration certificate.
@@ -57,6 +73,9 @@ pub struct Certificate {
     pub model_equation: Vec<String>,
     /// Each calibrated parameter: value +- U (k, 95 %).
     pub results: Vec<ResultLine>,
+    /// Each rate point and attitude: the reference, the IMU's reading, the error, U and
+    /// the verdict (empty: not stated).
+    pub measurement_points: Vec<MeasurementPoint>,
     /// Uncertainty budget: one entry per reported quantity.
     pub budget: Vec<Budget>,
     /// Statements of conformity, when the procedure has acceptance checks.
@@ -67,6 +86,53 @@ pub struct Certificate {
     pub approval: Option<ApprovalBlock>,
     /// Notes printed on the certificate (incomplete budgets, overridden refusals).
     pub notes: Vec<String>,
+    /// Deviations from the procedure's normal course: every `--allow-*` the issuer gave
+    /// and every warning of the run.
+    pub deviations: Vec<String>,
+}
+
+/// One measurement point: a rate point or an attitude of the procedure.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MeasurementPoint {
+    /// The segment (step) it was measured in.
+    pub segment: String,
+    /// `static` (an attitude) or `rate` (a rate point).
+    pub kind: String,
+    /// The sensor and axis compared (`accel.z`, `gyro.x`).
+    pub channel: String,
+    /// What the table applied, in words (`+z up`, `outer axis at 100 deg/s`).
+    pub condition: String,
+    /// The reference value on that channel.
+    pub reference: f64,
+    /// The IMU's reading: the segment's mean raw output on that channel.
+    pub reading: f64,
+    /// `reading - reference`.
+    pub error: f64,
+    /// The expanded uncertainty of the mean reading (k below), from its scatter.
+    #[serde(rename = "U")]
+    pub expanded: f64,
+    /// The coverage factor of `U`.
+    pub k: f64,
+    /// Unit of reference, reading, error and U.
+    pub unit: String,
+    /// `consistent` when the calibrated model explains the reading within U (its
+    /// residual), else `inconsistent`.
+    pub verdict: String,
+}
+
+/// A reference standard the measurement traces to.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ReferenceStandard {
+    /// What it is: `rate table`, `DAQ timebase`, `gravity survey`, `thermometer`.
+    pub standard: String,
+    /// Its calibration certificate's number (`None`: not stated).
+    pub certificate: Option<String>,
+    /// Who issued it.
+    pub issued_by: Option<String>,
+    /// When it is due, YYYY-MM-DD.
+    pub due: Option<String>,
+    /// Whether it was in date on the date of calibration (`None`: not stated).
+    pub valid: Option<bool>,
 }
 
 /// Customer, item, procedure, station, dates, place.
@@ -94,6 +160,12 @@ pub struct Identification {
     pub calibration_date: String,
     /// Date of issue (YYYY-MM-DD).
     pub issue_date: String,
+    /// The customer's address (`--customer-address`).
+    pub customer_address: Option<String>,
+    /// Date of receipt of the item (`--received`, YYYY-MM-DD).
+    pub item_received: Option<String>,
+    /// Condition of the item on receipt (`--condition`).
+    pub item_condition: Option<String>,
     /// Where: the laboratory's address and the site's latitude.
     pub location: String,
 }
@@ -133,6 +205,9 @@ pub struct Method {
     pub steps: Vec<String>,
     /// Ambient temperature during the measurement: mean, min, max (degC), when recorded.
     pub temperature_c: Option<[f64; 3]>,
+    /// The IMU's own (internal) temperature range during the measurement: min, max
+    /// (degC), when recorded.
+    pub imu_temperature_c: Option<[f64; 2]>,
     /// The site's gravity, m/s^2, and where the figure comes from.
     pub gravity_mps2: f64,
     /// Its standard uncertainty, when stated.
@@ -214,6 +289,8 @@ pub struct Traceability {
     pub due: Option<String>,
     /// The statement printed.
     pub statement: String,
+    /// Every reference standard (the table first), stated or not.
+    pub references: Vec<ReferenceStandard>,
 }
 
 /// The signature block.
@@ -258,6 +335,9 @@ pub const SPECIMEN: &str = "DRY RUN - SPECIMEN";
 /// The sentence every certificate ends with.
 pub const REPRODUCTION: &str = "This certificate shall not be reproduced except in full \
 without the written approval of the laboratory.";
+
+/// What the results are of (ISO/IEC 17025, 7.8.2.1 k).
+pub const ITEM_ONLY: &str = "The results relate only to the item calibrated.";
 
 /// The end-of-certificate mark.
 pub const END_MARK: &str = "End of certificate";

@@ -19,12 +19,27 @@ pub async fn add_one(archive: &Archive, dir: &Path) -> Result<String, Report> {
         ));
     }
     let added = archive.add(dir).await?;
-    Ok(if added.new {
+    Ok(if added.same_recording {
         format!(
-            "archived {} as {} ({} file(s))",
+            "{} is not approved and its recording is already archived as {} (one calibration, \
+             one entry): not added again",
+            dir.display(),
+            added.id
+        )
+    } else if added.new {
+        format!(
+            "archived {} as {} ({} file(s)){}",
             dir.display(),
             added.id,
-            added.files
+            added.files,
+            if added.replaced.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    ", replacing the unapproved entry {} of the same recording",
+                    added.replaced.join(", ")
+                )
+            }
         )
     } else {
         format!("{} is already archived as {}", dir.display(), added.id)

@@ -1,5 +1,5 @@
 //! `ratecal certificate RUN_DIR --lab LAB.yaml [--customer NAME] [--order REF]
-//! [--format pdf|html|md|json] [--out FILE] [--archive DIR_OR_URL] [--amend --reason TEXT]
+//! [--customer-address TEXT] [--received DATE] [--condition TEXT] [--format pdf|html|md|json] [--out FILE] [--archive DIR_OR_URL] [--amend --reason TEXT]
 //! [--allow-expired] [--allow-untraceable]` and `ratecal certificate verify FILE.pdf
 //! [--archive DIR_OR_URL]`: a calibration certificate (ISO/IEC 17025, 7.8)
 //! of an archived, sealed run (`ratecal_ops::certificate`). Exit codes: 0 written (a DRAFT
@@ -29,6 +29,15 @@ pub struct Args {
     /// The customer's order reference.
     #[arg(long, value_name = "REF")]
     order: Option<String>,
+    /// The customer's address.
+    #[arg(long, value_name = "TEXT")]
+    customer_address: Option<String>,
+    /// The date the item was received (YYYY-MM-DD).
+    #[arg(long, value_name = "DATE")]
+    received: Option<String>,
+    /// The item's condition on receipt.
+    #[arg(long, value_name = "TEXT")]
+    condition: Option<String>,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Pdf)]
     format: Format,
@@ -98,6 +107,9 @@ pub fn main(a: Args) -> ExitCode {
         lab: a.lab.unwrap_or_default(),
         customer: a.customer,
         order: a.order,
+        customer_address: a.customer_address,
+        received: a.received,
+        condition: a.condition,
         archive: a.archive,
         amend: a.amend,
         reason: a.reason,

@@ -1,5 +1,6 @@
-//! `ratecal import SOURCE... --map MAP.yaml --out RUN_DIR`: a lab's own DAQ files to a
-//! recording folder (docs/import.md). Prints what it found (segments, up axes, the
+//! `ratecal import SOURCE... --map MAP.yaml --out RUN_DIR [--station S.yaml]`: a lab's own
+//! DAQ files to a recording folder (docs/import.md), with a copy of the station file the
+//! recording was measured on when one is given (sealed with it: what `certificate` needs). Prints what it found (segments, up axes, the
 //! synthesized table) for the engineer to confirm. Exit codes: 0 written, 1 refused (a
 //! located diagnostic; nothing written), 2 usage error (clap).
 
@@ -22,6 +23,11 @@ pub struct Args {
     /// The recording folder to write (must not exist, or be empty).
     #[arg(long, value_name = "RUN_DIR")]
     out: PathBuf,
+    /// The station the recording was measured on: copied into the folder as
+    /// `station.yaml` and sealed with it (its Type B figures and the table's calibration,
+    /// which `analyze` and `certificate` read).
+    #[arg(long, value_name = "S.yaml")]
+    station: Option<PathBuf>,
 }
 
 /// Runs the subcommand.
@@ -47,8 +53,40 @@ pub fn main(args: Args) -> ExitCode {
             return ExitCode::from(1);
         }
     };
+    // The station file is read and checked before anything is written.
+    let station = match &args.station {
+        Some(path) => match station_copy(path) {
+            Ok(text) => Some(text),
+            Err(e) => {
+                errln!("{e:?}");
+                errln!("nothing was written to {}", args.out.display());
+                return ExitCode::from(1);
+            }
+        },
+        None => None,
+    };
     match ratecal_import::import(&args.sources, &map, &args.out) {
-        Ok(s) => {
+        Ok(mut s) => {
+            if let Some(text) = &station {
+                let path = s.out.join(ratecal_folder::names::STATION);
+                if let Err(e) = ratecal_recording::commit::write_nofollow(&path, text.as_bytes()) {
+                    let _ = std::fs::remove_dir_all(&s.out);
+                    let e = miette::miette!(
+                        code = "import::io",
+                        help = "check the space and permissions where --out points",
+                        "cannot write {}: {e}",
+                        path.display()
+                    );
+                    errln!("{e:?}");
+                    errln!("nothing was written to {}", args.out.display());
+                    return ExitCode::from(1);
+                }
+                s.files.push(ratecal_recording::WrittenFile {
+                    name: ratecal_folder::names::STATION.into(),
+                    sha256: ratecal_recording::sha256_hex(text.as_bytes()),
+                    len: text.len() as u64,
+                });
+            }
             // Sealed as written, like a run folder: `verify` shows it unaltered and
             // `archive add` accepts it.
             if let Err(e) = ratecal_folder::sealing::write_known(&s.out, None, &s.files) {
@@ -64,6 +102,22 @@ pub fn main(args: Args) -> ExitCode {
             ExitCode::from(1)
         }
     }
+}
+
+/// The station file's text, when it is one (`ratecal check --station` reads it the same
+/// way); else its diagnostic.
+fn station_copy(path: &std::path::Path) -> miette::Result<String> {
+    let name = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        miette::miette!(
+            code = "import::station",
+            help = "--station names the station file the recording was measured on \
+                    (docs/examples/station.yaml shows one)",
+            "cannot read {name}: {e}"
+        )
+    })?;
+    ratecal_drivers::Station::from_yaml(&text, &name).map_err(|e| miette::Report::new(*e))?;
+    Ok(text)
 }
 
 fn print_summary(map: &ImportMap, s: &Summary) {

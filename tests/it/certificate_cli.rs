@@ -10,7 +10,7 @@ use support::{code, mini_run, ratecal, text};
 
 /// The default station with the keys a certificate needs (`due` far ahead: the test
 /// does not expire).
-fn certified_station(due: &str) -> String {
+pub(crate) fn certified_station(due: &str) -> String {
     let s = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/docs/examples/station.yaml"
@@ -23,10 +23,22 @@ fn lab() -> String {
     concat!(env!("CARGO_MANIFEST_DIR"), "/docs/examples/lab.yaml").to_string()
 }
 
+/// The example laboratory in `dir/lab.yaml` (written once), its signer's public key
+/// `dir/keys/lab.pub`, the key [`approve`] approves with.
+pub(crate) fn lab_in(dir: &Path) -> String {
+    let path = dir.join("lab.yaml");
+    if !path.exists() {
+        let text = std::fs::read_to_string(lab()).unwrap();
+        assert!(text.contains("public_key: ../../keys/lab.pub"), "{text}");
+        std::fs::write(&path, text.replace("../../keys/lab.pub", "keys/lab.pub")).unwrap();
+    }
+    path.display().to_string()
+}
+
 /// Every page's text, by poppler's pdftotext (not our writer); `None`, said on standard
 /// error, when pdftotext is not installed (`.ci/run` installs it). lopdf cannot read the
 /// ToUnicode maps krilla writes, which poppler, pypdf and Acrobat read.
-fn pdf_pages(bytes: &[u8]) -> Option<Vec<String>> {
+pub(crate) fn pdf_pages(bytes: &[u8]) -> Option<Vec<String>> {
     if std::process::Command::new("pdftotext")
         .arg("-v")
         .output()
@@ -55,14 +67,14 @@ fn pdf_pages(bytes: &[u8]) -> Option<Vec<String>> {
 }
 
 /// Collapses whitespace, so that a phrase wrapped over two lines is still found.
-fn flat(s: &str) -> String {
+pub(crate) fn flat(s: &str) -> String {
     s.split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
 /// A MINI run in `dir/name` on `station`, approved (or not) and archived in `dir/archive`.
 /// Not a dry run: `station`'s drivers are the simulator's (virtual time, well under a
 /// second), but the run is recorded as a real one, so its certificate takes a number.
-fn mini(dir: &Path, name: &str, station: &str, approved: bool) -> PathBuf {
+pub(crate) fn mini(dir: &Path, name: &str, station: &str, approved: bool) -> PathBuf {
     std::fs::write(dir.join("s.yaml"), station).unwrap();
     std::fs::write(dir.join("p.rcal"), support::MINI).unwrap();
     let o = ratecal(
@@ -80,8 +92,8 @@ fn mini(dir: &Path, name: &str, station: &str, approved: bool) -> PathBuf {
     dir.join(name)
 }
 
-fn certificate(dir: &Path, run: &str, extra: &[&str]) -> Output {
-    let lab = lab();
+pub(crate) fn certificate(dir: &Path, run: &str, extra: &[&str]) -> Output {
+    let lab = lab_in(dir);
     let mut args = vec![
         "certificate",
         run,
@@ -94,7 +106,7 @@ fn certificate(dir: &Path, run: &str, extra: &[&str]) -> Output {
     ratecal(&args, dir)
 }
 
-fn json_of(o: &Output) -> serde_json::Value {
+pub(crate) fn json_of(o: &Output) -> serde_json::Value {
     serde_json::from_slice(&o.stdout).unwrap_or_else(|e| panic!("{e}: {}", text(o)))
 }
 
@@ -619,7 +631,7 @@ fn concurrent_numbering(dir: &Path, archive: &str) {
         assert_eq!(code(&o), 0, "{}", text(&o));
     }
     // Three processes per run, all at once.
-    let lab = lab();
+    let lab = lab_in(dir);
     let children: Vec<(usize, std::process::Child)> = (0..12)
         .map(|i| {
             let child = Command::new(env!("CARGO_BIN_EXE_ratecal"))
@@ -691,7 +703,7 @@ fn concurrent_numbering(dir: &Path, archive: &str) {
     );
 }
 
-fn copy_dir(from: &Path, to: &Path) {
+pub(crate) fn copy_dir(from: &Path, to: &Path) {
     std::fs::create_dir_all(to).unwrap();
     for e in std::fs::read_dir(from).unwrap() {
         let e = e.unwrap();
@@ -830,13 +842,13 @@ fn a_logo_that_cannot_be_read_is_refused_at_its_key() {
 // -- issue 37 item 2: the number bound to its content ------------------------------------
 
 /// `PREFIX-YYYY-NNNNNN` of the example lab for sequence number `n`, this year.
-fn numbered(n: u32) -> String {
+pub(crate) fn numbered(n: u32) -> String {
     let year = &ratecal_recording::rfc3339(std::time::SystemTime::now())[..4];
     format!("EICL-{year}-{n:06}")
 }
 
 /// `args` then `more`.
-fn with<'a>(args: &[&'a str], more: &[&'a str]) -> Vec<&'a str> {
+pub(crate) fn with<'a>(args: &[&'a str], more: &[&'a str]) -> Vec<&'a str> {
     [args, more].concat()
 }
 
@@ -846,12 +858,13 @@ fn verify_pdf(dir: &Path, pdf: &str) -> Output {
 }
 
 /// The help of a diagnostic, read unwrapped (miette wraps long help lines).
-fn unwrapped(o: &Output) -> String {
+pub(crate) fn unwrapped(o: &Output) -> String {
     flat(&text(o)).replace("- ", "-")
 }
 
-/// Approves `name` in `dir` with the key `keys/lab.key` (made when missing).
-fn approve(dir: &Path, name: &str) {
+/// Approves `name` in `dir` with the key `keys/lab.key` (made when missing), the key of
+/// the signer [`lab_in`] lists.
+pub(crate) fn approve(dir: &Path, name: &str) {
     if !dir.join("keys/lab.key").exists() {
         let o = ratecal(&["key", "new", "keys"], dir);
         assert_eq!(code(&o), 0, "{}", text(&o));

@@ -136,7 +136,8 @@ fn a_certificate_reads_back_whole_and_in_order_in_pdftotext_and_pypdf() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     approved_run(&bin, dir);
-    let lab = concat!(env!("CARGO_MANIFEST_DIR"), "/docs/examples/lab.yaml");
+    let lab = crate::certificate_cli::lab_in(dir);
+    let lab = lab.as_str();
     let started = Instant::now();
     let o = run(
         &bin,

@@ -13,6 +13,7 @@ mod archive_cli;
 mod archive_pg;
 mod audit_cli;
 mod bounded_cli;
+mod certificate_assessor;
 mod certificate_cli;
 mod certificate_pdf;
 mod cli_analyze;

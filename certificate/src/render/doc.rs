@@ -2,7 +2,7 @@
 //! PDF) walks the same blocks, so the formats hold the same content.
 
 use crate::budget::TermStatus;
-use crate::model::{Certificate, END_MARK, REPRODUCTION};
+use crate::model::{Certificate, END_MARK, ITEM_ONLY, REPRODUCTION};
 use crate::units::with_unit;
 
 /// One block of the certificate's body.
@@ -102,10 +102,19 @@ pub fn blocks(c: &Certificate) -> Vec<Block> {
     let st = &id.station;
     b.push(Block::Fields(vec![
         ("Customer".into(), or_not_stated(&id.customer)),
+        (
+            "Customer address".into(),
+            or_not_stated(&id.customer_address),
+        ),
         ("Order".into(), or_not_stated(&id.order)),
         ("Item".into(), format!("IMU {}", id.item_model)),
         ("Serial number".into(), id.item_serial.clone()),
         ("Grade".into(), id.item_grade.clone()),
+        ("Date of receipt".into(), or_not_stated(&id.item_received)),
+        (
+            "Condition on receipt".into(),
+            or_not_stated(&id.item_condition),
+        ),
         ("Procedure".into(), proc),
         (
             "Station".into(),
@@ -143,8 +152,19 @@ pub fn blocks(c: &Certificate) -> Vec<Block> {
             )
         })
         .unwrap_or_else(|| "not recorded".into());
+    let imu_temp = m
+        .imu_temperature_c
+        .map(|[lo, hi]| {
+            format!(
+                "range {} to {}",
+                with_unit(&num(lo), "degC"),
+                with_unit(&num(hi), "degC")
+            )
+        })
+        .unwrap_or_else(|| "not stated".into());
     b.push(Block::Fields(vec![
         ("Ambient temperature".into(), temp),
+        ("IMU temperature".into(), imu_temp),
         (
             "Gravity".into(),
             format!(
@@ -182,6 +202,46 @@ pub fn blocks(c: &Certificate) -> Vec<Block> {
             .map(|r| vec![r.quantity.clone(), r.text.clone()])
             .collect(),
     ));
+    b.push(Block::Heading("Measurement points".into()));
+    if c.measurement_points.is_empty() {
+        b.push(Block::Para("Measurement points: not stated.".into()));
+    } else {
+        b.push(Block::Para(
+            "At each attitude and rate point: the reference the table applied on the IMU's \
+             principal channel, the IMU's mean raw reading, the error (reading - reference) \
+             and its expanded uncertainty U (k = 2: the reading's scatter and the reference's \
+             stated uncertainty); consistent when the calibrated model explains the reading \
+             within U."
+                .into(),
+        ));
+        b.push(Block::Table(
+            [
+                "Point",
+                "Channel",
+                "Reference",
+                "Reading",
+                "Error",
+                "U",
+                "Verdict",
+            ]
+            .map(String::from)
+            .to_vec(),
+            c.measurement_points
+                .iter()
+                .map(|p| {
+                    vec![
+                        format!("{} ({})", p.segment, p.condition),
+                        p.channel.clone(),
+                        with_unit(&num(p.reference), &p.unit),
+                        with_unit(&num(p.reading), &p.unit),
+                        with_unit(&num(p.error), &p.unit),
+                        with_unit(&num(p.expanded), &p.unit),
+                        p.verdict.replace('_', " "),
+                    ]
+                })
+                .collect(),
+        ));
+    }
     if let Some(conf) = &c.conformity {
         b.push(Block::Heading("Statements of conformity".into()));
         b.push(Block::Para(format!("Decision rule: {}.", conf.rule)));
@@ -212,17 +272,51 @@ pub fn blocks(c: &Certificate) -> Vec<Block> {
     }
     let t = &c.traceability;
     b.push(Block::Heading("Traceability".into()));
-    b.push(Block::Fields(vec![(
-        "Reference standard".into(),
-        format!(
-            "rate table {}, calibration certificate {}, issued by {}, due {}",
-            c.identification.station.table_model,
-            or_not_stated(&t.certificate),
-            or_not_stated(&t.issued_by),
-            or_not_stated(&t.due)
-        ),
-    )]));
+    b.push(Block::Table(
+        [
+            "Reference standard",
+            "Certificate",
+            "Issued by",
+            "Due",
+            "Status",
+        ]
+        .map(String::from)
+        .to_vec(),
+        t.references
+            .iter()
+            .map(|r| {
+                vec![
+                    if r.standard == "rate table" {
+                        format!("rate table {}", c.identification.station.table_model)
+                    } else {
+                        r.standard.clone()
+                    },
+                    or_not_stated(&r.certificate),
+                    or_not_stated(&r.issued_by),
+                    r.due
+                        .as_ref()
+                        .map(|d| format!("due {d}"))
+                        .unwrap_or_else(|| "not stated".into()),
+                    match r.valid {
+                        Some(true) => "in date".into(),
+                        Some(false) => "expired".into(),
+                        None => "not stated".into(),
+                    },
+                ]
+            })
+            .collect(),
+    ));
     b.push(Block::Para(t.statement.clone()));
+    b.push(Block::Heading("Deviations".into()));
+    if c.deviations.is_empty() {
+        b.push(Block::Para(
+            "None: the run gave no warning and no refusal was overridden.".into(),
+        ));
+    } else {
+        for d in &c.deviations {
+            b.push(Block::Para(d.clone()));
+        }
+    }
     if !c.notes.is_empty() {
         b.push(Block::Heading("Notes".into()));
         for n in &c.notes {
@@ -292,6 +386,7 @@ pub fn blocks(c: &Certificate) -> Vec<Block> {
                 .collect(),
         ));
     }
+    b.push(Block::Para(ITEM_ONLY.into()));
     b.push(Block::Para(REPRODUCTION.into()));
     b.push(Block::Para(format!("{END_MARK} {}", c.number_text())));
     b

@@ -37,6 +37,10 @@ pub struct Station {
     /// The data acquisition's timing (the certificate's budget).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub daq: Option<DaqSpec>,
+    /// The reference standards besides the table (a certificate names them with their
+    /// calibrations): the DAQ's timebase, the gravity survey, the thermometer.
+    #[serde(default)]
+    pub references: ReferencesSpec,
     /// Faults to rehearse aborts with (simulated station only).
     #[serde(default)]
     pub faults: Vec<FaultSpec>,
@@ -195,7 +199,24 @@ pub struct TemperatureCoefficients {
     pub gyro_scale: Option<f64>,
 }
 
-/// The table's calibration certificate (`table.calibration`).
+/// The reference standards other than the table (`references`), each optional: their
+/// calibration certificates, as a certificate lists them.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReferencesSpec {
+    /// The DAQ's timebase (the clock that times the samples).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub daq_timebase: Option<TableCalibration>,
+    /// The survey that gives the site's gravity (`site.gravity_mps2`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gravity_survey: Option<TableCalibration>,
+    /// The thermometer that records the temperatures.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thermometer: Option<TableCalibration>,
+}
+
+/// A reference standard's calibration certificate (`table.calibration`, and each of
+/// `references`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TableCalibration {

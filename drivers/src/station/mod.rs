@@ -16,9 +16,9 @@ pub use edit::{SetValue, edit, locate, number};
 pub use effects::{EffectsSpec, TableEffectsSpec};
 pub use faults::{AxisName, DropoutMode, FaultSpec, LinkName, TableFaultMode};
 pub use file::{
-    AmbientSpec, DaqSpec, EnvironmentSpec, ImuSpec, ImuTemperatureSpec, MountSpec, SettlingSpec,
-    SiteSpec, Station, TableCalibration, TableSpec, TemperatureCoefficients, TemperatureSpec,
-    UserEffectRef, UserTerms,
+    AmbientSpec, DaqSpec, EnvironmentSpec, ImuSpec, ImuTemperatureSpec, MountSpec, ReferencesSpec,
+    SettlingSpec, SiteSpec, Station, TableCalibration, TableSpec, TemperatureCoefficients,
+    TemperatureSpec, UserEffectRef, UserTerms,
 };
 pub use quantity::{
     Accel, AccelDensity, Angle, Freq, Pressure, Rate, RateDensity, RateWalk, Ratio, Rotation, Temp,
