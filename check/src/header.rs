@@ -383,7 +383,10 @@ impl Ck<'_> {
                 };
                 ("not a calibrated parameter", help)
             } else {
-                ("not a quantity ratecal computes", suggest(&name.node, &names))
+                (
+                    "not a quantity ratecal computes",
+                    suggest(&name.node, &names),
+                )
             };
             self.err(
                 Diagnostic::error(
@@ -618,9 +621,17 @@ impl Ck<'_> {
 }
 
 /// IMU grades from the lowest: a class's rank, `None` for a name not in the scale.
-const GRADES: [&str; 5] = ["consumer", "industrial", "tactical", "navigation", "strategic"];
+const GRADES: [&str; 5] = [
+    "consumer",
+    "industrial",
+    "tactical",
+    "navigation",
+    "strategic",
+];
 
 fn grade_rank(name: &str) -> Option<usize> {
     let n = name.trim().to_ascii_lowercase();
-    GRADES.iter().position(|g| n == *g || n == format!("{g}-grade"))
+    GRADES
+        .iter()
+        .position(|g| n == *g || n == format!("{g}-grade"))
 }

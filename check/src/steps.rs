@@ -605,9 +605,7 @@ impl Ck<'_> {
                 self.err(
                     Diagnostic::error(
                         "check::unsettled",
-                        format!(
-                            "this settle cannot bring the table within `{rule}`"
-                        ),
+                        format!("this settle cannot bring the table within `{rule}`"),
                     )
                     .label(at, "its attitude limit is looser than the abort rule's")
                     .label(a.span, "the acquisition after it")
@@ -625,5 +623,10 @@ impl Ck<'_> {
 /// `table.attitude_error > 5 arcsec for 1 s`).
 fn limit_text(rule: &str) -> String {
     let after = rule.split_once('>').map_or(rule, |x| x.1).trim();
-    after.split(" for ").next().unwrap_or(after).trim().to_string()
+    after
+        .split(" for ")
+        .next()
+        .unwrap_or(after)
+        .trim()
+        .to_string()
 }

@@ -74,15 +74,11 @@ pub fn sign_text(key: &SigningKey, text: &str) -> (String, String) {
 /// Whether `signature` by `public_key` (both hex) signs `text`: `None` when it does,
 /// otherwise why not.
 pub fn text_signature_problem(public_key: &str, signature: &str, text: &str) -> Option<String> {
-    let key: Option<[u8; 32]> = hex::decode(public_key)
-        .ok()
-        .and_then(|b| b.try_into().ok());
+    let key: Option<[u8; 32]> = hex::decode(public_key).ok().and_then(|b| b.try_into().ok());
     let Some(key) = key.and_then(|k| VerifyingKey::from_bytes(&k).ok()) else {
         return Some("the public key is not an Ed25519 key".into());
     };
-    let bytes: Option<[u8; 64]> = hex::decode(signature)
-        .ok()
-        .and_then(|b| b.try_into().ok());
+    let bytes: Option<[u8; 64]> = hex::decode(signature).ok().and_then(|b| b.try_into().ok());
     let Some(bytes) = bytes else {
         return Some("the signature is not 64 bytes of hex".into());
     };

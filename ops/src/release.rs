@@ -196,13 +196,15 @@ pub fn release(spec: &str, signer: &str, key: &Path) -> Result<String, Report> {
         ));
     }
     let lock_path = dir.join(LOCK_FILE);
-    let lock_text = std::fs::read_to_string(&lock_path).unwrap_or_else(|_| {
-        versions::render_lock(&[])
-    });
+    let lock_text =
+        std::fs::read_to_string(&lock_path).unwrap_or_else(|_| versions::render_lock(&[]));
     let (entries, errors) = parse_lock(&lock_path.display().to_string(), &lock_text);
     if let Some(e) = errors.first() {
         report(e);
-        return Err(miette!("{}: fix the lock first; nothing released", lock_path.display()));
+        return Err(miette!(
+            "{}: fix the lock first; nothing released",
+            lock_path.display()
+        ));
     }
     let v = Version::parse(version).ok_or_else(|| miette!("`{version}` is not a version"))?;
     if let Some(e) = entries
@@ -216,7 +218,10 @@ pub fn release(spec: &str, signer: &str, key: &Path) -> Result<String, Report> {
             describe(e)
         ));
     }
-    if let Some(top) = entries.iter().filter_map(|e| Version::parse(&e.version)).max()
+    if let Some(top) = entries
+        .iter()
+        .filter_map(|e| Version::parse(&e.version))
+        .max()
         && v <= top
     {
         return Err(miette!(

@@ -89,7 +89,10 @@ pub fn load(
 /// The station `ratecal check` compares a procedure with: the file given, or else the
 /// embedded one `ratecal run` would use for it (`run::setup::builtin_for`); its limits and
 /// how it is named in `check`'s output.
-pub fn for_check(path: Option<&Path>, procedure_text: &str) -> Result<(StationLimits, String), Report> {
+pub fn for_check(
+    path: Option<&Path>,
+    procedure_text: &str,
+) -> Result<(StationLimits, String), Report> {
     let (yaml, name, described) = match path {
         Some(p) => {
             let yaml = std::fs::read_to_string(p)

@@ -132,8 +132,7 @@ pub fn lock_line(version: &str, sha256: &str, signed: Option<&LockSignature>) ->
 
 fn is_hex(s: &str, len: usize) -> bool {
     s.len() == len
-        && s
-            .bytes()
+        && s.bytes()
             .all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b))
 }
 
@@ -154,9 +153,8 @@ pub fn parse_lock(path: &str, text: &str) -> (Vec<LockEntry>, Vec<Diagnostic>) {
         let lead = content.len() - content.trim_start().len();
         let span = (start + lead, trimmed.len());
         let fields: Vec<&str> = trimmed.split_whitespace().collect();
-        let head = fields.len() >= 2
-            && Version::parse(fields[0]).is_some()
-            && is_hex(fields[1], 64);
+        let head =
+            fields.len() >= 2 && Version::parse(fields[0]).is_some() && is_hex(fields[1], 64);
         let signed = if fields.len() >= 5 && is_hex(fields[2], 64) && is_hex(fields[3], 128) {
             // The signer is the rest of the line after the signature, spaces kept.
             let sig_end = trimmed.find(fields[3]).map_or(0, |k| k + fields[3].len());
@@ -336,7 +334,12 @@ pub fn unreleased_file(
     }
     let sha = ratecal_grammar::canonical(text).ok()?.sha256;
     let v = version.to_string();
-    Some(unreleased(&source(path, text), version_span(text, &v), &v, &sha))
+    Some(unreleased(
+        &source(path, text),
+        version_span(text, &v),
+        &v,
+        &sha,
+    ))
 }
 
 /// `versions::no_lock` (warning): no lock at all.

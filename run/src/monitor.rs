@@ -81,11 +81,10 @@ impl RuleState {
     /// converted to that unit (to five significant digits, as a limit is written).
     fn shown(&self, signal: Signal, values: &[f64]) -> String {
         let (name, internal) = signal_parts(signal);
-        let (unit, conv): (&str, Vec<f64>) =
-            match self.rule.in_written_unit(1.0) {
-                Some((k, unit)) => (unit, values.iter().map(|x| x * k).collect()),
-                None => (internal, values.to_vec()),
-            };
+        let (unit, conv): (&str, Vec<f64>) = match self.rule.in_written_unit(1.0) {
+            Some((k, unit)) => (unit, values.iter().map(|x| x * k).collect()),
+            None => (internal, values.to_vec()),
+        };
         let list: Vec<String> = conv.iter().map(|x| significant(*x, 5)).collect();
         format!("{name} ({unit}) = [{}]", list.join(", "))
     }

@@ -38,7 +38,10 @@ fn check_names_the_station_it_checked_on() {
         "{}",
         text(&o)
     );
-    let st = format!("{}/drivers/stations/default.yaml", env!("CARGO_MANIFEST_DIR"));
+    let st = format!(
+        "{}/drivers/stations/default.yaml",
+        env!("CARGO_MANIFEST_DIR")
+    );
     let o = check(
         tmp.path(),
         &STATIC.replace("SETTLE", SETTLED),
@@ -59,7 +62,11 @@ fn a_rate_above_the_imu_range_is_refused_without_station() {
         "{}",
         text(&o)
     );
-    assert!(text(&o).contains("checked on <default station>"), "{}", text(&o));
+    assert!(
+        text(&o).contains("checked on <default station>"),
+        "{}",
+        text(&o)
+    );
 }
 
 #[test]
@@ -77,7 +84,10 @@ fn an_angle_beyond_the_stations_travel_is_refused_at_the_angle() {
     assert_eq!(code(&o), 1, "{}", text(&o));
     let t = text(&o);
     assert!(t.contains("check::station_limit"), "{t}");
-    assert!(t.contains("beyond the travel of the table's outer axis"), "{t}");
+    assert!(
+        t.contains("beyond the travel of the table's outer axis"),
+        "{t}"
+    );
     assert!(t.contains("p.rcal:7:19"), "located at `405 deg`: {t}");
     assert!(t.contains("-180 deg .. 180 deg"), "{t}");
     // Within the travel: accepted; the default station states none.

@@ -30,16 +30,25 @@ fn a_piped_run_says_each_step_and_each_minute() {
     let err = String::from_utf8_lossy(&o.stderr).into_owned();
     let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("[wall ")).collect();
     assert!(
-        lines.iter().any(|l| l.contains("| simulated 0:00:00") && l.contains("step 1 rest: started")),
+        lines
+            .iter()
+            .any(|l| l.contains("| simulated 0:00:00") && l.contains("step 1 rest: started")),
         "{err}"
     );
     let within: Vec<&&str> = lines
         .iter()
         .filter(|l| l.contains("step 1 rest: running"))
         .collect();
-    assert_eq!(within.len(), 2, "one line per minute of the long step: {err}");
+    assert_eq!(
+        within.len(),
+        2,
+        "one line per minute of the long step: {err}"
+    );
     assert!(within[0].contains("simulated 0:01:0"), "{err}");
-    assert!(lines.iter().any(|l| l.contains("step 2 tilt: started")), "{err}");
+    assert!(
+        lines.iter().any(|l| l.contains("step 2 tilt: started")),
+        "{err}"
+    );
     assert!(
         !lines.iter().any(|l| l.contains("step 2 tilt: running")),
         "a short step has no minute lines: {err}"
@@ -51,7 +60,15 @@ fn json_lines_carry_stable_keys() {
     let tmp = tempfile::tempdir().unwrap();
     std::fs::write(tmp.path().join("p.rcal"), LONG).unwrap();
     let o = ratecal(
-        &["run", "p.rcal", "--dry-run", "--out", "r", "--log-format", "json"],
+        &[
+            "run",
+            "p.rcal",
+            "--dry-run",
+            "--out",
+            "r",
+            "--log-format",
+            "json",
+        ],
         tmp.path(),
     );
     assert_eq!(code(&o), 0, "{}", text(&o));
@@ -77,5 +94,9 @@ fn json_lines_carry_stable_keys() {
     }
     assert_eq!(first["clock"], "simulated");
     assert_eq!(first["step"], "rest");
-    assert!(events[1]["run_s"].as_f64().unwrap() >= 60.0, "{}", events[1]);
+    assert!(
+        events[1]["run_s"].as_f64().unwrap() >= 60.0,
+        "{}",
+        events[1]
+    );
 }

@@ -22,7 +22,14 @@ fn folder(dir: &Path) -> std::path::PathBuf {
 
 fn release(dir: &Path, spec: &str) -> std::process::Output {
     ratecal(
-        &["release", spec, "--signer", "Ada Lovelace", "--key", "keys/lab.key"],
+        &[
+            "release",
+            spec,
+            "--signer",
+            "Ada Lovelace",
+            "--key",
+            "keys/lab.key",
+        ],
         dir,
     )
 }
@@ -147,5 +154,9 @@ fn the_folder_runs_its_newest_release_and_a_draft_needs_draft() {
     // No certificate for it, whatever else is given (refused before anything else).
     let o = ratecal(&["certificate", "r3", "--lab", "no-such-lab.yaml"], dir);
     assert_eq!(code(&o), 1, "{}", text(&o));
-    assert!(text(&o).contains("certificate::draft_procedure"), "{}", text(&o));
+    assert!(
+        text(&o).contains("certificate::draft_procedure"),
+        "{}",
+        text(&o)
+    );
 }

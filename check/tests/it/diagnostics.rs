@@ -5,8 +5,7 @@ use ratecal_check::{CheckOptions, NoImports, check_text};
 use ratecal_grammar::Diagnostic;
 
 fn refused(text: &str) -> Vec<Diagnostic> {
-    let d = check_text("p.rcal", text, &NoImports, &CheckOptions::default())
-        .expect_err("refused");
+    let d = check_text("p.rcal", text, &NoImports, &CheckOptions::default()).expect_err("refused");
     d.into_iter().filter(Diagnostic::is_error).collect()
 }
 
@@ -46,7 +45,10 @@ fn a_misspelt_parameter_is_matched_against_parameters() {
         .find(|d| d.message.contains("accel.residual.sdt"))
         .expect("the misspelt quantity is refused");
     assert!(
-        sdt.help.as_deref().unwrap_or("").contains("`accel.residual.std`"),
+        sdt.help
+            .as_deref()
+            .unwrap_or("")
+            .contains("`accel.residual.std`"),
         "{sdt:?}"
     );
 }

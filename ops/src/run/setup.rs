@@ -145,7 +145,10 @@ pub fn draft(path: &Path, allowed: bool) -> Result<Option<String>, Report> {
         .and_then(|n| ratecal_plan::versions::version_of_file_name(&n.to_string_lossy()))
         .map(|v| v.to_string())
         .unwrap_or_default();
-    let folder = path.parent().map(|p| p.display().to_string()).unwrap_or_default();
+    let folder = path
+        .parent()
+        .map(|p| p.display().to_string())
+        .unwrap_or_default();
     if !allowed {
         return Err(miette!(
             code = "run::unreleased",

@@ -79,17 +79,19 @@ pub fn main(a: Args) -> ExitCode {
     let json = a.log_format == "json";
     ExitCode::from(run(
         request,
-        Box::new(move |estimated_s, simulated| -> Box<dyn ratecal_ops::run::Shown> {
-            use std::io::IsTerminal;
-            if json || !std::io::stderr().is_terminal() {
-                Box::new(ratecal_ops::run::log::LogLines::new(
-                    estimated_s,
-                    simulated,
-                    json,
-                ))
-            } else {
-                Box::new(progress::Bar::new(estimated_s, simulated))
-            }
-        }),
+        Box::new(
+            move |estimated_s, simulated| -> Box<dyn ratecal_ops::run::Shown> {
+                use std::io::IsTerminal;
+                if json || !std::io::stderr().is_terminal() {
+                    Box::new(ratecal_ops::run::log::LogLines::new(
+                        estimated_s,
+                        simulated,
+                        json,
+                    ))
+                } else {
+                    Box::new(progress::Bar::new(estimated_s, simulated))
+                }
+            },
+        ),
     ))
 }
