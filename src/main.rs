@@ -45,6 +45,8 @@ enum Command {
     Diff(cli::diff::Args),
     /// Every version of a procedure folder, with hashes and summaries.
     Log(cli::log::Args),
+    /// Release a procedure version: its signed line in the folder's versions.lock.
+    Release(cli::release::Args),
     /// Check a run folder against its seal (and the lab's signature with --key).
     Verify(cli::verify::Args),
     /// Locate where a recording and the nominal model disagree and name the physics left out.
@@ -73,6 +75,7 @@ fn main() -> ExitCode {
         Command::Report(a) => cli::report::main(a),
         Command::Diff(a) => cli::diff::main(a),
         Command::Log(a) => cli::log::main(a),
+        Command::Release(a) => cli::release::main(a),
         Command::Verify(a) => cli::verify::main(a),
         Command::Explain(a) => cli::explain::main(a),
         Command::Key(a) => cli::key::main(a),

@@ -75,6 +75,10 @@ pub struct Results {
     /// verdict, the report and the certificate state these `U` and `k`.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub budgets: Vec<crate::budget::Budget>,
+    /// Set when the run's procedure was a draft (`run --draft`): the manifest's
+    /// `DRAFT PROCEDURE: ...` sentence, repeated for every reader of the results.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub draft_procedure: Option<String>,
 }
 
 /// How a recording without a table was calibrated (docs/results.md, `manual`).

@@ -3,7 +3,7 @@
 
 use super::Ck;
 use super::steps::FitCheck;
-use super::values::suggest;
+use super::values::{did_you_mean, suggest};
 use ratecal_grammar::ast::{self, Cond, EnvBound, ProcItem, Span};
 use ratecal_grammar::{Diagnostic, format_abort};
 use ratecal_plan::derived::parameter_dim;
@@ -94,7 +94,10 @@ impl Ck<'_> {
     pub(crate) fn header_item(&mut self, item: &ProcItem, plan: &mut Plan) {
         match item {
             ProcItem::Title(t) => plan.title = t.node.clone(),
-            ProcItem::ImuClass(c) => plan.imu_class = Some(c.node.clone()),
+            ProcItem::ImuClass(c) => {
+                self.imu_class(c);
+                plan.imu_class = Some(c.node.clone());
+            }
             ProcItem::Reference(r) => plan.references.push(r.node.clone()),
             ProcItem::Meta(k, v) => {
                 plan.meta.insert(k.node.clone(), v.node.clone());
@@ -251,6 +254,7 @@ impl Ck<'_> {
     }
 
     pub(crate) fn abort(&mut self, a: &ast::Abort) -> Option<AbortRule> {
+        let mut unit = String::new();
         let condition = match &a.cond {
             Cond::Cmp(p, op, v) => {
                 let (signal, dim) = self.signal(p)?;
@@ -262,26 +266,37 @@ impl Ck<'_> {
                     );
                     return None;
                 }
+                let q = self.quantity(v, dim, "an abort limit")?;
+                unit = q.unit;
                 AbortCondition::Above {
                     signal,
-                    limit: self.quantity(v, dim, "an abort limit")?.value,
+                    limit: q.value,
                 }
             }
             Cond::Outside(p, lo, hi) => {
                 let (signal, dim) = self.signal(p)?;
                 let lo = self.quantity(lo, dim, "the lower end");
                 let hi = self.quantity(hi, dim, "the upper end");
+                let (lo, hi) = (lo?, hi?);
+                if lo.unit == hi.unit {
+                    unit = lo.unit;
+                }
                 AbortCondition::Outside {
                     signal,
-                    lo: lo?.value,
-                    hi: hi?.value,
+                    lo: lo.value,
+                    hi: hi.value,
                 }
             }
             Cond::Drifts(p, _, v) => {
                 let (signal, dim) = self.signal(p)?;
+                let q = self.tolerance(v, dim)?;
+                // A temperature difference in K is one in degC: say it in degC.
+                if q.unit != "K" {
+                    unit = q.unit;
+                }
                 AbortCondition::Drifts {
                     signal,
-                    limit: self.tolerance(v, dim)?.value,
+                    limit: q.value,
                 }
             }
             Cond::Abnormal(p) => {
@@ -324,6 +339,7 @@ impl Ck<'_> {
             condition,
             persistence_s,
             action,
+            unit,
         })
     }
 
@@ -356,16 +372,59 @@ impl Ck<'_> {
             .map(|&(n, d)| (n.to_string(), d))
             .or_else(|| parameter_dim(&name.node).map(|d| (name.node.clone(), d)));
         if found.is_none() {
+            // Suggest from the namespace the name is shaped like: a parameter
+            // (`accel.bais.x`) among parameters, a computed quantity among those.
+            let params = ratecal_plan::derived::parameter_names();
+            let param_refs: Vec<&str> = params.iter().map(String::as_str).collect();
+            let (label, help) = if ratecal_plan::derived::looks_like_parameter(&name.node) {
+                let help = match did_you_mean(&name.node, param_refs.iter().copied()) {
+                    Some(c) => format!("did you mean the parameter `{c}`?"),
+                    None => "name a calibrated parameter (`accel.bias.x`, `gyro.scale.y`, `gyro.misalignment.xy`); docs/language.md lists them".to_string(),
+                };
+                ("not a calibrated parameter", help)
+            } else {
+                (
+                    "not a quantity ratecal computes",
+                    suggest(&name.node, &names),
+                )
+            };
             self.err(
                 Diagnostic::error(
                     "check::unknown_name",
                     format!("unknown quantity `{}`", name.node),
                 )
-                .label(name.span, "not a quantity ratecal computes")
-                .help(suggest(&name.node, &names)),
+                .label(name.span, label)
+                .help(help),
             );
         }
         found
+    }
+
+    /// `imu class C` on a station whose IMU is of a lower grade: a warning (the procedure's
+    /// limits were written for a better IMU).
+    fn imu_class(&mut self, c: &ast::Ident) {
+        let Some(grade) = self.station.as_ref().map(|s| s.imu_grade.clone()) else {
+            return;
+        };
+        let (Some(asked), Some(has)) = (grade_rank(&c.node), grade_rank(&grade)) else {
+            return;
+        };
+        if has < asked {
+            self.err(
+                Diagnostic::warning(
+                    "check::imu_class",
+                    format!(
+                        "the procedure is for a {} IMU; the station's IMU is {grade}",
+                        c.node
+                    ),
+                )
+                .label(c.span, format!("asks for {} grade", c.node))
+                .help(format!(
+                    "its limits were written for a {} IMU: a {grade} one may fail them; use a procedure for {grade} IMUs or a station with a {} IMU",
+                    c.node, c.node
+                )),
+            );
+        }
     }
 
     pub(crate) fn verify(&mut self, v: &ast::Verify) -> Option<Verification> {
@@ -559,4 +618,20 @@ impl Ck<'_> {
             using: f.using.clone(),
         });
     }
+}
+
+/// IMU grades from the lowest: a class's rank, `None` for a name not in the scale.
+const GRADES: [&str; 5] = [
+    "consumer",
+    "industrial",
+    "tactical",
+    "navigation",
+    "strategic",
+];
+
+fn grade_rank(name: &str) -> Option<usize> {
+    let n = name.trim().to_ascii_lowercase();
+    GRADES
+        .iter()
+        .position(|g| n == *g || n == format!("{g}-grade"))
 }

@@ -12,7 +12,10 @@
 //! `check::duplicate_step`, `check::duplicate_segment`, `check::duplicate_param`,
 //! `check::segment_in_repeat`, `check::bad_segment_name`, `check::no_segment`,
 //! `check::loop_arity`, `check::expansion_too_large`, `check::unobservable`,
-//! `check::station_limit`, `check::manual_station`, `check::no_rest`, `check::import`, `check::structure`, `check::missing_runs`.
+//! `check::station_limit`, `check::manual_station`, `check::no_rest`, `check::import`, `check::structure`, `check::missing_runs`,
+//! `check::unsettled` (a static acquisition the table may not be settled for, against the
+//! attitude abort rules); warning `check::imu_class` (the station's IMU is of a lower
+//! grade than `imu class` asks for).
 
 mod accept;
 mod header;
@@ -69,6 +72,11 @@ pub struct StationLimits {
     /// Whether the station's table is the operator (`table.driver: manual`): `place` and
     /// `turn` instead of `move` and `spin`.
     pub manual: bool,
+    /// Travel of the outer and inner axes, deg (lowest, highest); `None`: the axis turns
+    /// without end.
+    pub travel_deg: [Option<(f64, f64)>; 2],
+    /// The grade of the station's IMU (`tactical`), empty when the station does not say.
+    pub imu_grade: String,
 }
 
 /// Options of a check.
@@ -260,6 +268,7 @@ impl<'a> Ck<'a> {
         self.finish_segments();
         self.fitted_against_model(&plan);
         self.observability(&plan);
+        self.settles_against_aborts(&plan);
         plan.estimated_duration_s = plan.steps.iter().map(|s| s.estimated_duration_s).sum();
         Some(plan)
     }

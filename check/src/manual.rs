@@ -211,7 +211,10 @@ impl Ck<'_> {
     ) -> Option<Action> {
         self.manual_statement(span, "turn");
         self.walk.time_s += TURN_S;
-        let id = self.segment_id(&segment.node, segment.span)?;
+        let Some(id) = self.segment_id(&segment.node, segment.span) else {
+            self.walk.incomplete = true;
+            return None;
+        };
         self.register_segment(&id, segment.span);
         let Some((face, angle)) = about else {
             return Some(Action::Turn(HandTurn {

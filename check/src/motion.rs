@@ -16,9 +16,9 @@ impl Ck<'_> {
         let mut pitch_roll = false;
         let mut ok = true;
         for a in angles {
-            let slot = match a.axis.node.as_str() {
-                "pitch" | "outer" => &mut outer,
-                "roll" | "inner" => &mut inner,
+            let (slot, index) = match a.axis.node.as_str() {
+                "pitch" | "outer" => (&mut outer, 0),
+                "roll" | "inner" => (&mut inner, 1),
                 other => {
                     self.err(
                         Diagnostic::error(
@@ -54,7 +54,10 @@ impl Ck<'_> {
                 |o: Span| if o == r.span { o } else { o.join(r.span) },
             ));
             match self.as_quantity(&r, &a.value, Dim::Angle, "a table angle") {
-                Some(q) => *slot = Some(q.value),
+                Some(q) => {
+                    self.travel_check(index, &q, r.span);
+                    *slot = Some(q.value);
+                }
                 None => ok = false,
             }
         }
@@ -116,7 +119,55 @@ impl Ck<'_> {
         }
     }
 
+    /// An angle within the station's travel of that axis (`index` 0 outer, 1 inner).
+    fn travel_check(&mut self, index: usize, q: &ratecal_plan::Quantity, span: Span) {
+        let Some((lo, hi)) = self.station.as_ref().and_then(|s| s.travel_deg[index]) else {
+            return;
+        };
+        if q.value >= lo - 1e-9 && q.value <= hi + 1e-9 {
+            return;
+        }
+        let (axis, key) = [("outer", "outer_travel"), ("inner", "inner_travel")][index];
+        self.err(
+            Diagnostic::error(
+                "check::station_limit",
+                format!("angle beyond the travel of the table's {axis} axis"),
+            )
+            .label(
+                span,
+                format!(
+                    "{} {}, the station's `table.{key}` is {lo} deg .. {hi} deg",
+                    q.written, q.unit
+                ),
+            )
+            .help("write the attitude within the axis's travel (an angle and the angle 360 deg away name the same attitude)"),
+        );
+    }
+
+    /// A spin or oscillation needs an axis that may turn that far: a spin one without end.
+    fn travel_spin(&mut self, ax: Axis, span: Span) {
+        let index = usize::from(ax == Axis::Inner);
+        let Some((lo, hi)) = self.station.as_ref().and_then(|s| s.travel_deg[index]) else {
+            return;
+        };
+        let (axis, key) = [("outer", "outer_travel"), ("inner", "inner_travel")][index];
+        self.err(
+            Diagnostic::error(
+                "check::station_limit",
+                format!("the table's {axis} axis cannot spin: its travel is limited"),
+            )
+            .label(
+                span,
+                format!("the station's `table.{key}` is {lo} deg .. {hi} deg"),
+            )
+            .help("spin an axis that turns without end, or run on a station whose table can"),
+        );
+    }
+
     pub(crate) fn spin(&mut self, ax: Axis, rate: f64, span: Span) {
+        if rate != 0.0 {
+            self.travel_spin(ax, span);
+        }
         let (_, a) = self.table_limits();
         let m = &mut self.walk.motion;
         let cur = match ax {

@@ -66,6 +66,11 @@ fn attitude_text(s: &SegInfo) -> String {
 impl Ck<'_> {
     pub(crate) fn observability(&mut self, plan: &Plan) {
         let fits = std::mem::take(&mut self.walk.fits);
+        if self.walk.incomplete {
+            // One error per cause: the statement that failed has been reported.
+            self.walk.verify_from.clear();
+            return;
+        }
         let segs = self.walk.segments.clone();
         for fc in &fits {
             let Some(spec) = plan.fits.get(fc.index) else {

@@ -89,6 +89,29 @@ pub(crate) struct Walk {
     pub max_list_len: u64,
     pub verify_from: Vec<ast::Spanned<String>>,
     pub manual: super::manual::ManualWalk,
+    /// A statement that records segments could not be checked (a loop over a list with
+    /// a wrong unit, a segment name naming nothing): which segments exist is unknown, so
+    /// matching fits and verifications against them would only repeat that error.
+    pub incomplete: bool,
+    /// The table statement no settle has followed yet.
+    pub unsettled: Option<Span>,
+    /// The attitude limit (deg) of the settle since the last table statement, and where.
+    pub settle_attitude: Option<(f64, Span)>,
+    /// Static acquisitions, for the check of their settles against the attitude aborts.
+    pub static_acquires: Vec<StaticAcquire>,
+}
+
+/// A static acquisition and how the table was brought to rest before it.
+#[derive(Debug, Clone)]
+pub(crate) struct StaticAcquire {
+    /// The acquisition.
+    pub span: Span,
+    /// The table statement it follows with no settle between them.
+    pub unsettled: Option<Span>,
+    /// The settle's attitude limit, deg, and where it is written.
+    pub settle_attitude: Option<(f64, Span)>,
+    /// The step's own attitude abort limit, deg, and its rule.
+    pub step_limit: Option<(f64, String)>,
 }
 
 pub(crate) fn move_time(dist_deg: f64, v: f64, a: f64) -> f64 {
@@ -216,8 +239,11 @@ impl Ck<'_> {
     ) {
         match s {
             Stmt::Move(..) | Stmt::Spin { .. } | Stmt::Stop(..) | Stmt::Oscillate { .. } => {
-                self.table_statement(span)
+                self.table_statement(span);
+                self.walk.unsettled = Some(span);
+                self.walk.settle_attitude = None;
             }
+            Stmt::SettleFor(..) | Stmt::Settle(..) => self.walk.unsettled = None,
             Stmt::Acquire { .. } => self.rest_missing(),
             _ => {}
         }
@@ -324,6 +350,7 @@ impl Ck<'_> {
             }
             Stmt::Settle(b) => {
                 let st = self.settle(b);
+                self.walk.settle_attitude = st.attitude_error_deg.map(|a| (a, span));
                 self.settled(&st);
                 self.walk.time_s += st.min_time_s;
                 out.push(Node::Do(Action::Settle(st)));
@@ -348,8 +375,20 @@ impl Ck<'_> {
                 }
                 let d = self.quantity(duration, Dim::Time, "an acquisition duration");
                 let r = self.quantity(rate, Dim::Frequency, "a sample rate");
+                if self.walk.motion.is_static() {
+                    let step_limit = attitude_limit(aborts);
+                    self.walk.static_acquires.push(StaticAcquire {
+                        span,
+                        unsettled: self.walk.unsettled,
+                        settle_attitude: self.walk.settle_attitude,
+                        step_limit,
+                    });
+                }
                 let id = self.segment_id(&segment.node, segment.span);
-                let Some(id) = id else { return };
+                let Some(id) = id else {
+                    self.walk.incomplete = true;
+                    return;
+                };
                 // Registered even when its duration or rate is wrong, so that fits naming
                 // it do not report a second, spurious error.
                 self.register_segment(&id, segment.span);
@@ -462,9 +501,11 @@ impl Ck<'_> {
         out: &mut Vec<Node>,
     ) {
         let Some(r) = self.resolve(list, None) else {
+            self.walk.incomplete = true;
             return;
         };
         let Val::List(items) = r.v else {
+            self.walk.incomplete = true;
             self.err(
                 Diagnostic::error("check::type_mismatch", "a `for` loop runs over a list")
                     .label(list.span, "not a list")
@@ -492,6 +533,7 @@ impl Ck<'_> {
                                     .join(", ")
                             )),
                         );
+                        self.walk.incomplete = true;
                         continue;
                     }
                 };
@@ -514,4 +556,77 @@ impl Ck<'_> {
             out.extend(nodes);
         }
     }
+}
+
+/// The tightest attitude-error abort limit among `rules` (deg), with its rule's text.
+pub(crate) fn attitude_limit(rules: &[ratecal_plan::AbortRule]) -> Option<(f64, String)> {
+    rules
+        .iter()
+        .filter_map(|r| match r.condition {
+            ratecal_plan::AbortCondition::Above {
+                signal: ratecal_plan::Signal::AttitudeError,
+                limit,
+            } if r.action == ratecal_plan::AbortAction::Abort => Some((limit, r.text.clone())),
+            _ => None,
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+}
+
+impl Ck<'_> {
+    /// Every static acquisition starts with the table within the procedure's attitude
+    /// limit (its abort rules on `table.attitude_error`): a settle must come between the
+    /// table statement and the acquisition, and its own attitude limit must not be looser.
+    pub(crate) fn settles_against_aborts(&mut self, plan: &Plan) {
+        let global = attitude_limit(&plan.aborts);
+        for a in std::mem::take(&mut self.walk.static_acquires) {
+            let limit = match (&global, &a.step_limit) {
+                (Some(g), Some(s)) => Some(if s.0 < g.0 { s.clone() } else { g.clone() }),
+                (g, s) => g.clone().or_else(|| s.clone()),
+            };
+            let Some((limit, rule)) = limit else { continue };
+            if let Some(moved) = a.unsettled {
+                self.err(
+                    Diagnostic::error(
+                        "check::unsettled",
+                        format!(
+                            "this static acquisition may start before the table is within `{rule}`"
+                        ),
+                    )
+                    .label(a.span, "acquires with no settle since the table last moved")
+                    .label(moved, "the table moves here")
+                    .help(format!(
+                        "settle between the two, e.g. `settle {{ at least 30 s  table.attitude_error <= {}  timeout 120 s -> abort }}`",
+                        limit_text(&rule)
+                    )),
+                );
+            } else if let Some((settle, at)) = a.settle_attitude
+                && settle > limit * (1.0 + 1e-9)
+            {
+                self.err(
+                    Diagnostic::error(
+                        "check::unsettled",
+                        format!("this settle cannot bring the table within `{rule}`"),
+                    )
+                    .label(at, "its attitude limit is looser than the abort rule's")
+                    .label(a.span, "the acquisition after it")
+                    .help(format!(
+                        "settle to `table.attitude_error <= {}` or tighter",
+                        limit_text(&rule)
+                    )),
+                );
+            }
+        }
+    }
+}
+
+/// The limit of an abort rule's text as written (`5 arcsec` of
+/// `table.attitude_error > 5 arcsec for 1 s`).
+fn limit_text(rule: &str) -> String {
+    let after = rule.split_once('>').map_or(rule, |x| x.1).trim();
+    after
+        .split(" for ")
+        .next()
+        .unwrap_or(after)
+        .trim()
+        .to_string()
 }

@@ -52,7 +52,9 @@ pub(crate) fn suggest(name: &str, candidates: &[&str]) -> String {
 
 impl Ck<'_> {
     /// Resolves a value: names are looked up in loop variables, then parameters.
-    pub(crate) fn resolve(&mut self, v: &Value, list_unit: Option<&str>) -> Option<RVal> {
+    /// `list_unit` is the unit written after an enclosing list, with its span (a unit
+    /// error is located on that unit, not on the number it applies to).
+    pub(crate) fn resolve(&mut self, v: &Value, list_unit: Option<(&str, Span)>) -> Option<RVal> {
         let span = v.span;
         let val = match &v.kind {
             ValueKind::Quantity { number, unit } => {
@@ -69,8 +71,11 @@ impl Ck<'_> {
                         return None;
                     }
                 };
-                let unit_name = unit.as_ref().map(|u| u.node.as_str()).or(list_unit);
-                let q = match unit_name {
+                let unit_at = unit
+                    .as_ref()
+                    .map(|u| (u.node.as_str(), u.span))
+                    .or(list_unit);
+                let q = match unit_at.map(|(u, _)| u) {
                     None => Quantity {
                         written,
                         unit: String::new(),
@@ -87,7 +92,7 @@ impl Ck<'_> {
                         None => {
                             let names: Vec<&str> =
                                 units::UNITS.iter().map(|(n, _, _)| *n).collect();
-                            let uspan = unit.as_ref().map_or(span, |u| u.span);
+                            let uspan = unit_at.map_or(span, |(_, s)| s);
                             self.err(
                                 Diagnostic::error(
                                     "check::unknown_unit",
@@ -120,7 +125,10 @@ impl Ck<'_> {
                 Val::Sym(n.clone())
             }
             ValueKind::List { items, unit } => {
-                let u = unit.as_ref().map(|u| u.node.as_str()).or(list_unit);
+                let u = unit
+                    .as_ref()
+                    .map(|u| (u.node.as_str(), u.span))
+                    .or(list_unit);
                 let mut out = Vec::with_capacity(items.len());
                 for i in items {
                     out.push(self.resolve(i, u)?);

@@ -29,7 +29,8 @@ mod traits;
 
 pub use registry::{DRIVERS, DriverKind, DriverSpec, Drivers, build};
 pub use station::{
-    DEFAULT_STATION_YAML, SWAYING_STATION_YAML, Station, StationError, StationInfo, yaml_offset,
+    DEFAULT_STATION_YAML, MANUAL_STATION_YAML, SWAYING_STATION_YAML, Station, StationError,
+    StationInfo, yaml_offset,
 };
 pub use traits::{
     DriverError, DriverErrorKind, ImuDriver, ImuInfo, ImuSample, LinkStats, OperatorAsk,

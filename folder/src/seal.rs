@@ -61,6 +61,33 @@ pub fn key_fingerprint(key: &VerifyingKey) -> String {
     format!("SHA256:{}", sha256_hex(key.as_bytes()))
 }
 
+/// Signs `text` with the lab's key: the public key and the signature, both hex (what a
+/// seal and a procedure's release line hold).
+pub fn sign_text(key: &SigningKey, text: &str) -> (String, String) {
+    let sig = key.sign(text.as_bytes());
+    (
+        hex::encode(key.verifying_key().as_bytes()),
+        hex::encode(sig.to_bytes()),
+    )
+}
+
+/// Whether `signature` by `public_key` (both hex) signs `text`: `None` when it does,
+/// otherwise why not.
+pub fn text_signature_problem(public_key: &str, signature: &str, text: &str) -> Option<String> {
+    let key: Option<[u8; 32]> = hex::decode(public_key).ok().and_then(|b| b.try_into().ok());
+    let Some(key) = key.and_then(|k| VerifyingKey::from_bytes(&k).ok()) else {
+        return Some("the public key is not an Ed25519 key".into());
+    };
+    let bytes: Option<[u8; 64]> = hex::decode(signature).ok().and_then(|b| b.try_into().ok());
+    let Some(bytes) = bytes else {
+        return Some("the signature is not 64 bytes of hex".into());
+    };
+    match key.verify(text.as_bytes(), &Signature::from_bytes(&bytes)) {
+        Ok(()) => None,
+        Err(_) => Some("the signature does not match".into()),
+    }
+}
+
 /// An Ed25519 signature and the public key that made it (both hex).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SealSignature {
@@ -146,11 +173,11 @@ impl Seal {
 
     /// Signs the sealed files with the lab's key.
     pub fn sign(&mut self, key: &SigningKey) {
-        let sig = key.sign(self.signed_text().as_bytes());
+        let (public_key, signature) = sign_text(key, &self.signed_text());
         self.signature = Some(SealSignature {
             algorithm: "ed25519".into(),
-            public_key: hex::encode(key.verifying_key().as_bytes()),
-            signature: hex::encode(sig.to_bytes()),
+            public_key,
+            signature,
         });
     }
 

@@ -48,6 +48,7 @@ fn manifest(files: &[(&str, &str)]) -> Manifest {
             failure: None,
             resumes: Vec::new(),
             changed_after_release: None,
+            draft_procedure: None,
             sync: None,
             write_failure: None,
         }),

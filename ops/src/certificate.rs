@@ -10,6 +10,23 @@ pub use ratecal_certificate::issue::Format;
 /// spec/cli.md. With `out`, the document is written aside before its number is recorded and
 /// renamed into place after: it appears only together with its recorded number.
 pub fn certificate(args: &Request, format: Format, out: Option<&Path>) -> u8 {
+    // A run of an unreleased procedure is no calibration: refused before anything else.
+    if let Some(draft) = ratecal_folder::RunFolder::new(&args.run_dir)
+        .manifest_quiet()
+        .and_then(|m| m.run)
+        .and_then(|r| r.draft_procedure)
+    {
+        errln!(
+            "{:?}",
+            miette::miette!(
+                code = "certificate::draft_procedure",
+                help = "release the procedure (`ratecal release FOLDER@VERSION --signer NAME --key KEY`) and run it again",
+                "{}: {draft}; no certificate for a draft procedure",
+                args.run_dir.display()
+            )
+        );
+        return 1;
+    }
     // An output never replaces an input: refused before a number is taken.
     if let Some(path) = out
         && let Err(e) =

@@ -20,6 +20,7 @@ pub mod certificate;
 pub mod console;
 pub mod explain;
 pub mod procedure;
+pub mod release;
 pub mod report;
 pub mod run;
 pub mod station;

@@ -34,8 +34,14 @@ pub fn versions(dir: &Path) -> Result<Vec<(String, PathBuf)>, Diagnostic> {
     Ok(files.into_iter().map(|(v, p)| (v.to_string(), p)).collect())
 }
 
-/// Resolves an argument to a file: a file, a folder's newest version, or `folder@version`.
+/// Resolves an argument to a file: a file, a folder's newest released version (its newest
+/// version when it releases none), or `folder@version`.
 pub fn resolve(arg: &str) -> Result<PathBuf, Diagnostic> {
+    resolve_for(arg, false)
+}
+
+/// As [`resolve`]; with `draft`, a folder stands for its newest version, released or not.
+pub fn resolve_for(arg: &str, draft: bool) -> Result<PathBuf, Diagnostic> {
     let path = Path::new(arg);
     if path.is_file() {
         return Ok(path.to_path_buf());
@@ -63,6 +69,9 @@ pub fn resolve(arg: &str) -> Result<PathBuf, Diagnostic> {
         }
     }
     if path.is_dir() {
+        if !draft && let Some(p) = crate::release::newest_released(path) {
+            return Ok(p);
+        }
         return match versions(path)?.pop() {
             Some((_, p)) => Ok(p),
             None => Err(Diagnostic::error(

@@ -86,6 +86,32 @@ pub fn load(
     Ok(effects)
 }
 
+/// The station `ratecal check` compares a procedure with: the file given, or else the
+/// embedded one `ratecal run` would use for it (`run::setup::builtin_for`); its limits and
+/// how it is named in `check`'s output.
+pub fn for_check(
+    path: Option<&Path>,
+    procedure_text: &str,
+) -> Result<(StationLimits, String), Report> {
+    let (yaml, name, described) = match path {
+        Some(p) => {
+            let yaml = std::fs::read_to_string(p)
+                .map_err(|e| miette!("cannot read station `{}`: {e}", p.display()))?;
+            (yaml, p.display().to_string(), p.display().to_string())
+        }
+        None => {
+            let (y, n) = crate::run::setup::builtin_for(procedure_text);
+            (
+                y.to_string(),
+                n.to_string(),
+                format!("{n} (built in; --station FILE for yours)"),
+            )
+        }
+    };
+    let st = Station::from_yaml(&yaml, &name).map_err(|e| Report::new(*e))?;
+    Ok((station_limits(&st), described))
+}
+
 /// The limits `check` compares a plan with, from a station description.
 pub fn station_limits(st: &Station) -> StationLimits {
     StationLimits {
@@ -95,5 +121,8 @@ pub fn station_limits(st: &Station) -> StationLimits {
         accel_range_mps2: st.imu.accel_range.get(),
         geometry: st.geometry(),
         manual: st.table.driver.kind.operator,
+        travel_deg: [st.table.outer_travel, st.table.inner_travel]
+            .map(|t| t.map(|[lo, hi]| (lo.get(), hi.get()))),
+        imu_grade: st.imu.grade.clone(),
     }
 }

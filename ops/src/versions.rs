@@ -62,10 +62,18 @@ pub fn folder_data(folder: &Path) -> std::io::Result<FolderData> {
     Ok(data)
 }
 
-/// The version rules of a procedure folder (`ratecal check FOLDER` calls this).
+/// The version rules of a procedure folder (`ratecal check FOLDER` calls this), and the
+/// signatures of its release lines.
 pub fn check_folder(folder: &Path) -> Vec<ratecal_grammar::Diagnostic> {
     match folder_data(folder) {
-        Ok(data) => versions::check_versions(&data),
+        Ok(data) => {
+            let mut out = versions::check_versions(&data);
+            if let Some(lock) = &data.lock {
+                let path = format!("{}/{LOCK_FILE}", data.path.trim_end_matches('/'));
+                out.extend(crate::release::bad_signatures(&path, lock));
+            }
+            out
+        }
         Err(e) => vec![
             ratecal_grammar::Diagnostic::error(
                 "io::read",

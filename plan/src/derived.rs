@@ -61,6 +61,29 @@ pub fn parameter_dim(name: &str) -> Option<Dim> {
     }
 }
 
+/// Every calibrated parameter a check may name (`accel.bias.x`, ..., `gyro.misalignment.zy`),
+/// for suggestions.
+pub fn parameter_names() -> Vec<String> {
+    ["accel", "gyro"]
+        .iter()
+        .flat_map(|s| {
+            ["bias", "scale", "misalignment"]
+                .iter()
+                .flat_map(move |q| vector(&format!("{s}.{q}")).map_or_else(Vec::new, |v| v.0))
+        })
+        .collect()
+}
+
+/// Whether `name` is shaped like a parameter (its last part a body axis or a pair of
+/// them: `accel.bais.x`), so that a misspelling is matched against parameters.
+pub fn looks_like_parameter(name: &str) -> bool {
+    let last = name.rsplit('.').next().unwrap_or_default();
+    name.contains('.')
+        && !last.is_empty()
+        && last.len() <= 2
+        && last.chars().all(|c| "xyz".contains(c))
+}
+
 /// The parameters of a triad (`accel.bias`, `gyro.misalignment`, `accel.misalignment.x`)
 /// and their dimension, `None` when `name` is not one.
 pub fn vector(name: &str) -> Option<(Vec<String>, Dim)> {

@@ -307,6 +307,27 @@ pub struct AbortRule {
     pub persistence_s: f64,
     /// What to do.
     pub action: AbortAction,
+    /// The unit its limit was written in (`arcsec`): messages state the live value in it.
+    /// Empty: the signal's internal unit.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub unit: String,
+}
+
+impl AbortRule {
+    /// A live value of the rule's signal (internal unit) in the unit its limit was written
+    /// in, and that unit; `None` when it was written in the internal unit or in one that
+    /// is not a plain multiple of it (`K` against degC).
+    pub fn in_written_unit(&self, internal: f64) -> Option<(f64, &str)> {
+        if self.unit.is_empty() {
+            return None;
+        }
+        let (_, one) = ratecal_physics::units::to_internal(1.0, &self.unit)?;
+        let (_, zero) = ratecal_physics::units::to_internal(0.0, &self.unit)?;
+        if zero != 0.0 || one == 0.0 || one == 1.0 {
+            return None;
+        }
+        Some((internal / one, &self.unit))
+    }
 }
 
 /// Conditions an abort rule can watch.

@@ -96,6 +96,44 @@ pub struct LockEntry {
     pub sha256: String,
     /// Byte range of the line in the lock text.
     pub span: (usize, usize),
+    /// Who released it and with which key, for a line `ratecal release` wrote; `None` for
+    /// an older hash-only line (still a release: unsigned).
+    pub signed: Option<LockSignature>,
+}
+
+/// The signature of a release line: the signer's Ed25519 public key and signature over
+/// [`release_message`].
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LockSignature {
+    /// Lowercase hex of the 32-byte public key.
+    pub public_key: String,
+    /// Lowercase hex of the 64-byte signature.
+    pub signature: String,
+    /// The signer's name (the rest of the line).
+    pub signer: String,
+}
+
+/// What a release signs: the folder's procedure version, its canonical hash and the signer.
+pub fn release_message(version: &str, sha256: &str, signer: &str) -> String {
+    format!("ratecal release\nversion {version}\nsha256 {sha256}\nsigner {signer}\n")
+}
+
+/// A line of `versions.lock`: `<version> <sha256>`, and for a signed release
+/// ` <public key hex> <signature hex> <signer>`.
+pub fn lock_line(version: &str, sha256: &str, signed: Option<&LockSignature>) -> String {
+    match signed {
+        None => format!("{version} {sha256}\n"),
+        Some(s) => format!(
+            "{version} {sha256} {} {} {}\n",
+            s.public_key, s.signature, s.signer
+        ),
+    }
+}
+
+fn is_hex(s: &str, len: usize) -> bool {
+    s.len() == len
+        && s.bytes()
+            .all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b))
 }
 
 /// Reads `versions.lock`: its entries, and a diagnostic per malformed line.
@@ -115,17 +153,25 @@ pub fn parse_lock(path: &str, text: &str) -> (Vec<LockEntry>, Vec<Diagnostic>) {
         let lead = content.len() - content.trim_start().len();
         let span = (start + lead, trimmed.len());
         let fields: Vec<&str> = trimmed.split_whitespace().collect();
-        let ok = fields.len() == 2
-            && Version::parse(fields[0]).is_some()
-            && fields[1].len() == 64
-            && fields[1]
-                .bytes()
-                .all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b));
-        if ok {
+        let head =
+            fields.len() >= 2 && Version::parse(fields[0]).is_some() && is_hex(fields[1], 64);
+        let signed = if fields.len() >= 5 && is_hex(fields[2], 64) && is_hex(fields[3], 128) {
+            // The signer is the rest of the line after the signature, spaces kept.
+            let sig_end = trimmed.find(fields[3]).map_or(0, |k| k + fields[3].len());
+            Some(LockSignature {
+                public_key: fields[2].into(),
+                signature: fields[3].into(),
+                signer: trimmed[sig_end..].trim().to_string(),
+            })
+        } else {
+            None
+        };
+        if head && (fields.len() == 2 || signed.is_some()) {
             entries.push(LockEntry {
                 version: fields[0].into(),
                 sha256: fields[1].into(),
                 span,
+                signed,
             });
         } else {
             errors.push(bad_lock_line(&src, span));
@@ -251,8 +297,8 @@ fn bad_lock_line(lock: &Source, at: (usize, usize)) -> Diagnostic {
         "versions::bad_lock_line",
         format!("malformed line in {LOCK_FILE}"),
     )
-    .label(span(at), "expected `<version> <sha256>`")
-    .help("each line is `<version> <64 lowercase hex digits>` or a # comment")
+    .label(span(at), "expected `<version> <sha256>` [`<key> <signature> <signer>`]")
+    .help("each line is `<version> <64 lowercase hex digits>` (`ratecal release` adds the key, signature and signer) or a # comment; write release lines with `ratecal release FOLDER@VERSION --signer NAME --key KEY`")
     .with_source(lock)
 }
 
@@ -264,9 +310,36 @@ fn unreleased(src: &Source, at: (usize, usize), version: &str, sha256: &str) -> 
     )
     .label(span(at), "a draft")
     .help(format!(
-        "to release it, add this line to {LOCK_FILE}: {version} {sha256}"
+        "release it with `ratecal release FOLDER@{version} --signer NAME --key lab.key` (its canonical hash is {sha256})"
     ))
     .with_source(src)
+}
+
+/// `versions::unreleased` (warning) for a version file named any way (a path, or
+/// `folder@version`): its folder's lock `lock_text` does not list it. `None` when it is
+/// released (or its name is not a version's).
+pub fn unreleased_file(
+    path: &str,
+    file_name: &str,
+    text: &str,
+    lock_text: &str,
+) -> Option<Diagnostic> {
+    let version = version_of_file_name(file_name)?;
+    let (entries, _) = parse_lock(LOCK_FILE, lock_text);
+    if entries
+        .iter()
+        .any(|e| Version::parse(&e.version).as_ref() == Some(&version))
+    {
+        return None;
+    }
+    let sha = ratecal_grammar::canonical(text).ok()?.sha256;
+    let v = version.to_string();
+    Some(unreleased(
+        &source(path, text),
+        version_span(text, &v),
+        &v,
+        &sha,
+    ))
 }
 
 /// `versions::no_lock` (warning): no lock at all.

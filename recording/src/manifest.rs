@@ -262,6 +262,10 @@ pub struct RunInfo {
     /// (`--allow-changed`): what changed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub changed_after_release: Option<String>,
+    /// Set when the procedure ran as a draft (`--draft`: a version its folder's
+    /// `versions.lock` does not release): `DRAFT PROCEDURE: <name> <version> ...`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub draft_procedure: Option<String>,
     /// How hardware links delivered their samples, and the table-to-IMU synchronisation.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sync: Option<SyncRecord>,

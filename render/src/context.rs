@@ -202,6 +202,10 @@ fn history(run: &Value) -> Vec<String> {
         Some("running") => out.push("The run never ended (status `running`).".into()),
         _ => {}
     }
+    if let Some(d) = s(run.get("draft_procedure")) {
+        // A draft procedure heads the report: it is no calibration of record.
+        out.insert(0, format!("{d}."));
+    }
     if let Some(c) = s(run.get("changed_after_release")) {
         out.push(format!("Run with --allow-changed: {c}."));
     }

@@ -77,17 +77,32 @@ impl RuleState {
         }
     }
 
+    /// A signal's name with the unit the rule's limit was written in, and its values
+    /// converted to that unit (to five significant digits, as a limit is written).
+    fn shown(&self, signal: Signal, values: &[f64]) -> String {
+        let (name, internal) = signal_parts(signal);
+        let (unit, conv): (&str, Vec<f64>) = match self.rule.in_written_unit(1.0) {
+            Some((k, unit)) => (unit, values.iter().map(|x| x * k).collect()),
+            None => (internal, values.to_vec()),
+        };
+        let list: Vec<String> = conv.iter().map(|x| significant(*x, 5)).collect();
+        format!("{name} ({unit}) = [{}]", list.join(", "))
+    }
+
     fn describe(&self, v: &[f64]) -> String {
         match &self.rule.condition {
             AbortCondition::Above { signal, .. } | AbortCondition::Outside { signal, .. } => {
-                format!("{} = {:?}", signal_name(*signal), &v[channels(*signal).1])
+                self.shown(*signal, &v[channels(*signal).1])
             }
-            AbortCondition::Drifts { signal, .. } => format!(
-                "{} = {:?}, at scope start {:?}",
-                signal_name(*signal),
-                &v[channels(*signal).1],
-                self.baseline.as_deref().unwrap_or(&[])
-            ),
+            AbortCondition::Drifts { signal, .. } => {
+                let base = self.baseline.as_deref().unwrap_or(&[]);
+                let at_start = self.shown(*signal, base);
+                let at_start = at_start.split_once(" = ").map_or("", |x| x.1);
+                format!(
+                    "{}, at scope start {at_start}",
+                    self.shown(*signal, &v[channels(*signal).1])
+                )
+            }
             AbortCondition::ImuAbnormal => {
                 format!("accel = {:?} m/s^2, gyro = {:?} deg/s", &v[0..3], &v[3..6])
             }
@@ -117,17 +132,33 @@ impl RuleState {
     }
 }
 
-/// Name of a signal for messages.
-pub(crate) fn signal_name(s: Signal) -> &'static str {
+/// Name of a signal and its internal unit, for messages.
+fn signal_parts(s: Signal) -> (&'static str, &'static str) {
     match s {
-        Signal::Accel => "imu.accel (m/s^2)",
-        Signal::Gyro => "imu.gyro (deg/s)",
-        Signal::AttitudeError => "table.attitude_error (deg)",
-        Signal::RateError => "table.rate_error (deg/s)",
-        Signal::AmbientTemperature => "ambient.temperature (degC)",
-        Signal::AmbientDrift => "ambient.drift (degC/h)",
-        Signal::ImuTemperature => "imu.temperature (degC)",
+        Signal::Accel => ("imu.accel", "m/s^2"),
+        Signal::Gyro => ("imu.gyro", "deg/s"),
+        Signal::AttitudeError => ("table.attitude_error", "deg"),
+        Signal::RateError => ("table.rate_error", "deg/s"),
+        Signal::AmbientTemperature => ("ambient.temperature", "degC"),
+        Signal::AmbientDrift => ("ambient.drift", "degC/h"),
+        Signal::ImuTemperature => ("imu.temperature", "degC"),
     }
+}
+
+/// `x` to `digits` significant digits (`307851.6` -> `307850`, `0.000123456` -> `0.00012346`).
+fn significant(x: f64, digits: i32) -> String {
+    if !x.is_finite() || x == 0.0 {
+        return format!("{x}");
+    }
+    let magnitude = x.abs().log10().floor() as i32;
+    let decimals = (digits - 1 - magnitude).clamp(0, 12) as usize;
+    let scale = 10f64.powi(magnitude + 1 - digits);
+    let rounded = if decimals == 0 {
+        (x / scale).round() * scale
+    } else {
+        x
+    };
+    format!("{rounded:.decimals$}")
 }
 
 /// The rules in force: the run's, and the current step's.
@@ -195,6 +226,7 @@ mod tests {
             condition,
             persistence_s,
             action: AbortAction::Abort,
+            unit: String::new(),
         }
     }
 
@@ -232,6 +264,49 @@ mod tests {
         }
         assert_eq!(out.len(), 1);
         assert!((out[0].t - 1.96).abs() < 1e-9, "{}", out[0].t);
+    }
+
+    #[test]
+    fn values_are_stated_in_the_unit_of_the_limit() {
+        let mut r = rule(
+            AbortCondition::Above {
+                signal: Signal::AttitudeError,
+                limit: 5.0 / 3600.0,
+            },
+            0.0,
+        );
+        r.unit = "arcsec".into();
+        let mut m = Monitor::new(&[r], (0.0, 0.0));
+        let mut out = Vec::new();
+        m.on_table(&table_row(11.0, 85.51434352570847), true, &mut out);
+        assert_eq!(out.len(), 1);
+        assert!(
+            out[0]
+                .values
+                .starts_with("table.attitude_error (arcsec) = [307850]"),
+            "{}",
+            out[0].values
+        );
+        // A limit in the internal unit keeps it, rounded as a limit is written.
+        let mut m = Monitor::new(
+            &[rule(
+                AbortCondition::Above {
+                    signal: Signal::AttitudeError,
+                    limit: 1.0,
+                },
+                0.0,
+            )],
+            (0.0, 0.0),
+        );
+        let mut out = Vec::new();
+        m.on_table(&table_row(11.0, 85.51434352570847), true, &mut out);
+        assert!(
+            out[0]
+                .values
+                .starts_with("table.attitude_error (deg) = [85.514]"),
+            "{}",
+            out[0].values
+        );
     }
 
     #[test]

@@ -2,9 +2,7 @@
 //! each procedure given; every diagnostic at once. Exit 0 (warnings allowed), 1 errors.
 
 use ratecal_check::{CheckOptions, check_text};
-use ratecal_drivers::Station;
 use ratecal_ops::procedure::{self, FsSources};
-use ratecal_ops::station::station_limits;
 use std::process::ExitCode;
 
 /// Arguments of `ratecal check`.
@@ -13,7 +11,8 @@ pub struct Args {
     /// Procedures: files, folders (newest version) or folder@version.
     #[arg(required = true)]
     inputs: Vec<String>,
-    /// Station file: compare rates and accelerations with its table and IMU limits.
+    /// Station file: compare rates, accelerations, travel and the IMU with it (default: the
+    /// built-in station `run` would use).
     #[arg(long)]
     station: Option<std::path::PathBuf>,
     /// Output format: text, or json (the checked plans on standard output).
@@ -75,26 +74,6 @@ fn observability_lines(obs: &[ratecal_check::EffectObservability]) -> Vec<String
 
 /// Runs the subcommand.
 pub fn main(args: Args) -> ExitCode {
-    let mut opts = CheckOptions::default();
-    if let Some(path) = &args.station {
-        let text = match std::fs::read_to_string(path) {
-            Ok(t) => t,
-            Err(e) => {
-                errln!(
-                    "ratecal check: cannot read station `{}`: {e}",
-                    path.display()
-                );
-                return ExitCode::from(1);
-            }
-        };
-        match Station::from_yaml(&text, &path.display().to_string()) {
-            Ok(st) => opts.station = Some(station_limits(&st)),
-            Err(e) => {
-                errln!("{:?}", miette::Report::new(*e));
-                return ExitCode::from(1);
-            }
-        }
-    }
     let mut failed = false;
     let mut plans = Vec::new();
     for input in &args.inputs {
@@ -114,17 +93,33 @@ pub fn main(args: Args) -> ExitCode {
             }
         };
         // A folder's versions were checked against the lock just above.
-        if !std::path::Path::new(input).is_dir()
-            && procedure::released_unchanged(&file, args.allow_changed).is_err()
-        {
-            failed = true;
+        if !std::path::Path::new(input).is_dir() {
+            if procedure::released_unchanged(&file, args.allow_changed).is_err() {
+                failed = true;
+            }
+            // A draft or a broken release however it is named (a path, folder@version).
+            for d in ratecal_ops::release::file_diagnostics(&file) {
+                procedure::report(&d);
+                failed |= d.is_error();
+            }
         }
+        let (limits, station) =
+            match ratecal_ops::station::for_check(args.station.as_deref(), &file.text) {
+                Ok(s) => s,
+                Err(e) => {
+                    errln!("{e:?}");
+                    return ExitCode::from(1);
+                }
+            };
+        let opts = CheckOptions {
+            station: Some(limits),
+        };
         match check_text(&file.display, &file.text, &FsSources, &opts) {
             Ok(checked) => {
                 checked.warnings.iter().for_each(procedure::report);
                 let p = &checked.plan;
                 let line = format!(
-                    "{} {}: ok, estimated duration {}",
+                    "{} {}: ok, estimated duration {}\n  station: {station}",
                     p.name,
                     p.version,
                     human_duration(p.estimated_duration_s)
@@ -143,7 +138,7 @@ pub fn main(args: Args) -> ExitCode {
                 diags.iter().for_each(procedure::report);
                 let n = diags.iter().filter(|d| d.is_error()).count();
                 errln!(
-                    "{}: {n} error{}",
+                    "{}: {n} error{} (checked on {station})",
                     file.display,
                     if n == 1 { "" } else { "s" }
                 );

@@ -1,7 +1,8 @@
 //! `ratecal log FOLDER`: every version of a procedure folder, oldest first, with the
-//! SHA-256 of its canonical text, whether `versions.lock` records it as released, and a
-//! one-line summary of its semantic changes from the version before. Exit 0, or 2 when
-//! the folder or one of its versions cannot be read or checked.
+//! SHA-256 of its canonical text, whether `versions.lock` records it as released (signed by
+//! whom, its signature verified, or unsigned for an older hash-only line), and a one-line
+//! summary of its semantic changes from the version before. Exit 0, or 2 when the folder
+//! or one of its versions cannot be read or checked, or a release's signature fails.
 
 use ratecal_audit::versions::{self, LOCK_FILE, Version};
 use ratecal_audit::{diff, render};
@@ -58,16 +59,20 @@ pub fn main(args: Args) -> ExitCode {
             .iter()
             .find(|e| Version::parse(&e.version).as_ref() == Some(&version))
         {
-            Some(e) if e.sha256 == loaded.sha256 => "released",
-            Some(_) => "CHANGED AFTER RELEASE",
-            None => "unreleased",
+            Some(e) if e.sha256 == loaded.sha256 => {
+                let how = ratecal_ops::release::describe(e);
+                failed |= how.starts_with("BAD SIGNATURE");
+                format!("released ({how})")
+            }
+            Some(_) => "CHANGED AFTER RELEASE".to_string(),
+            None => "unreleased (draft)".to_string(),
         };
         let summary = match &previous {
             None => "first version".to_string(),
             Some(p) => render::summary(&diff(&p.plan, &loaded.plan)),
         };
         outln!(
-            "{:<8} {}  {status:<10}  {summary}",
+            "{:<8} {}  {status:<22}  {summary}",
             version.to_string(),
             loaded.sha256
         );

@@ -13,6 +13,7 @@ pub mod fmt;
 pub mod import;
 pub mod key;
 pub mod log;
+pub mod release;
 pub mod report;
 pub mod run;
 pub mod verify;

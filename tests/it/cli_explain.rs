@@ -121,9 +121,11 @@ fn the_adoption_diff_applies_and_the_new_version_checks() {
         return;
     };
     assert!(p.status.success(), "{}", text(&p));
-    let c = ratecal(&["check", "procedures/imu-2d-standard"], tmp.path());
+    // The folder stands for its newest release (1.1.0): the adopted draft is named.
+    let c = ratecal(&["check", "procedures/imu-2d-standard@1.2.0"], tmp.path());
     assert_eq!(c.status.code(), Some(0), "{}", text(&c));
     assert!(String::from_utf8_lossy(&c.stdout).contains("imu-2d-standard 1.2.0: ok"));
+    assert!(text(&c).contains("versions::unreleased"), "{}", text(&c));
     let d = ratecal(
         &[
             "diff",

@@ -238,6 +238,7 @@ pub fn analyze_source<S: Source>(
         size_effect: out.size_effect.take(),
         manual: None,
         budgets: Vec::new(),
+        draft_procedure: m.run.as_ref().and_then(|r| r.draft_procedure.clone()),
     };
     res.fits = fitted.fits;
     res.model

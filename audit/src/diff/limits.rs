@@ -428,6 +428,7 @@ mod tests {
             },
             persistence_s,
             action,
+            unit: String::new(),
         };
         let mut out = vec![];
         aborts(

@@ -88,6 +88,7 @@ pub fn gyro_bias() -> Step {
             },
             persistence_s: 0.0,
             action: AbortAction::Abort,
+            unit: String::new(),
         }],
         body: vec![
             Node::Do(Action::MoveTo {
@@ -185,12 +186,14 @@ pub fn standard() -> Plan {
                 },
                 persistence_s: 1.0,
                 action: AbortAction::Abort,
+                unit: String::new(),
             },
             AbortRule {
                 text: "imu.accel out of range or imu.stuck for 0.5 s".into(),
                 condition: AbortCondition::ImuAbnormal,
                 persistence_s: 0.5,
                 action: AbortAction::Abort,
+                unit: String::new(),
             },
         ],
         steps,

@@ -14,6 +14,8 @@ fn opts(manual: bool) -> CheckOptions {
             accel_range_mps2: 16.0 * 9.80665,
             geometry: Geometry::seed(),
             manual,
+            travel_deg: [None, None],
+            imu_grade: String::new(),
         }),
     }
 }

@@ -194,6 +194,8 @@ fn station(max_rate: f64, gyro_range: f64, max_accel: f64) -> CheckOptions {
             accel_range_mps2: 16.0 * 9.80665,
             geometry: Geometry::seed(),
             manual: false,
+            travel_deg: [None, None],
+            imu_grade: String::new(),
         }),
     }
 }

@@ -16,6 +16,8 @@ fn station(max_accel: f64) -> CheckOptions {
             accel_range_mps2: 16.0 * 9.80665,
             geometry: Geometry::vertical_outer(),
             manual: false,
+            travel_deg: [None, None],
+            imu_grade: String::new(),
         }),
     }
 }

@@ -132,6 +132,12 @@ pub struct TableSpec {
     /// Maximum angular acceleration per axis, deg/s^2.
     #[serde(deserialize_with = "positive")]
     pub max_accel_dps2: f64,
+    /// Travel of the outer axis, [lowest, highest] (not stated: it turns without end).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub outer_travel: Option<[Angle; 2]>,
+    /// Travel of the inner axis, [lowest, highest] (not stated: it turns without end).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inner_travel: Option<[Angle; 2]>,
     /// Encoder noise on the angle feedback (1 sigma).
     #[serde(default)]
     pub position_noise: Angle,

@@ -37,6 +37,10 @@ pub const DEFAULT_STATION_YAML: &str = include_str!("../../stations/default.yaml
 /// vertical_outer`.
 pub const SWAYING_STATION_YAML: &str = include_str!("../../stations/swaying.yaml");
 
+/// The embedded manual station's YAML (a cube fixture and a consumer IMU, the operator in
+/// place of a table): the default of procedures that ask the operator (`place`, `turn`).
+pub const MANUAL_STATION_YAML: &str = include_str!("../../stations/manual.yaml");
+
 /// A station file that cannot be used, located in the file.
 #[derive(Debug, thiserror::Error, Diagnostic)]
 #[error("{message}")]

@@ -9,8 +9,9 @@ use ratecal_folder::names::{MANIFEST, PROCEDURE, STATION};
 mod check;
 mod finish;
 mod imports;
+pub mod log;
 mod resume;
-mod setup;
+pub(crate) mod setup;
 
 use ed25519_dalek::SigningKey;
 use miette::Report;
@@ -43,6 +44,8 @@ pub struct Request {
     pub sign: Option<PathBuf>,
     /// Run a released version changed after release.
     pub allow_changed: bool,
+    /// Run an unreleased version (a draft).
+    pub draft: bool,
     /// Archive the run there.
     pub archive: Option<String>,
 }
@@ -266,7 +269,11 @@ fn link_timeout_s(station: &ratecal_drivers::Station) -> Option<f64> {
 }
 
 fn prepare_new(args: &Request) -> Result<(Prepared, FolderLock), Report> {
-    let proc_path = setup::procedure_file(args.procedure.as_deref().unwrap_or(Path::new(".")))?;
+    let proc_path = setup::procedure_file(
+        args.procedure.as_deref().unwrap_or(Path::new(".")),
+        args.draft,
+    )?;
+    let draft = setup::draft(&proc_path, args.draft)?;
     // Without --station the procedure's geometry picks the embedded station.
     let builtin = std::fs::read_to_string(&proc_path)
         .ok()
@@ -311,6 +318,7 @@ fn prepare_new(args: &Request) -> Result<(Prepared, FolderLock), Report> {
         seed: args.seed,
         operator: args.operator.clone(),
         changed_after_release: changed,
+        draft,
     };
     let manifest = setup::manifest(&st, &pr, &facts);
     // Hardware links stamp each sample with its host arrival time as well (`t_host`).

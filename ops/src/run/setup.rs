@@ -2,7 +2,7 @@
 //! (text, canonical hash, checked plan), the run folder and its manifest.
 
 use miette::{IntoDiagnostic, Report, WrapErr, miette};
-use ratecal_drivers::{DEFAULT_STATION_YAML, SWAYING_STATION_YAML, Station};
+use ratecal_drivers::{DEFAULT_STATION_YAML, MANUAL_STATION_YAML, SWAYING_STATION_YAML, Station};
 use ratecal_plan::Plan;
 use ratecal_recording::{
     EnvironmentRecord, FORMAT, Manifest, ManifestStation, Mount, ProcedureRef, RunInfo, TableAxes,
@@ -26,21 +26,37 @@ pub fn station(path: Option<&Path>, dry_run: bool) -> Result<LoadedStation, Repo
     station_for(path, dry_run, None)
 }
 
-/// The embedded station a procedure runs on without `--station`: the swaying one for a
-/// procedure that declares `geometry vertical_outer`, the default one otherwise.
+/// The embedded station a procedure runs (and is checked) on without `--station`: the
+/// swaying one for a procedure that declares `geometry vertical_outer`, the manual one for
+/// a procedure that asks the operator (`place`, `turn`), the default one otherwise.
 pub fn builtin_for(procedure_text: &str) -> (&'static str, &'static str) {
-    use ratecal_grammar::ast::{ProcItem, TopItem};
-    let vertical =
-        ratecal_grammar::parse(procedure_text).is_ok_and(|f| {
-            f.body.items.iter().any(|it| match &it.node {
-                TopItem::Procedure(p) => p.body.items.iter().any(
-                    |pi| matches!(&pi.node, ProcItem::Geometry(g) if g.node == "vertical_outer"),
-                ),
-                _ => false,
-            })
-        });
+    use ratecal_grammar::ast::{Block, ProcItem, Stmt, TopItem};
+    fn asks_operator(b: &Block<Stmt>) -> bool {
+        b.items.iter().any(|s| match &s.node {
+            Stmt::Place { .. } | Stmt::Turn { .. } => true,
+            Stmt::For { body, .. } | Stmt::Repeat { body, .. } => asks_operator(body),
+            _ => false,
+        })
+    }
+    let Ok(file) = ratecal_grammar::parse(procedure_text) else {
+        return (DEFAULT_STATION_YAML, "<default station>");
+    };
+    let items = file.body.items.iter().flat_map(|it| match &it.node {
+        TopItem::Procedure(p) => p.body.items.iter().collect::<Vec<_>>(),
+        _ => Vec::new(),
+    });
+    let (mut vertical, mut manual) = (false, false);
+    for pi in items {
+        match &pi.node {
+            ProcItem::Geometry(g) if g.node == "vertical_outer" => vertical = true,
+            ProcItem::Step(s) if asks_operator(&s.body) => manual = true,
+            _ => {}
+        }
+    }
     if vertical {
         (SWAYING_STATION_YAML, "<swaying station>")
+    } else if manual {
+        (MANUAL_STATION_YAML, "<manual station>")
     } else {
         (DEFAULT_STATION_YAML, "<default station>")
     }
@@ -105,13 +121,50 @@ pub struct LoadedProcedure {
     pub imports: Imports,
 }
 
-/// Finds the procedure file: a file, a procedure folder (its newest version) or
-/// `folder@version`.
-pub fn procedure_file(arg: &Path) -> Result<PathBuf, Report> {
-    crate::procedure::resolve(&arg.to_string_lossy()).map_err(|d| {
+/// Finds the procedure file: a file, a procedure folder (its newest released version, or
+/// with `draft` its newest version) or `folder@version`.
+pub fn procedure_file(arg: &Path, draft: bool) -> Result<PathBuf, Report> {
+    crate::procedure::resolve_for(&arg.to_string_lossy(), draft).map_err(|d| {
         crate::procedure::report(&d);
         miette!("no procedure to run")
     })
+}
+
+/// Refuses a version its folder has not released, unless `allowed` (`--draft`): then what
+/// the manifest, results, reports and console say of it (also said now on the console).
+pub fn draft(path: &Path, allowed: bool) -> Result<Option<String>, Report> {
+    let file = crate::procedure::read(&path.display().to_string()).map_err(|d| {
+        crate::procedure::report(&d);
+        miette!("no procedure to run")
+    })?;
+    if crate::release::release_of(&file) != crate::release::Release::Draft {
+        return Ok(None);
+    }
+    let version = path
+        .file_name()
+        .and_then(|n| ratecal_plan::versions::version_of_file_name(&n.to_string_lossy()))
+        .map(|v| v.to_string())
+        .unwrap_or_default();
+    let folder = path
+        .parent()
+        .map(|p| p.display().to_string())
+        .unwrap_or_default();
+    if !allowed {
+        return Err(miette!(
+            code = "run::unreleased",
+            help = format!(
+                "release it (`ratecal release {folder}@{version} --signer NAME --key lab.key`), or run it as a draft with --draft"
+            ),
+            "{}: version {version} is not released; nothing was run",
+            file.display
+        ));
+    }
+    let note = format!(
+        "DRAFT PROCEDURE: {} version {version} is not released (run with --draft)",
+        file.display
+    );
+    errln!("{note}");
+    Ok(Some(note))
 }
 
 /// Reads, hashes and checks a procedure against the station's limits; its imports come
@@ -162,6 +215,8 @@ pub struct RunFacts<'a> {
     pub operator: Option<String>,
     /// Set when a released version changed after release runs (`--allow-changed`).
     pub changed_after_release: Option<String>,
+    /// Set when an unreleased version runs (`--draft`): what the outputs say of it.
+    pub draft: Option<String>,
 }
 
 /// The manifest of a new run.
@@ -224,6 +279,7 @@ pub fn manifest(st: &LoadedStation, proc_: &LoadedProcedure, facts: &RunFacts) -
             failure: None,
             resumes: Vec::new(),
             changed_after_release: facts.changed_after_release.clone(),
+            draft_procedure: facts.draft.clone(),
             sync: None,
             write_failure: None,
         }),

@@ -46,6 +46,15 @@ pub struct Args {
     /// manifest and the report record it).
     #[arg(long)]
     allow_changed: bool,
+    /// Run a version its folder has not released (the folder form then takes the newest
+    /// version): manifest, results, reports and console say DRAFT PROCEDURE, and no
+    /// certificate is issued for the run.
+    #[arg(long)]
+    draft: bool,
+    /// Progress when standard error is not a terminal: `text` lines, or `json` lines (one
+    /// object per line; on a terminal too). Keys: docs/run-folders.md.
+    #[arg(long, value_parser = ["text", "json"], default_value = "text")]
+    log_format: String,
     /// Archive the run here (folder or postgres:// URL; also $RATECAL_ARCHIVE).
     #[arg(long, value_name = "DIR_OR_URL")]
     archive: Option<String>,
@@ -64,10 +73,25 @@ pub fn main(a: Args) -> ExitCode {
         serial: a.serial,
         sign: a.sign,
         allow_changed: a.allow_changed,
+        draft: a.draft,
         archive: a.archive,
     };
+    let json = a.log_format == "json";
     ExitCode::from(run(
         request,
-        Box::new(|estimated_s, simulated| Box::new(progress::Bar::new(estimated_s, simulated))),
+        Box::new(
+            move |estimated_s, simulated| -> Box<dyn ratecal_ops::run::Shown> {
+                use std::io::IsTerminal;
+                if json || !std::io::stderr().is_terminal() {
+                    Box::new(ratecal_ops::run::log::LogLines::new(
+                        estimated_s,
+                        simulated,
+                        json,
+                    ))
+                } else {
+                    Box::new(progress::Bar::new(estimated_s, simulated))
+                }
+            },
+        ),
     ))
 }

@@ -362,6 +362,7 @@ pub fn manifest(name: &str) -> Manifest {
             failure: None,
             resumes: Vec::new(),
             changed_after_release: None,
+            draft_procedure: None,
             sync: None,
             write_failure: None,
         }),

@@ -70,6 +70,7 @@ pub fn rule(text: &str, condition: AbortCondition, persistence_s: f64) -> AbortR
         condition,
         persistence_s,
         action: AbortAction::Abort,
+        unit: String::new(),
     }
 }
 

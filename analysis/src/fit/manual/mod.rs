@@ -180,6 +180,7 @@ pub(crate) fn analyze<S: Source>(
         size_effect: None,
         manual: Some(manual),
         budgets: Vec::new(),
+        draft_procedure: m.run.as_ref().and_then(|r| r.draft_procedure.clone()),
     };
     let mut q = BTreeMap::new();
     if let Some(man) = &res.manual {
