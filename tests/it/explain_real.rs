@@ -227,7 +227,7 @@ fn imucal_ferraris_session_on_exact_faces_names_imucals_misalignment() {
         .iter()
         .find(|f| f["effect"] == "accel_misalignment")
         .unwrap_or_else(|| panic!("{:#?}", x["findings"]));
-    let cal: Value = serde_json::from_str(&std::fs::read_to_string(cal).unwrap()).unwrap();
+    let cal = json(&cal);
     let (k, r) = (&cal["K_a"], &cal["R_a"]);
     for (i, j) in [(0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1)] {
         let name = format!("{}{}_mrad", ["x", "y", "z"][i], ["x", "y", "z"][j]);

@@ -254,7 +254,7 @@ pub(crate) fn discover(
                 continue;
             }
             if let Some(prev) = refined_beside(data, out, &chans) {
-                let gain = tau::beyond(data, terms, &tt, prev);
+                let gain = tau::beyond(data, &base, &f, prev);
                 if debug {
                     eprintln!(
                         "  beyond the refined decay {}: chi2 {gain:.1}",

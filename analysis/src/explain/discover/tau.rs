@@ -164,6 +164,13 @@ impl Profile {
         Profile { x, misfit }
     }
 
+    /// The profile from half the library's shortest time constant on `probe`'s sensor to
+    /// ten times the recording's span.
+    fn over_limits(data: &Data, probe: &Probe, channels: &[Channel]) -> Self {
+        let (shortest, span) = limits(data, probe, channels);
+        Profile::new(channels, (SHORTEST * shortest).ln(), (LONGEST * span).ln())
+    }
+
     /// The least misfit: its `ln tau` (a parabola through the grid's neighbours) and value.
     fn least(&self) -> (usize, f64) {
         let i = (0..self.x.len())
@@ -218,21 +225,11 @@ pub(super) fn refine(
     };
     let work = data.working();
     let (center, _) = fit(data, terms, &work, &work);
-    if std::env::var_os("RATECAL_EXPLAIN_DEBUG").is_some() {
-        for &g in keep {
-            let c = channel_of(data, g);
-            eprintln!(
-                "refine: column {g} channel {c}: grid amplitude {:.4e}, noise {:?}",
-                center.theta[g], center.noise[c]
-            );
-        }
-    }
     let channels: Vec<Channel> = keep
         .iter()
         .map(|&g| Channel::new(data, (&center, &center), &work, best, g, t0))
         .collect();
-    let (shortest, span) = limits(data, probe, &channels);
-    let profile = Profile::new(&channels, (SHORTEST * shortest).ln(), (LONGEST * span).ln());
+    let profile = Profile::over_limits(data, probe, &channels);
     let (i, x) = profile.least();
     let floor = profile.misfit[i];
     let (lo, hi) = (
@@ -261,19 +258,16 @@ pub(super) fn refine(
 /// time constant profiled afresh in each: a later term must pay beyond the refinement of
 /// the decay already held, or it is only the mismatch of the decay's grid time constant
 /// (a sum of exponentials standing in for one).
-pub(super) fn beyond(data: &Data, without: &Terms, with: &Terms, d: &super::Discovery) -> f64 {
+pub(super) fn beyond(data: &Data, without: &Fit, with: &Fit, d: &super::Discovery) -> f64 {
     let Form::Decay { t0, .. } = d.probe.form else {
         return f64::INFINITY;
     };
     let work = data.working();
-    let (base, _) = fit(data, without, &work, &work);
-    let least = |terms: &Terms| {
-        let (center, _) = fit(data, terms, &work, &work);
+    let least = |center: &Fit| {
         let channels: Vec<Channel> = (d.columns.iter())
-            .map(|&g| Channel::new(data, (&center, &base), &work, d.step.effect, g, t0))
+            .map(|&g| Channel::new(data, (center, without), &work, d.step.effect, g, t0))
             .collect();
-        let (shortest, span) = limits(data, d.probe, &channels);
-        let profile = Profile::new(&channels, (SHORTEST * shortest).ln(), (LONGEST * span).ln());
+        let profile = Profile::over_limits(data, d.probe, &channels);
         let (i, _) = profile.least();
         channels.iter().map(|ch| ch.yy).sum::<f64>() + profile.misfit[i]
     };
