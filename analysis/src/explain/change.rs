@@ -50,20 +50,13 @@ type Res = (f64, f64, f64);
 
 /// Residual mean of each block of segment `i` on channel `c` under `theta`.
 fn residuals(data: &Data, fit: &Fit, i: usize, c: usize) -> Vec<Res> {
-    let cols = &data.layout.by_channel[c];
-    data.accs[i]
-        .blocks
-        .iter()
-        .map(|b| {
-            let mut s = b.sy[c];
-            for (k, &g) in cols.iter().enumerate() {
-                let th = fit.theta[g];
-                if th != 0.0 {
-                    s -= b.sx[c][k] * th;
-                }
-            }
-            (b.t, b.n as f64, s / b.n.max(1) as f64)
-        })
+    let nonzero: Vec<(usize, f64)> = (data.layout.by_channel[c].iter().enumerate())
+        .map(|(k, &g)| (k, fit.theta[g]))
+        .filter(|&(_, th)| th != 0.0)
+        .collect();
+    let acc = &data.accs[i];
+    (acc.blocks.iter().zip(acc.block_sums(c, &nonzero)))
+        .map(|(b, s)| (b.t, b.n as f64, s / b.n.max(1) as f64))
         .collect()
 }
 

@@ -256,6 +256,7 @@ fn extend(
         }
     }
     acc.r[c] = m;
+    acc.blocks_changed();
     for b in &mut acc.blocks {
         for j in 0..cols.len() {
             let (src, scale, on) = cols[j];

@@ -34,12 +34,65 @@ pub(crate) struct SegAcc {
     pub blocks: Vec<Block>,
     /// Samples.
     pub n: usize,
+    /// The blocks' sums laid out per channel as columns ([`SegAcc::block_sums`]), built on
+    /// first use; whatever changes `blocks` calls [`SegAcc::blocks_changed`].
+    columns: std::sync::OnceLock<Box<[BlockColumns; 6]>>,
+}
+
+/// One channel's block sums, column by column: a fit reads a few columns over every block
+/// hundreds of times, which the per-block vectors make a cache miss a block.
+#[derive(Debug, Clone)]
+struct BlockColumns {
+    /// Blocks x the channel's columns: the sums of each regressor.
+    sx: DMatrix<f64>,
+    /// Per block, the sum of the observations.
+    sy: Vec<f64>,
 }
 
 impl SegAcc {
+    /// Per block of channel `c`, the sum of its residuals under the channel's coefficients
+    /// `nonzero` (`(column within the channel, coefficient)`, the zero ones left out).
+    pub(crate) fn block_sums(&self, c: usize, nonzero: &[(usize, f64)]) -> Vec<f64> {
+        let cols = self.columns(c);
+        let mut s = cols.sy.clone();
+        for &(k, th) in nonzero {
+            for (s, x) in s.iter_mut().zip(cols.sx.column(k).iter()) {
+                *s -= x * th;
+            }
+        }
+        s
+    }
+
+    /// Blocks x channel `c`'s columns: the sums of each regressor over each block.
+    pub(crate) fn block_regressors(&self, c: usize) -> &DMatrix<f64> {
+        &self.columns(c).sx
+    }
+
+    fn columns(&self, c: usize) -> &BlockColumns {
+        let cols = &self.columns.get_or_init(|| Box::new(self.lay_out()))[c];
+        debug_assert_eq!(cols.sy.len(), self.blocks.len());
+        cols
+    }
+
+    fn lay_out(&self) -> [BlockColumns; 6] {
+        std::array::from_fn(|c| {
+            let p = self.blocks.first().map_or(0, |b| b.sx[c].len());
+            BlockColumns {
+                sx: DMatrix::from_fn(self.blocks.len(), p, |i, k| self.blocks[i].sx[c][k]),
+                sy: self.blocks.iter().map(|b| b.sy[c]).collect(),
+            }
+        })
+    }
+
+    /// The blocks were changed: the columns are laid out again on next use.
+    pub(crate) fn blocks_changed(&mut self) {
+        self.columns = Default::default();
+    }
+
     /// Adds the accumulation of a later piece of the same segment: the factors stacked and
     /// triangulated again, the blocks and counts joined.
     pub(crate) fn merge(&mut self, later: SegAcc) {
+        self.blocks_changed();
         for (c, r) in later.r.into_iter().enumerate() {
             let w = r.ncols();
             let mut m = DMatrix::zeros(self.r[c].nrows() + r.nrows(), w);
@@ -54,12 +107,18 @@ impl SegAcc {
 
 /// Folds one segment's samples into the factors and block sums of every channel, a sample
 /// at a time, so a segment of any length streams through.
+///
+/// At rest only the terms that read the time or the temperature change from sample to
+/// sample: only their columns are evaluated, written into each channel's row and added
+/// to the block sums; the other columns' sums are their value times the samples they held
+/// it for, added when the motion changes or the block ends.
 pub(crate) struct Accumulator<'l> {
     seg: usize,
     layout: &'l Layout,
     tris: Vec<Tri>,
     parts: Vec<Partials>,
-    row: Vec<f64>,
+    /// Per channel, the current row: its columns, then the observation.
+    rows: [Vec<f64>; 6],
     blocks: Vec<Block>,
     cur: Block,
     block_end: f64,
@@ -67,12 +126,31 @@ pub(crate) struct Accumulator<'l> {
     filled: Option<Signals>,
     /// Layout indices of the effects whose regressors change at rest.
     varying: Vec<usize>,
+    /// Per channel, the positions in its row that change at rest (the observation's
+    /// included, last), ascending.
+    moving: [Vec<usize>; 6],
+    /// Per channel, the positions that keep their value at rest.
+    resting: [Vec<usize>; 6],
+    /// Samples since the resting columns' values were last added to the block sums.
+    pending: usize,
 }
 
 impl<'l> Accumulator<'l> {
     /// An empty accumulation of segment `seg`, whose blocks start at `t_start`.
     pub(crate) fn new(seg: usize, t_start: f64, layout: &'l Layout) -> Self {
         let ncol = layout.cols.len();
+        let varying: Vec<usize> = (0..layout.effects.len())
+            .filter(|&e| layout.effects[e].varies_at_rest())
+            .collect();
+        let varies = |g: usize| varying.contains(&layout.cols[g].effect);
+        let positions = |c: usize, want: bool| -> Vec<usize> {
+            let cols = &layout.by_channel[c];
+            let mut v: Vec<usize> = (0..cols.len()).filter(|&k| varies(cols[k]) == want).collect();
+            if want {
+                v.push(cols.len());
+            }
+            v
+        };
         Accumulator {
             seg,
             layout,
@@ -80,14 +158,15 @@ impl<'l> Accumulator<'l> {
                 .map(|c| Tri::new(layout.by_channel[c].len() + 1))
                 .collect(),
             parts: vec![Partials::default(); ncol],
-            row: Vec::with_capacity(ncol + 1),
+            rows: std::array::from_fn(|c| vec![0.0; layout.by_channel[c].len() + 1]),
             blocks: Vec::new(),
             cur: Self::new_block(layout),
             block_end: t_start + BLOCK_S,
             filled: None,
-            varying: (0..layout.effects.len())
-                .filter(|&e| layout.effects[e].varies_at_rest())
-                .collect(),
+            moving: std::array::from_fn(|c| positions(c, true)),
+            resting: std::array::from_fn(|c| positions(c, false)),
+            varying,
+            pending: 0,
         }
     }
 
@@ -97,6 +176,40 @@ impl<'l> Accumulator<'l> {
             n: 0,
             sx: std::array::from_fn(|c| vec![0.0; layout.by_channel[c].len()]),
             sy: [0.0; 6],
+        }
+    }
+
+    /// Adds the resting columns' values for the samples that held them to the block sums.
+    fn settle(&mut self) {
+        if self.pending == 0 {
+            return;
+        }
+        let n = self.pending as f64;
+        for c in 0..6 {
+            for &k in &self.resting[c] {
+                self.cur.sx[c][k] += self.rows[c][k] * n;
+            }
+        }
+        self.pending = 0;
+    }
+
+    /// Writes channel `c`'s columns into its row from `parts`: all of them, or only those
+    /// that change at rest.
+    fn write_row(&mut self, c: usize, all: bool) {
+        let (sensor, ax) = channel(c);
+        let cols = &self.layout.by_channel[c];
+        let row = &mut self.rows[c];
+        match all {
+            true => {
+                for (k, &g) in cols.iter().enumerate() {
+                    row[k] = self.parts[g].of(sensor)[ax];
+                }
+            }
+            false => {
+                for &k in &self.moving[c][..self.moving[c].len() - 1] {
+                    row[k] = self.parts[cols[k]].of(sensor)[ax];
+                }
+            }
         }
     }
 
@@ -118,6 +231,7 @@ impl<'l> Accumulator<'l> {
             return;
         }
         if t > self.block_end && self.cur.n > 0 {
+            self.settle();
             self.cur.t /= self.cur.n as f64;
             let full = std::mem::replace(&mut self.cur, Self::new_block(layout));
             self.blocks.push(full);
@@ -126,35 +240,45 @@ impl<'l> Accumulator<'l> {
         // At rest only the terms that read the time or the temperature change.
         let mut motion = *sig;
         (motion.t_s, motion.dtemp_c) = (0.0, 0.0);
-        if self.filled == Some(motion) {
+        let at_rest = self.filled == Some(motion);
+        if at_rest {
             for &e in &self.varying {
                 layout.effects[e].regressors(sig, &mut self.parts[layout.columns_of(e)]);
             }
         } else {
+            self.settle();
             for (e, fx) in layout.effects.iter().enumerate() {
                 fx.regressors(sig, &mut self.parts[layout.columns_of(e)]);
             }
             self.filled = Some(motion);
         }
         for c in 0..6 {
-            let (sensor, ax) = channel(c);
-            self.row.clear();
-            for &g in &layout.by_channel[c] {
-                self.row.push(self.parts[g].of(sensor)[ax]);
-            }
-            self.row.push(out[c]);
-            self.tris[c].push(&self.row);
-            for (k, v) in self.row[..self.row.len() - 1].iter().enumerate() {
-                self.cur.sx[c][k] += v;
+            self.write_row(c, !at_rest);
+            let last = self.rows[c].len() - 1;
+            self.rows[c][last] = out[c];
+            let changed = at_rest.then_some(self.moving[c].as_slice());
+            self.tris[c].push_changed(&self.rows[c], changed);
+            let (row, sx) = (&self.rows[c], &mut self.cur.sx[c]);
+            if at_rest {
+                for &k in &self.moving[c][..self.moving[c].len() - 1] {
+                    sx[k] += row[k];
+                }
+            } else {
+                for (s, v) in sx.iter_mut().zip(&row[..last]) {
+                    *s += v;
+                }
             }
             self.cur.sy[c] += out[c];
         }
+        // The resting columns were added whole for a sample that changed the motion.
+        self.pending += usize::from(at_rest);
         self.cur.t += t;
         self.cur.n += 1;
     }
 
     /// The segment's contribution.
     pub(crate) fn finish(mut self) -> SegAcc {
+        self.settle();
         if self.cur.n > 0 {
             self.cur.t /= self.cur.n as f64;
             self.blocks.push(self.cur);
@@ -166,6 +290,7 @@ impl<'l> Accumulator<'l> {
             r: std::array::from_fn(|_| it.next().expect("six channels")),
             blocks: self.blocks,
             n,
+            columns: Default::default(),
         }
     }
 }
@@ -180,4 +305,77 @@ pub(crate) fn seg_rss(acc: &SegAcc, layout: &Layout, c: usize, theta: &DVector<f
     }
     v[cols.len()] = -1.0;
     (&acc.r[c] * v).norm_squared()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ratecal_physics::effects::Signals;
+    use ratecal_physics::{Geometry, REGISTRY, Site, TableState};
+
+    /// Rows at rest at one attitude, then at another, each with the time and temperature
+    /// moving: the columns that keep their value at rest are summed once per stretch
+    /// and left out of the factor's comparisons, which must change nothing but rounding.
+    #[test]
+    fn resting_columns_sum_and_fold_as_the_rows_do() {
+        let layout = Layout::new(REGISTRY.to_vec());
+        let site = Site {
+            latitude_deg: 50.0,
+            gravity_mps2: 9.81,
+        };
+        let geo = Geometry::seed();
+        let rest = |o: f64, i: f64| {
+            Signals::new(&TableState::at_rest_deg(o, i).snapshot(&geo, &site), &site, 0.0)
+        };
+        let (a, b) = (rest(0.0, 0.0), rest(90.0, 30.0));
+        let mut acc = Accumulator::new(0, 0.0, &layout);
+        let mut rows: [Vec<Vec<f64>>; 6] = Default::default();
+        let mut parts = vec![Partials::default(); layout.cols.len()];
+        for i in 0..700 {
+            let t = i as f64 * 0.01;
+            let mut s = if i < 430 { a } else { b }.at(t);
+            s.dtemp_c = 0.3 * (t * 1.7).sin();
+            let (fa, fg) = ([0.01, -0.02, 9.8 + 1e-3 * t], [0.3, 0.1 * t, -0.2]);
+            acc.push(&s, t, fa, fg);
+            for (e, fx) in layout.effects.iter().enumerate() {
+                fx.regressors(&s, &mut parts[layout.columns_of(e)]);
+            }
+            let (base_a, base_g) = (s.f_b, s.w_b_dps());
+            let out = [
+                fa[0] - base_a.x,
+                fa[1] - base_a.y,
+                fa[2] - base_a.z,
+                fg[0] - base_g.x,
+                fg[1] - base_g.y,
+                fg[2] - base_g.z,
+            ];
+            for (c, r) in rows.iter_mut().enumerate() {
+                let (sensor, ax) = channel(c);
+                let mut row: Vec<f64> = (layout.by_channel[c].iter())
+                    .map(|&g| parts[g].of(sensor)[ax])
+                    .collect();
+                row.push(out[c]);
+                r.push(row);
+            }
+        }
+        let got = acc.finish();
+        assert_eq!(got.blocks.len(), 7);
+        assert_eq!(got.blocks.iter().map(|b| b.n).sum::<usize>(), 700);
+        for (c, r) in rows.iter().enumerate() {
+            let p = r[0].len();
+            let x = DMatrix::from_fn(r.len(), p, |i, k| r[i][k]);
+            let (g, h) = (x.transpose() * &x, got.r[c].transpose() * &got.r[c]);
+            assert!((&g - &h).norm() <= 1e-12 * g.norm(), "channel {c}");
+            let mut from = 0;
+            for (j, blk) in got.blocks.iter().enumerate() {
+                let rows_in = &r[from..from + blk.n];
+                from += blk.n;
+                for k in 0..p - 1 {
+                    let want: f64 = rows_in.iter().map(|row| row[k]).sum();
+                    let tol = 1e-12 * rows_in.iter().map(|row| row[k].abs()).sum::<f64>();
+                    assert!((blk.sx[c][k] - want).abs() <= tol, "{c} {j} {k}");
+                }
+            }
+        }
+    }
 }

@@ -3,7 +3,7 @@
 //! bias (a random walk, from the growth of ten-second block-mean differences), so that
 //! slowly varying regressors are judged against the low-frequency noise.
 
-use super::accumulate::{Block, SegAcc};
+use super::accumulate::SegAcc;
 use nalgebra::{DMatrix, DVector};
 
 /// The noise model of one channel.
@@ -15,18 +15,6 @@ pub(crate) struct ChannelNoise {
     pub phi: f64,
     /// Random-walk intensity of the residual, (unit^2) per second.
     pub q: f64,
-}
-
-/// Residual mean of a block for the channel's coefficients `nonzero` (`(column within the
-/// channel, coefficient)`, the zero ones left out: a model holds a few of the channel's
-/// many columns, and skipping a zero term leaves the sum as it was).
-fn block_mean(b: &Block, c: usize, nonzero: &[(usize, f64)]) -> f64 {
-    let mut s = b.sy[c];
-    let sx = &b.sx[c];
-    for &(k, th) in nonzero {
-        s -= sx[k] * th;
-    }
-    s / b.n as f64
 }
 
 /// Lags of the wander's pairs, in ten-second groups (10 s to about 3 min): the longer lags
@@ -77,10 +65,9 @@ pub(crate) fn estimate(
         .map(|(k, th)| (k, *th))
         .collect();
     for acc in accs {
-        let means: Vec<(f64, usize, f64)> = acc
-            .blocks
-            .iter()
-            .map(|b| (b.t, b.n, block_mean(b, c, &nonzero)))
+        let sums = acc.block_sums(c, &nonzero);
+        let means: Vec<(f64, usize, f64)> = (acc.blocks.iter().zip(sums))
+            .map(|(b, s)| (b.t, b.n, s / b.n as f64))
             .collect();
         let (mut seg_num, mut seg_den) = (0.0, 0.0);
         for w in means.windows(2) {
@@ -141,8 +128,12 @@ pub(crate) fn random_walk_gram(
     local: &[Option<usize>],
     p: usize,
 ) -> DMatrix<f64> {
-    let mut blocks: Vec<&Block> = accs.iter().flat_map(|a| a.blocks.iter()).collect();
-    blocks.sort_by(|a, b| a.t.total_cmp(&b.t));
+    // (time, segment, block) in time order.
+    let mut blocks: Vec<(f64, usize, usize)> = (accs.iter().enumerate())
+        .flat_map(|(s, a)| a.blocks.iter().enumerate().map(move |(i, b)| (b.t, s, i)))
+        .collect();
+    blocks.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let sums: Vec<&DMatrix<f64>> = accs.iter().map(|a| a.block_regressors(c)).collect();
     // The channel's columns in the model: the model holds few of them, so the walk is
     // summed over those alone and scattered into the model's `p x p` at the end.
     let used: Vec<(usize, usize)> = local
@@ -155,11 +146,11 @@ pub(crate) fn random_walk_gram(
     let mut suffix = DVector::zeros(u);
     // Walk backwards: suffix sums of the regressors after each gap.
     for w in (1..blocks.len()).rev() {
-        let b = blocks[w];
+        let (t, s, b) = blocks[w];
         for (i, &(k, _)) in used.iter().enumerate() {
-            suffix[i] += b.sx[c][k];
+            suffix[i] += sums[s][(b, k)];
         }
-        let gap = b.t - blocks[w - 1].t;
+        let gap = t - blocks[w - 1].0;
         small.syger(gap, &suffix, &suffix, 1.0);
     }
     let mut m = DMatrix::zeros(p, p);

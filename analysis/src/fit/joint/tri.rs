@@ -11,8 +11,9 @@
 
 use nalgebra::DMatrix;
 
-/// Rows folded per QR.
-const BLOCK: usize = 256;
+/// Rows folded per QR: few enough that a fold's columns (a static hour has about twenty
+/// moving) stay in the first-level cache while each reflection sweeps them.
+const BLOCK: usize = 64;
 
 /// The triangular factor `R` of `[X y]` (the last column is the observation): `R^T R =
 /// [X y]^T [X y]`, so any least-squares question about the rows can be answered from it.
@@ -58,18 +59,32 @@ impl Tri {
     }
 
     /// Adds one row (regressors then the observation).
+    #[cfg(test)]
     pub(crate) fn push(&mut self, row: &[f64]) {
+        self.push_changed(row, None);
+    }
+
+    /// Adds one row (regressors then the observation), of which only the columns
+    /// `changed` (ascending) may differ from the previous row's (`None`: any).
+    pub(crate) fn push_changed(&mut self, row: &[f64], changed: Option<&[usize]>) {
         debug_assert_eq!(row.len(), self.cols);
         if self.n == 0 {
             self.first = row.to_vec();
         } else if !self.still.is_empty() {
             // Bits, not values: a NaN that stays is constant, and -0 is not 0.
             let first = &self.first;
-            let changed = |l: &usize| row[*l].to_bits() != first[*l].to_bits();
-            if self.still.iter().any(changed) {
-                let (now, kept): (Vec<usize>, Vec<usize>) =
-                    self.still.iter().partition(|l| changed(l));
-                self.still = kept;
+            let pos = &self.pos;
+            let differs = |l: &usize| row[*l].to_bits() != first[*l].to_bits();
+            // A column that is still and unchanged since the previous row is still.
+            let now: Vec<usize> = match changed {
+                Some(cols) => (cols.iter())
+                    .filter(|l| pos[**l].is_none() && differs(l))
+                    .copied()
+                    .collect(),
+                None => self.still.iter().filter(|l| differs(l)).copied().collect(),
+            };
+            if !now.is_empty() {
+                self.still.retain(|l| !now.contains(l));
                 for l in now {
                     self.start_moving(l);
                 }
