@@ -119,15 +119,28 @@ impl VerifyReport {
             };
             s.push_str(&line);
         }
-        let n = self.altered().count();
-        if n == 0 {
+        // Not signed by the key asked for is not altered: the files may all be intact.
+        let unsigned = |c: &&FileCheck| matches!(c.status, Status::Unsigned(_));
+        let names: Vec<&str> = (self.altered().filter(|c| !unsigned(c)))
+            .map(|c| c.file.as_str())
+            .collect();
+        let intact = self.checks.iter().filter(|c| c.status == Status::Intact);
+        if names.is_empty() {
             s.push_str(&format!(
                 "intact: {} file(s) match the hashes recorded by the run\n",
-                self.checks.len()
+                intact.count()
             ));
         } else {
-            let names: Vec<&str> = self.altered().map(|c| c.file.as_str()).collect();
             s.push_str(&format!("ALTERED since the run: {}\n", names.join(", ")));
+        }
+        let unsigned: Vec<&str> = (self.checks.iter().filter(unsigned))
+            .map(|c| c.file.as_str())
+            .collect();
+        if !unsigned.is_empty() {
+            s.push_str(&format!(
+                "NOT SIGNED by the key given: {}\n",
+                unsigned.join(", ")
+            ));
         }
         s
     }

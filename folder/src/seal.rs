@@ -524,6 +524,13 @@ mod tests {
             "{}",
             signed.text()
         );
+        // Not vouched for is not altered: the verdict says which (issue 39).
+        assert!(!signed.text().contains("ALTERED"), "{}", signed.text());
+        assert!(
+            (signed.text()).contains("NOT SIGNED by the key given: report.md"),
+            "{}",
+            signed.text()
+        );
 
         // An unknown file, and a seal whose hash is not the one beside it.
         let h = folder(&[("imu.csv", "1"), ("report.md", "new"), ("x", "")]);

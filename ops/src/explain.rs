@@ -263,10 +263,13 @@ fn compute(
             ratecal_analysis::twin::compare_source(rec, &twin, &opts).map(|(x, r)| (x, Some(r)))
         }
     };
-    let (x, mut twin) = explained.map_err(|e| {
+    let (mut x, mut twin) = explained.map_err(|e| {
         errln!("{:?}", miette::Report::new(e));
         2
     })?;
+    if args.procedure.is_none() && twin.is_none() {
+        held_by_the_run(&args.run, rec, &mut x);
+    }
     let mut failed = None;
     if let (Some(f), Some(r)) = (&twin_file, &mut twin) {
         r.station = args
@@ -279,6 +282,18 @@ fn compute(
         }
     }
     Ok((x, twin, failed))
+}
+
+/// A run folder's own procedure (its `plan.json`): the findings it already holds are not
+/// to be added (`already_held`). A folder without one (an import) is left as it is.
+fn held_by_the_run(run: &Path, rec: &Streamed, x: &mut explain::Explanation) {
+    let plan = std::fs::read_to_string(run.join(ratecal_folder::names::PLAN))
+        .ok()
+        .and_then(|t| serde_json::from_str::<ratecal_analysis::plan::Plan>(&t).ok());
+    if let Some(plan) = plan {
+        let lat = rec.manifest().station.site.latitude_deg;
+        explain::mark_held(x, &NominalModel::from_plan(&plan, lat));
+    }
 }
 
 /// The twin's station file, read and held against the manifest; its user effects join

@@ -142,3 +142,45 @@ fn the_adoption_diff_applies_and_the_new_version_checks() {
         text(&d)
     );
 }
+
+/// A run folder explained against the seed model: its own procedure already holds the
+/// Earth's rate (every procedure's references hold it at the station's latitude), so
+/// explain names it but does not ask to add it (issue 39: "add `with earth_rate`" where
+/// results.json held `earth_rate (fixed)`).
+#[test]
+fn what_the_runs_procedure_holds_is_not_to_be_added() {
+    let tmp = tempfile::tempdir().unwrap();
+    let run = ratecal(
+        &[
+            "run",
+            &support::procedures("imu-2d-standard"),
+            "--dry-run",
+            "--out",
+            "run",
+        ],
+        tmp.path(),
+    );
+    assert_eq!(run.status.code(), Some(0), "{}", text(&run));
+    let results = support::json(&tmp.path().join("run/results.json"));
+    assert!(results.to_string().contains("earth_rate"), "{results}");
+    let o = ratecal(&["explain", "run", "--format", "json"], tmp.path());
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(
+        (v["findings"].as_array().unwrap().iter()).any(|f| f["effect"] == "earth_rate"),
+        "{v}"
+    );
+    assert_eq!(v["already_held"], serde_json::json!(["earth_rate"]));
+    assert!(
+        !v["adopt"].as_str().unwrap_or("").contains("earth_rate"),
+        "{}",
+        v["adopt"]
+    );
+    let t = ratecal(&["explain", "run"], tmp.path());
+    let out = String::from_utf8_lossy(&t.stdout);
+    assert!(!out.contains("add `with earth_rate`"), "{out}");
+    assert!(
+        out.contains("already in the run's procedure (nothing to add): earth_rate"),
+        "{out}"
+    );
+}

@@ -357,6 +357,7 @@ pub(crate) fn explain_fitted(
             .collect(),
         unexplained,
         adopt,
+        already_held: Vec::new(),
         adopt_diff: None,
         draft_effects: Vec::new(),
         user_effects: opts
@@ -422,12 +423,34 @@ fn gap_step_beside(d: &Finding, channel: &str, seg: &crate::recording::Segment) 
 /// How to adopt the findings (`with lever_arm, time_offset`): only the registry's effects
 /// can be declared in a procedure.
 fn adopt_of(findings: &[Finding]) -> Option<String> {
+    adopt_ids(findings, &[])
+}
+
+fn adopt_ids(findings: &[Finding], held: &[String]) -> Option<String> {
     let ids: Vec<&str> = findings
         .iter()
-        .filter(|f| f.defined_in.is_none() && !f.discovered)
+        .filter(|f| f.defined_in.is_none() && !f.discovered && !held.contains(&f.effect))
         .map(|f| f.effect.as_str())
         .collect();
     (!ids.is_empty()).then(|| format!("with {}", ids.join(", ")))
+}
+
+/// A run folder explained against the seed model: the findings its own procedure already
+/// holds (`model`: fitted, or held at a known value such as the Earth's rate in every
+/// procedure's references) are listed in `already_held` and left out of `adopt`, so that
+/// explain never asks to add what the run's results hold.
+pub fn mark_held(x: &mut Explanation, model: &NominalModel) {
+    let held: Vec<String> = (x.findings.iter())
+        .filter(|f| f.defined_in.is_none() && !f.discovered)
+        .map(|f| f.effect.clone())
+        .filter(|id| {
+            model.effects.contains(&id.as_str()) || model.fixed.iter().any(|(f, _)| f == id)
+        })
+        .collect();
+    if !held.is_empty() {
+        x.adopt = adopt_ids(&x.findings, &held);
+        x.already_held = held;
+    }
 }
 
 /// One accepted step as a finding, its parameters from the final model fitted on every

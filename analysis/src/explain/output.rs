@@ -269,6 +269,10 @@ pub struct Explanation {
     pub unexplained: Vec<Unexplained>,
     /// How to adopt the findings: the registry effects to add to the procedure's fits.
     pub adopt: Option<String>,
+    /// Registry effects found that the run's own procedure already holds (a run folder
+    /// explained against the seed model): nothing to add for them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub already_held: Vec<String>,
     /// With a procedure: the unified diff that adds them to its fit statements.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub adopt_diff: Option<String>,

@@ -164,6 +164,13 @@ pub fn render_text(x: &Explanation) -> String {
         }
         (None, None) => {}
     }
+    if !x.already_held.is_empty() {
+        let _ = writeln!(
+            s,
+            "already in the run's procedure (nothing to add): {}",
+            x.already_held.join(", ")
+        );
+    }
     let user: Vec<&str> = x
         .findings
         .iter()

@@ -344,9 +344,7 @@ pub fn blocks(c: &Certificate) -> Vec<Block> {
             bu.quantity,
             with_unit(&num(bu.value), &bu.unit),
             with_unit(&num(bu.u_c), &bu.unit),
-            bu.nu_eff
-                .map(|n| format!("{n:.1}"))
-                .unwrap_or_else(|| "∞".into()),
+            nu_eff_text(bu.nu_eff),
             bu.k,
             with_unit(&num(bu.expanded), &bu.unit)
         )));
@@ -390,4 +388,27 @@ pub fn blocks(c: &Certificate) -> Vec<Block> {
     b.push(Block::Para(REPRODUCTION.into()));
     b.push(Block::Para(format!("{END_MARK} {}", c.number_text())));
     b
+}
+
+/// Effective degrees of freedom as a metrologist writes them: "∞" above 1000 (k no longer
+/// depends on them) and when infinite, else to one decimal. The JSON keeps the number.
+pub(crate) fn nu_eff_text(nu: Option<f64>) -> String {
+    match nu {
+        Some(n) if n <= NU_EFF_INFINITE => format!("{n:.1}"),
+        _ => "∞".into(),
+    }
+}
+
+/// Above this many effective degrees of freedom they are printed as infinite.
+pub(crate) const NU_EFF_INFINITE: f64 = 1000.0;
+
+#[cfg(test)]
+mod nu_eff_tests {
+    #[test]
+    fn large_degrees_of_freedom_read_as_infinite() {
+        assert_eq!(super::nu_eff_text(Some(2527562934.9)), "∞");
+        assert_eq!(super::nu_eff_text(Some(1000.0)), "1000.0");
+        assert_eq!(super::nu_eff_text(Some(12.34)), "12.3");
+        assert_eq!(super::nu_eff_text(None), "∞");
+    }
 }

@@ -165,6 +165,15 @@ impl Refs {
     }
 }
 
+/// Adds `sign` times the references to the outputs.
+fn shift(outputs: &mut [Cow<[f64]>; 6], refs: &Refs, sign: f64) {
+    for (c, o) in outputs.iter_mut().enumerate() {
+        for (i, v) in o.to_mut().iter_mut().enumerate() {
+            *v += sign * refs.at(c, i);
+        }
+    }
+}
+
 /// What ideal sensors read: specific force, m/s^2, and inertial rate, deg/s.
 fn reference(s: &Signals) -> [f64; 6] {
     let (f, w) = (s.f_b, s.w_ib_dps());
@@ -251,11 +260,17 @@ impl Window<'_> {
             if let Some((order, cutoff)) = po.lowpass {
                 let first = self.sum.rows == 0;
                 let id = &self.seg.id;
+                // The filter runs on what the outputs hold beyond their references: the
+                // motion itself (gravity turning through an axis at g w) is not noise, and
+                // a filter started at a segment's first sample would leave its start-up
+                // transient on it (0.03 m/s^2 at 100 deg/s on the default station).
+                shift(&mut outputs, &refs, -1.0);
                 match prep::lowpass(&mut outputs, &keep_a, &keep_g, v.t, order, cutoff) {
                     Ok(()) => {}
                     Err(why) if first => self.sum.warnings.push(format!("segment {id}: {why}")),
                     Err(_) => {}
                 }
+                shift(&mut outputs, &refs, 1.0);
             }
         }
         // The raw rows against their references, for the sanity checks.
