@@ -145,7 +145,9 @@ impl<'l> Accumulator<'l> {
         let varies = |g: usize| varying.contains(&layout.cols[g].effect);
         let positions = |c: usize, want: bool| -> Vec<usize> {
             let cols = &layout.by_channel[c];
-            let mut v: Vec<usize> = (0..cols.len()).filter(|&k| varies(cols[k]) == want).collect();
+            let mut v: Vec<usize> = (0..cols.len())
+                .filter(|&k| varies(cols[k]) == want)
+                .collect();
             if want {
                 v.push(cols.len());
             }
@@ -325,7 +327,11 @@ mod tests {
         };
         let geo = Geometry::seed();
         let rest = |o: f64, i: f64| {
-            Signals::new(&TableState::at_rest_deg(o, i).snapshot(&geo, &site), &site, 0.0)
+            Signals::new(
+                &TableState::at_rest_deg(o, i).snapshot(&geo, &site),
+                &site,
+                0.0,
+            )
         };
         let (a, b) = (rest(0.0, 0.0), rest(90.0, 30.0));
         let mut acc = Accumulator::new(0, 0.0, &layout);
