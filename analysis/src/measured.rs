@@ -48,6 +48,24 @@ pub fn format_value(value: f64, unit: &str) -> String {
 
 /// `value ± u` without a unit (`0.01234 ± 0.00056`, `(3.20 ± 0.41)e-6`).
 pub fn measured_number(value: f64, u: f64) -> String {
+    let (v, u, e) = measured_parts(value, u);
+    match e {
+        None => format!("{v} ± {u}"),
+        Some(e) => format!("({v} ± {u})e{e}"),
+    }
+}
+
+/// The value and `u` of [`measured_number`] apart, for a table that prints them in two
+/// columns, each with the power of ten they share (`8.54e-6`, `0.16e-6`).
+pub fn measured_columns(value: f64, u: f64) -> (String, String) {
+    match measured_parts(value, u) {
+        (v, u, None) => (v, u),
+        (v, u, Some(e)) => (format!("{v}e{e}"), format!("{u}e{e}")),
+    }
+}
+
+/// The digits of the value and of `u`, and the power of ten factored out of both.
+fn measured_parts(value: f64, u: f64) -> (String, String, Option<i32>) {
     if !value.is_finite() {
         let u = if u.is_finite() && u > 0.0 {
             let (n, p) = round_sig(u, 2);
@@ -55,7 +73,7 @@ pub fn measured_number(value: f64, u: f64) -> String {
         } else {
             special(u)
         };
-        return format!("{} ± {u}", special(value));
+        return (special(value), u, None);
     }
     if !(u.is_finite() && u > 0.0) {
         let shown = if u < 0.0 && u.is_finite() {
@@ -63,7 +81,7 @@ pub fn measured_number(value: f64, u: f64) -> String {
         } else {
             special(u)
         };
-        return format!("{} ± {shown}", short(value, 6));
+        return (short(value, 6), shown, None);
     }
     let (nu, p) = round_sig(u, 2);
     let nv = Dec::of(value).round_at(p);
@@ -73,10 +91,14 @@ pub fn measured_number(value: f64, u: f64) -> String {
         let pv = p.min(0);
         let nv = Dec::of(value).round_at(pv);
         let sign = if value < 0.0 && nv != "0" { "-" } else { "" };
-        format!("{sign}{} ± {}", plain(&nv, pv), plain(&nu, p))
+        (format!("{sign}{}", plain(&nv, pv)), plain(&nu, p), None)
     } else {
         let sign = if value < 0.0 && nv != "0" { "-" } else { "" };
-        format!("({sign}{} ± {})e{e}", plain(&nv, p - e), plain(&nu, p - e))
+        (
+            format!("{sign}{}", plain(&nv, p - e)),
+            plain(&nu, p - e),
+            Some(e),
+        )
     }
 }
 

@@ -3,8 +3,9 @@
 use crate::{RunDetail, RunSummary};
 use ratecal_analysis::measured::format_measured;
 
-/// `archive list` as a table, one run a line, with the count.
-pub fn list_table(runs: &[RunSummary]) -> String {
+/// `archive list` as a table, one run a line, with the count and how many dry runs the
+/// filter left out (`hidden_dry`), so that an empty list is never a mystery.
+pub fn list_table(runs: &[RunSummary], hidden_dry: usize) -> String {
     let mut s = format!(
         "{:<16}  {:<12}  {:<12}  {:<20}  {:<8}  {:<20}  {:<10}  {}\n",
         "ID", "SERIAL", "MODEL", "PROCEDURE", "VERSION", "STARTED", "VERDICT", "DRY RUN"
@@ -22,8 +23,26 @@ pub fn list_table(runs: &[RunSummary]) -> String {
             if r.dry_run { "yes" } else { "no" }
         ));
     }
-    s.push_str(&format!("{} run(s)\n", runs.len()));
+    s.push_str(&format!("{} run(s)", runs.len()));
+    if hidden_dry > 0 {
+        s.push_str(&format!(
+            "; {hidden_dry} dry run(s) not listed (--include-dry-runs lists them)"
+        ));
+    }
+    s.push('\n');
     s
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn hidden_dry_runs_are_counted() {
+        assert!(super::list_table(&[], 0).ends_with("\n0 run(s)\n"));
+        assert!(
+            super::list_table(&[], 4)
+                .ends_with("0 run(s); 4 dry run(s) not listed (--include-dry-runs lists them)\n")
+        );
+    }
 }
 
 /// `archive show` in words: the run, its parameters and its stored files.

@@ -159,7 +159,7 @@ pub fn twin_of(st: &Station) -> Twin {
             accel_mps2: imu.accel_noise_density.0 * fs,
             gyro_dps: imu.gyro_noise_density.0 * fs,
         },
-        gyro_bias_instability_dps: imu.gyro_bias_instability.0,
+        gyro_bias_markov_sigma_dps: imu.gyro_bias_markov_sigma.0,
         gyro_bias_random_walk: imu.gyro_bias_random_walk.0,
     }
 }

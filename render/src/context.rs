@@ -106,6 +106,13 @@ pub fn build(input: &ReportInput) -> Value {
         "imu_rows": recording.get("imu_rows"),
         "table_rows": recording.get("table_rows"),
         "duration_s": recording.get("duration_s"),
+        // An import without a table (`table: none`) synthesizes the table stream from the
+        // declared attitudes: no feedback to speak of (docs/import.md).
+        "table_synthesized": manifest
+            .and_then(|m| m.get("station"))
+            .and_then(|s| s.pointer("/table/model"))
+            .and_then(Value::as_str)
+            .is_some_and(|t| t.starts_with("none")),
     });
 
     json!({

@@ -80,7 +80,7 @@ pub fn from_minijinja(
             "check the tag syntax: {{ expr }}, {% if %}...{% endif %}, {% for %}...{% endfor %}"
         }
         minijinja::ErrorKind::UnknownFilter => {
-            "report filters: measured, fmt_num, si, ppm, unit, cmp, verdict_label (see docs/report-templates.md)"
+            "report filters: measured, fmt_num, si, ppm, unit, cmp, verdict_label, value_of, expanded, as_written (see docs/report-templates.md)"
         }
         minijinja::ErrorKind::TemplateNotFound => "included templates must sit in the same directory",
         _ => "see docs/report-templates.md for the fields a report template can use",

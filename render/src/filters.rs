@@ -24,6 +24,56 @@ pub fn register(env: &mut Environment<'_>) {
     });
     env.add_filter("verdict_label", verdict_label);
     env.add_filter("cmp", cmp);
+    env.add_filter("value_of", value_of);
+    env.add_filter("expanded", expanded);
+    env.add_filter("as_written", as_written);
+}
+
+/// What a U column prints where no uncertainty is stated (a condition recorded once).
+pub const NOT_STATED: &str = "not stated";
+
+/// The expanded uncertainty `u` when it is one (positive and finite).
+fn stated(u: Option<Value>) -> Option<f64> {
+    u.as_ref()
+        .and_then(number)
+        .filter(|u| *u > 0.0 && u.is_finite())
+}
+
+/// `{{ c.value | value_of(c.expanded_u, c.unit) }}`: a value in a column beside its U,
+/// rounded at the place of U's second significant digit (GUM 7.2.6, the rule of
+/// `measured`); without a stated U, six significant digits.
+pub fn value_of(value: Value, u: Option<Value>, unit: Option<String>) -> String {
+    let Some(x) = number(&value) else {
+        return MISSING.to_string();
+    };
+    let unit = pretty_unit(unit.as_deref().unwrap_or(""));
+    let text = match stated(u) {
+        Some(u) => ratecal_analysis::measured::measured_columns(x, u).0,
+        None => ratecal_analysis::measured::format_value(x, ""),
+    };
+    join_unit(text, &unit)
+}
+
+/// `{{ c.expanded_u | expanded(c.unit) }}`: U to two significant digits, or `not stated`
+/// where there is none (zero or missing).
+pub fn expanded(u: Value, unit: Option<String>) -> String {
+    let Some(u) = stated(Some(u)) else {
+        return NOT_STATED.to_string();
+    };
+    let unit = pretty_unit(unit.as_deref().unwrap_or(""));
+    join_unit(ratecal_analysis::measured::measured_columns(u, u).1, &unit)
+}
+
+/// `{{ c.limit | as_written(c.unit) }}`: a limit as the procedure wrote it (six significant
+/// digits, no prefix added: `100.325 kPa`, never `100 kPa`).
+pub fn as_written(value: Value, unit: Option<String>) -> String {
+    match number(&value) {
+        Some(x) => join_unit(
+            ratecal_analysis::measured::format_value(x, ""),
+            &pretty_unit(unit.as_deref().unwrap_or("")),
+        ),
+        None => MISSING.to_string(),
+    }
 }
 
 /// `{{ check.op | cmp }}`: `<=` -> `≤`, `>=` -> `≥` (also the plan's `Le`, `Ge`...); `≤` when absent.
@@ -273,6 +323,28 @@ mod tests {
         assert_eq!(measured(Value::UNDEFINED, None, None), MISSING);
         assert_eq!(fmt_num(Value::from(()), None), MISSING);
         assert_eq!(si(Value::from("x"), None, None), MISSING);
+    }
+
+    #[test]
+    fn conformity_columns_round_as_a_lab_writes_them() {
+        // The value at U's second digit, U at two digits, the limit as written.
+        let u = Some(v(1.57e-7));
+        assert_eq!(
+            value_of(v(8.5432e-6), u.clone(), Some("g".into())),
+            "8.54e-6 g"
+        );
+        assert_eq!(expanded(v(1.57e-7), Some("g".into())), "1.6e-7 g");
+        assert_eq!(
+            value_of(v(20.0), Some(v(0.0)), Some("degC".into())),
+            "20 °C"
+        );
+        assert_eq!(expanded(v(0.0), Some("degC".into())), NOT_STATED);
+        assert_eq!(as_written(v(100.325), Some("kPa".into())), "100.325 kPa");
+        assert_eq!(
+            value_of(v(416.96137), Some(v(16.79)), Some("ppm".into())),
+            "417 ppm"
+        );
+        assert_eq!(expanded(v(16.79), Some("ppm".into())), "17 ppm");
     }
 
     #[test]

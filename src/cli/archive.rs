@@ -182,7 +182,14 @@ async fn run(loc: &Location, cmd: Command) -> Result<ExitCode, Report> {
             let runs = archive.list(&f).await?;
             match format {
                 Format::Json => outln!("{}", to_json(&runs)?),
-                Format::Table => out!("{}", ratecal_archive::list_table(&runs)),
+                Format::Table => {
+                    let all = Filter {
+                        include_dry_runs: true,
+                        ..f.clone()
+                    };
+                    let hidden = archive.list(&all).await?.len() - runs.len();
+                    out!("{}", ratecal_archive::list_table(&runs, hidden))
+                }
             }
             ExitCode::SUCCESS
         }

@@ -243,7 +243,7 @@ fn lookup(
         });
     }
     match name {
-        "repeatability.cv" => Err("repeatability needs several complete runs (`ratecal analyze RUN1 RUN2 RUN3`); one was given".into()),
+        "repeatability.cv" => Err("repeatability needs several complete runs (`ratecal analyze RUN1 RUN2 RUN3 --procedure PROCEDURE`); one was given".into()),
         "accel.error" | "gyro.error" => {
             let sensor = &name[..name.find('.').unwrap_or(0)];
             res.verification
@@ -445,7 +445,7 @@ pub(crate) fn not_evaluated(a: &Accept, why: &str) -> Acceptance {
 fn deferred(a: &Accept, n: u32) -> Acceptance {
     let mut d = not_evaluated(
         a,
-        &format!("decided over {n} runs: `ratecal analyze RUN1 ... RUN{n}`"),
+        &format!("decided over {n} runs: `ratecal analyze RUN1 ... RUN{n} --procedure PROCEDURE`"),
     );
     d.verdict = Verdict::Deferred;
     d

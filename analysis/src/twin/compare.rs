@@ -74,7 +74,7 @@ pub(super) fn report(
             .map(|s| s.t_start)
             .fold(f64::INFINITY, f64::min);
     let wander = twin
-        .gyro_bias_instability_dps
+        .gyro_bias_markov_sigma_dps
         .hypot(twin.gyro_bias_random_walk * span.max(0.0).sqrt());
     let ok = |g: usize| f.estimated.contains(&g) && !unobservable.contains(&g);
     // The fitted value of a column in the twin's reference temperature: the bias at the

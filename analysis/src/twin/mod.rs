@@ -32,7 +32,7 @@ pub struct Twin {
     /// White noise per sample: accelerometers m/s^2, gyros deg/s.
     pub noise: explain::Rms,
     /// Sigma of the gyro bias wander (Gauss-Markov), deg/s.
-    pub gyro_bias_instability_dps: f64,
+    pub gyro_bias_markov_sigma_dps: f64,
     /// Gyro bias random walk, deg/s per root second.
     pub gyro_bias_random_walk: f64,
 }

@@ -110,7 +110,7 @@ pub(super) fn predict(
             let wander2 = if c < 3 {
                 0.0
             } else {
-                twin.gyro_bias_instability_dps.powi(2)
+                twin.gyro_bias_markov_sigma_dps.powi(2)
                     + twin.gyro_bias_random_walk.powi(2) * t_mid.max(0.0)
             };
             let white_twin = if c < 3 {
@@ -167,7 +167,7 @@ pub(super) fn predict(
         },
         noise: Rms {
             accel_mps2: twin.noise.accel_mps2,
-            gyro_dps: twin.noise.gyro_dps.hypot(twin.gyro_bias_instability_dps),
+            gyro_dps: twin.noise.gyro_dps.hypot(twin.gyro_bias_markov_sigma_dps),
         },
         segments,
         disagree: disagree.into_iter().take(MOST).map(|d| d.1).collect(),

@@ -178,8 +178,8 @@ fn navigation_grade_imu_shows_the_earth_rate() {
                 "gyro_noise_density: 0.00003 deg/s/rtHz",
             ),
             (
-                "gyro_bias_instability: 2 deg/h",
-                "gyro_bias_instability: 0.01 deg/h",
+                "gyro_bias_markov_sigma: 2 deg/h",
+                "gyro_bias_markov_sigma: 0.01 deg/h",
             ),
             (
                 "gyro_bias_random_walk: 1e-6 deg/s/rts",
@@ -231,8 +231,8 @@ fn thermal_drift_at_two_thirds_of_the_noise() {
     let st = station(
         "{ gyro_thermal_drift: { x: 0.0005 } }",
         &[(
-            "gyro_bias_instability: 2 deg/h",
-            "gyro_bias_instability: 0.3 deg/h",
+            "gyro_bias_markov_sigma: 2 deg/h",
+            "gyro_bias_markov_sigma: 0.3 deg/h",
         )],
     );
     for seed in [18, 19] {

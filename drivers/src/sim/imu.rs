@@ -68,7 +68,7 @@ impl SimImu {
         let fs = imu.sample_rate.0;
         let bias_every = ((BIAS_STEP_S * fs).floor() as u64).max(1);
         let step = bias_every as f64 / fs;
-        let sigma_gm = imu.gyro_bias_instability.0;
+        let sigma_gm = imu.gyro_bias_markov_sigma.0;
         let gm_phi = (-step / imu.gyro_bias_correlation_time.0).exp();
         let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x1_0000_0000_1A1B);
         // Start the Gauss-Markov bias in its stationary distribution.

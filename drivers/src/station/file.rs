@@ -285,9 +285,12 @@ pub struct ImuSpec {
     /// Gyro white-noise density; per-sample sigma = density * sqrt(sample rate).
     #[serde(default)]
     pub gyro_noise_density: RateDensity,
-    /// Gyro bias instability: sigma of a first-order Gauss-Markov bias.
-    #[serde(default)]
-    pub gyro_bias_instability: Rate,
+    /// Sigma of a first-order Gauss-Markov gyro bias. Not the Allan deviation's
+    /// bias-instability floor a report prints (about 0.66 of this sigma at its best
+    /// averaging time): one name per quantity. `gyro_bias_instability`, its former name,
+    /// is still read.
+    #[serde(default, alias = "gyro_bias_instability")]
+    pub gyro_bias_markov_sigma: Rate,
     /// Correlation time of the Gauss-Markov bias.
     #[serde(default = "default_correlation", deserialize_with = "positive")]
     pub gyro_bias_correlation_time: Time,

@@ -144,7 +144,7 @@ impl Station {
         let imu = &mut self.imu;
         imu.accel_noise_density = AccelDensity(0.0);
         imu.gyro_noise_density = RateDensity(0.0);
-        imu.gyro_bias_instability = Rate(0.0);
+        imu.gyro_bias_markov_sigma = Rate(0.0);
         imu.gyro_bias_random_walk = RateWalk(0.0);
         self.table.position_noise = Angle(0.0);
         self.table.rate_ripple = Rate(0.0);

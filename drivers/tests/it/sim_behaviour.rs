@@ -236,3 +236,16 @@ async fn noise_has_the_configured_size() {
     assert!((sa / (2e-6 * 9.80665 * 10.0) - 1.0).abs() < 0.05, "{sa}");
     assert!((sg / 0.003 - 1.0).abs() < 0.05, "{sg}");
 }
+
+/// The Gauss-Markov sigma has one name (`gyro_bias_markov_sigma`, not the Allan floor's
+/// "bias instability"); station files written with the former name read the same.
+#[test]
+fn the_markov_sigma_reads_under_its_former_name_too() {
+    let now = station(&[]);
+    let old = station(&[("gyro_bias_markov_sigma:", "gyro_bias_instability:")]);
+    assert!(now.imu.gyro_bias_markov_sigma.0 > 0.0);
+    assert_eq!(
+        now.imu.gyro_bias_markov_sigma.0,
+        old.imu.gyro_bias_markov_sigma.0
+    );
+}
