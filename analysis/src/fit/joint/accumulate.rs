@@ -219,16 +219,7 @@ impl<'l> Accumulator<'l> {
     /// with a non-finite output (a saturated channel) is left out.
     pub(crate) fn push(&mut self, sig: &Signals, t: f64, acc: [f64; 3], gyr: [f64; 3]) {
         let layout = self.layout;
-        let base_a = sig.f_b;
-        let base_g = sig.w_b_dps();
-        let out = [
-            acc[0] - base_a.x,
-            acc[1] - base_a.y,
-            acc[2] - base_a.z,
-            gyr[0] - base_g.x,
-            gyr[1] - base_g.y,
-            gyr[2] - base_g.z,
-        ];
+        let out = observed(sig, acc, gyr);
         if out.iter().any(|v| !v.is_finite()) {
             return;
         }
@@ -297,6 +288,20 @@ impl<'l> Accumulator<'l> {
     }
 }
 
+/// The outputs less what ideal sensors read (the specific force, m/s^2, and the inertial
+/// rate, deg/s): the observation each channel's row ends with.
+fn observed(sig: &Signals, acc: [f64; 3], gyr: [f64; 3]) -> [f64; 6] {
+    let (f, w) = (sig.f_b, sig.w_b_dps());
+    [
+        acc[0] - f.x,
+        acc[1] - f.y,
+        acc[2] - f.z,
+        gyr[0] - w.x,
+        gyr[1] - w.y,
+        gyr[2] - w.z,
+    ]
+}
+
 /// Residual sum of squares of channel `c` of a segment for global coefficients `theta`
 /// (zero for columns outside the model): `|R [theta_c; -1]|^2`.
 pub(crate) fn seg_rss(acc: &SegAcc, layout: &Layout, c: usize, theta: &DVector<f64>) -> f64 {
@@ -346,15 +351,7 @@ mod tests {
             for (e, fx) in layout.effects.iter().enumerate() {
                 fx.regressors(&s, &mut parts[layout.columns_of(e)]);
             }
-            let (base_a, base_g) = (s.f_b, s.w_b_dps());
-            let out = [
-                fa[0] - base_a.x,
-                fa[1] - base_a.y,
-                fa[2] - base_a.z,
-                fg[0] - base_g.x,
-                fg[1] - base_g.y,
-                fg[2] - base_g.z,
-            ];
+            let out = observed(&s, fa, fg);
             for (c, r) in rows.iter_mut().enumerate() {
                 let (sensor, ax) = channel(c);
                 let mut row: Vec<f64> = (layout.by_channel[c].iter())
