@@ -33,18 +33,6 @@ pub fn list_table(runs: &[RunSummary], hidden_dry: usize) -> String {
     s
 }
 
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn hidden_dry_runs_are_counted() {
-        assert!(super::list_table(&[], 0).ends_with("\n0 run(s)\n"));
-        assert!(
-            super::list_table(&[], 4)
-                .ends_with("0 run(s); 4 dry run(s) not listed (--include-dry-runs lists them)\n")
-        );
-    }
-}
-
 /// `archive show` in words: the run, its parameters and its stored files.
 pub fn show_text(d: &RunDetail) -> String {
     let r = &d.summary;
@@ -83,4 +71,16 @@ pub fn show_text(d: &RunDetail) -> String {
         ));
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn hidden_dry_runs_are_counted() {
+        assert!(super::list_table(&[], 0).ends_with("\n0 run(s)\n"));
+        assert!(
+            super::list_table(&[], 4)
+                .ends_with("0 run(s); 4 dry run(s) not listed (--include-dry-runs lists them)\n")
+        );
+    }
 }
