@@ -220,7 +220,11 @@ fn explain_or_exit(args: &Request) -> Result<u8, Exit> {
     }
     Ok(match &twin {
         Some(r) => u8::from(r.needs_change),
-        None => u8::from(!(x.findings.is_empty() && x.unexplained.is_empty())),
+        // What the run's own procedure already holds is nothing to add.
+        None => u8::from(
+            (x.findings.iter()).any(|f| !x.already_held.contains(&f.effect))
+                || !x.unexplained.is_empty(),
+        ),
     })
 }
 

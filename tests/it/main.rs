@@ -39,6 +39,7 @@ mod manual_real;
 mod manual_resume;
 mod manual_station;
 mod progress_log;
+mod readme_walkthrough;
 mod release_cli;
 mod run_cli;
 mod run_folder_lock;
