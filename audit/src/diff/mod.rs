@@ -24,11 +24,12 @@ pub fn diff(old: &Plan, new: &Plan) -> Vec<Change> {
     limits::accepts(None, &old.accepts, &new.accepts, &mut out);
     limits::verifications(&old.verifications, &new.verifications, &mut out);
     if (old.estimated_duration_s - new.estimated_duration_s).abs() >= 1.0 {
+        let (a, b) = fmt_durations(old.estimated_duration_s, new.estimated_duration_s);
         out.push(Change::value(
             "estimated duration",
             ChangeKind::Changed,
-            fmt_duration(old.estimated_duration_s),
-            fmt_duration(new.estimated_duration_s),
+            a,
+            b,
         ));
     }
     out
@@ -41,6 +42,20 @@ fn fmt_duration(s: f64) -> String {
     } else {
         fmt_s(s.round())
     }
+}
+
+/// Two durations that differ, in the coarsest form that shows it (`73.4 min` to `73.5
+/// min`, else minutes and seconds: `73 min 24 s` to `73 min 27 s`).
+fn fmt_durations(old: f64, new: f64) -> (String, String) {
+    let (a, b) = (fmt_duration(old), fmt_duration(new));
+    if a != b {
+        return (a, b);
+    }
+    let ms = |s: f64| {
+        let s = s.round();
+        format!("{} min {} s", (s / 60.0).floor(), s % 60.0)
+    };
+    (ms(old), ms(new))
 }
 
 fn text_change(path: &str, old: &str, new: &str, out: &mut Vec<Change>) {

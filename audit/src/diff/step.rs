@@ -201,9 +201,22 @@ fn values_same(a: &Option<serde_json::Value>, b: &Option<serde_json::Value>) -> 
     }
 }
 
-/// Added, removed and (when `order` matters) moved elements of a multiset.
+/// Added, removed and (when `order` matters) moved elements of a multiset. An edited list
+/// (elements both out and in, more than one of each, as one edit of a `for` list gives on
+/// every axis) is one change: the list as it was and as it is, as a procedure writes it.
 fn elements(path: &str, old: &[String], new: &[String], order: bool, out: &mut Vec<Change>) {
     let pairs = pair(old, new, |s| s.clone());
+    let gone = pairs.iter().filter(|p| matches!(p, Pair::Old(..))).count();
+    let came = pairs.iter().filter(|p| matches!(p, Pair::New(..))).count();
+    if order && gone > 0 && came > 0 && gone + came > 2 {
+        out.push(Change::value(
+            format!("{path}s"),
+            ChangeKind::Changed,
+            compact(old),
+            compact(new),
+        ));
+        return;
+    }
     let mut flags = moved_pairs(&pairs).into_iter();
     for p in pairs {
         match p {
@@ -221,6 +234,34 @@ fn elements(path: &str, old: &[String], new: &[String], order: bool, out: &mut V
             }
         }
     }
+}
+
+/// A list of elements as a procedure's `for` list reads: consecutive elements that share
+/// their first and last word (`outer 50 deg/s`, `outer 100 deg/s`) as one group
+/// (`outer 50, 100 deg/s`), groups separated by `; `.
+fn compact(items: &[String]) -> String {
+    let split = |s: &str| -> Option<(String, String, String)> {
+        let w: Vec<&str> = s.split(' ').collect();
+        (w.len() == 3).then(|| (w[0].into(), w[1].into(), w[2].into()))
+    };
+    let mut groups: Vec<(String, Vec<String>, String)> = Vec::new();
+    for it in items {
+        match (split(it), groups.last_mut()) {
+            (Some((h, v, u)), Some(g)) if g.0 == h && g.2 == u && !g.1.is_empty() => g.1.push(v),
+            (Some((h, v, u)), _) => groups.push((h, vec![v], u)),
+            (None, _) => groups.push((it.clone(), Vec::new(), String::new())),
+        }
+    }
+    if groups.is_empty() {
+        return "none".into();
+    }
+    (groups.iter())
+        .map(|(h, v, u)| match v.is_empty() {
+            true => h.clone(),
+            false => format!("{h} {} {u}", v.join(", ")),
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
 }
 
 fn repeats(
@@ -315,10 +356,39 @@ fn collapse(
     }
 }
 
+/// Acquisitions that went out and came in alike but for their segment's name, in order:
+/// what an edited rate or attitude list renames. `None` when any differs in more.
+fn renamed(pairs: &[Pair<'_, &Acquire>]) -> Option<(Vec<String>, Vec<String>)> {
+    let gone: Vec<&Acquire> = (pairs.iter())
+        .filter_map(|p| if let Pair::Old(a) = p { Some(**a) } else { None })
+        .collect();
+    let came: Vec<&Acquire> = (pairs.iter())
+        .filter_map(|p| if let Pair::New(a) = p { Some(**a) } else { None })
+        .collect();
+    let alike = gone.len() == came.len()
+        && gone.len() > 1
+        && gone.iter().zip(&came).all(|(o, n)| acquire_str(o) == acquire_str(n));
+    let names = |v: &[&Acquire]| v.iter().map(|a| a.segment.clone()).collect();
+    alike.then(|| (names(&gone), names(&came)))
+}
+
 fn acquires(path: &str, old: &[&Acquire], new: &[&Acquire], out: &mut Vec<Change>) {
     let mut changes = Vec::new();
     let mut paired = 0;
-    for p in pair(old, new, |a| a.segment.clone()) {
+    let pairs = pair(old, new, |a| a.segment.clone());
+    let renamed = renamed(&pairs);
+    if let Some((gone, came)) = &renamed {
+        out.push(Change::value(
+            format!("{path} / acquisitions renamed"),
+            ChangeKind::Changed,
+            gone.join(", "),
+            came.join(", "),
+        ));
+    }
+    for p in pairs {
+        if renamed.is_some() && !matches!(p, Pair::Both(..)) {
+            continue;
+        }
         match p {
             Pair::Old(a) => out.push(Change::removed(
                 format!("{path} / acquire {}", a.segment),

@@ -159,6 +159,14 @@ fn each_case_reports_the_edit_it_made() {
             "step gyro_scale / rate point inner 150 deg/s",
             Added,
         ),
+        // One edit of a `for` list is one change to the list, not one per axis and
+        // acquisition.
+        ("rate_list_edited", "step gyro_scale / rate points", Changed),
+        (
+            "rate_list_edited",
+            "step gyro_scale / acquisitions renamed",
+            Changed,
+        ),
         (
             "settle_changed",
             "step accel_static / settle / fluctuation",
@@ -208,4 +216,30 @@ fn each_case_reports_the_edit_it_made() {
             );
         }
     }
+}
+
+/// One edited rate list (100 deg/s made 150 deg/s, on both axes) reads as that edit: the
+/// list, the acquisitions it renames and the duration, not a removal and an addition per
+/// axis and per acquisition.
+#[test]
+fn an_edited_rate_list_is_one_change_of_the_list() {
+    let r = report("rate_list_edited");
+    let paths: Vec<&str> = r.changes.iter().map(|c| c.path.as_str()).collect();
+    assert_eq!(
+        paths,
+        [
+            "step gyro_scale / rate points",
+            "step gyro_scale / acquisitions renamed",
+            "estimated duration"
+        ],
+        "{:#?}",
+        r.changes
+    );
+    let list = &r.changes[0];
+    assert_eq!(
+        list.new.as_deref(),
+        Some("outer -100, -50, 0, 50, 150 deg/s; inner -100, -50, 0, 50, 150 deg/s")
+    );
+    let (old, new) = (&r.changes[2].old, &r.changes[2].new);
+    assert_ne!(old, new, "a duration change that prints as none");
 }
