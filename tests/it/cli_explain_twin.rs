@@ -105,6 +105,22 @@ fn twins_of_the_independent_example_right_missing_wrong_and_a_pair() {
         ["lever_arm.rxx_mm", "lever_arm.ryy_mm", "lever_arm.rzz_mm"]
     );
     assert!(ch.iter().all(|c| c.1 == 0.0));
+    // The six off-diagonal coordinates the standard's rotations cannot excite are kept at
+    // the twin's value, and said to be.
+    let kept: Vec<String> = (v["twin"]["not_determined"].as_array().unwrap().iter())
+        .map(|k| {
+            format!(
+                "{}.{}",
+                k["effect"].as_str().unwrap(),
+                k["parameter"].as_str().unwrap()
+            )
+        })
+        .collect();
+    assert_eq!(kept.len(), 6, "{kept:?}");
+    assert!(
+        kept.iter()
+            .all(|k| k.starts_with("lever_arm.r") && !names.contains(&k.as_str()))
+    );
     for (name, truth) in [
         ("lever_arm.rxx_mm", -4.0),
         ("lever_arm.ryy_mm", 14.0),

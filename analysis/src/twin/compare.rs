@@ -9,7 +9,7 @@
 //! but a fraction `alpha` of recordings. An effect found that the twin lacks is added with
 //! every parameter the recording determines (`from` 0).
 
-use super::output::{Change, TwinReport};
+use super::output::{Change, Kept, TwinReport};
 use super::predict::{THERMAL, predict, theta};
 use super::{Twin, update};
 use crate::explain::data::Data;
@@ -194,14 +194,46 @@ pub(super) fn report(
     let after = predict(m, data, &updated, &th_updated, &white);
     let series = super::series::pick(m, data, &before, &th_twin, &th_updated);
     let needs_change = !changes.is_empty() || !x.findings.is_empty() || !x.unexplained.is_empty();
+    let not_determined = not_determined(lay, twin, &changes, ok);
     TwinReport {
         station: String::new(),
         before,
         after,
         changes,
+        not_determined,
         needs_change,
         written: None,
         diff: None,
         series,
     }
+}
+
+/// The parameters of every effect that changes or joins the twin which this recording
+/// cannot determine: they keep the twin's value (0 for an effect it lacked), said so.
+fn not_determined(
+    lay: &crate::fit::joint::Layout,
+    twin: &Twin,
+    changes: &[Change],
+    ok: impl Fn(usize) -> bool,
+) -> Vec<Kept> {
+    let mut ids: Vec<&str> = changes.iter().map(|c| c.effect.as_str()).collect();
+    ids.dedup();
+    let mut out = Vec::new();
+    for id in ids {
+        let Some(e) = lay.index(id) else { continue };
+        let fx = lay.effects[e];
+        for (k, g) in lay.columns_of(e).enumerate() {
+            if ok(g) {
+                continue;
+            }
+            let p = &fx.params()[k];
+            out.push(Kept {
+                effect: id.into(),
+                parameter: p.name.into(),
+                value: (twin.values(id).and_then(|v| v.get(k)).copied()).unwrap_or(0.0),
+                unit: p.unit.into(),
+            });
+        }
+    }
+    out
 }

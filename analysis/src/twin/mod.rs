@@ -14,7 +14,7 @@ mod series;
 mod text;
 mod update;
 
-pub use output::{Change, Prediction, SegmentResidual, Series, TwinReport};
+pub use output::{Change, Kept, Prediction, SegmentResidual, Series, TwinReport};
 pub use text::render_text;
 
 use crate::explain::{self, Explanation, NominalModel, Options};

@@ -15,6 +15,10 @@ pub struct TwinReport {
     pub after: Prediction,
     /// What the recording says the twin gets wrong or lacks (empty when it is right).
     pub changes: Vec<Change>,
+    /// Parameters of the changed or added effects that the recording cannot determine
+    /// (its motion does not excite them): kept at the twin's value, not changed.
+    #[serde(default)]
+    pub not_determined: Vec<Kept>,
     /// Whether the twin needs a change: a changed parameter, missing physics or a
     /// residual nothing explains.
     pub needs_change: bool,
@@ -115,4 +119,17 @@ pub struct Change {
     /// The user effect's file, for a user effect.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub defined_in: Option<String>,
+}
+
+/// A parameter the recording cannot determine, kept as the twin has it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Kept {
+    /// Registry or user effect id.
+    pub effect: String,
+    /// Parameter name.
+    pub parameter: String,
+    /// The twin's value, kept (0 for an effect it lacked).
+    pub value: f64,
+    /// Its unit.
+    pub unit: String,
 }

@@ -49,6 +49,19 @@ pub fn render_text(r: &TwinReport) -> String {
             );
         }
     }
+    if !r.not_determined.is_empty() {
+        let names: Vec<String> = (r.not_determined.iter())
+            .map(|k| {
+                let v = crate::measured::format_value(k.value, &k.unit);
+                format!("{}.{} ({v})", k.effect, k.parameter)
+            })
+            .collect();
+        let _ = writeln!(
+            s,
+            "  kept as the twin has them (this recording cannot determine them): {}",
+            names.join(", ")
+        );
+    }
     if let Some(w) = &r.written {
         let _ = writeln!(s, "  written: {w}");
     }

@@ -360,14 +360,29 @@ fn collapse(
 /// what an edited rate or attitude list renames. `None` when any differs in more.
 fn renamed(pairs: &[Pair<'_, &Acquire>]) -> Option<(Vec<String>, Vec<String>)> {
     let gone: Vec<&Acquire> = (pairs.iter())
-        .filter_map(|p| if let Pair::Old(a) = p { Some(**a) } else { None })
+        .filter_map(|p| {
+            if let Pair::Old(a) = p {
+                Some(**a)
+            } else {
+                None
+            }
+        })
         .collect();
     let came: Vec<&Acquire> = (pairs.iter())
-        .filter_map(|p| if let Pair::New(a) = p { Some(**a) } else { None })
+        .filter_map(|p| {
+            if let Pair::New(a) = p {
+                Some(**a)
+            } else {
+                None
+            }
+        })
         .collect();
     let alike = gone.len() == came.len()
         && gone.len() > 1
-        && gone.iter().zip(&came).all(|(o, n)| acquire_str(o) == acquire_str(n));
+        && gone
+            .iter()
+            .zip(&came)
+            .all(|(o, n)| acquire_str(o) == acquire_str(n));
     let names = |v: &[&Acquire]| v.iter().map(|a| a.segment.clone()).collect();
     alike.then(|| (names(&gone), names(&came)))
 }
