@@ -250,6 +250,16 @@ pub enum Parameter {
         /// Unit (`m/s^2`, `ppm`, `deg/s`, `mrad`...).
         unit: String,
     },
+    /// `{ "upper_bound": 26.9, "unit": "deg/h", "why": "..." }`: the data bound the value from
+    /// above and determine it no further (no value, no uncertainty is printed for it).
+    UpperBound {
+        /// The bound.
+        upper_bound: f64,
+        /// Unit.
+        unit: String,
+        /// Why only a bound.
+        why: String,
+    },
     /// `{ "observable": false, "needs": "..." }`.
     Unobservable {
         /// Always `false`.
@@ -290,14 +300,14 @@ impl Parameter {
     pub fn value_u(&self) -> Option<(f64, f64)> {
         match self {
             Parameter::Estimate { value, u, .. } => Some((*value, *u)),
-            Parameter::Unobservable { .. } => None,
+            Parameter::UpperBound { .. } | Parameter::Unobservable { .. } => None,
         }
     }
 
     /// Unit of an estimate.
     pub fn unit(&self) -> Option<&str> {
         match self {
-            Parameter::Estimate { unit, .. } => Some(unit),
+            Parameter::Estimate { unit, .. } | Parameter::UpperBound { unit, .. } => Some(unit),
             Parameter::Unobservable { .. } => None,
         }
     }

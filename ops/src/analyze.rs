@@ -215,6 +215,12 @@ fn summary(r: &Results) {
                 errln!("  {name:<32} {}", format_measured(*value, *u, unit))
             }
             Parameter::Unobservable { .. } => errln!("  {name:<32} not observable"),
+            Parameter::UpperBound {
+                upper_bound, unit, ..
+            } => errln!(
+                "  {name:<32} <= {} (upper bound only)",
+                ratecal_analysis::measured::format_value(*upper_bound, unit)
+            ),
         }
     }
     for a in &r.acceptance {

@@ -260,6 +260,8 @@ pub fn summary(checks: &Value, results: &Value, params: &Value) -> Value {
     let unobservable: Vec<Value> = arr(Some(params))
         .into_iter()
         .filter(|p| p.get("observable") == Some(&json!(false)))
+        // A value bounded from above is shown as its bound where it stands.
+        .filter(|p| !p.get("upper_bound").is_some_and(Value::is_number))
         .map(|p| json!({ "name": p.get("name"), "reason": p.get("reason") }))
         .collect();
     let [failed, indeterminate, not_evaluated, deferred] = by;

@@ -97,6 +97,12 @@ pub fn render_text(x: &Explanation) -> String {
                 Parameter::Unobservable { needs: None, .. } => {
                     let _ = writeln!(s, "   {name}: not determined");
                 }
+                Parameter::UpperBound {
+                    upper_bound, unit, ..
+                } => {
+                    let b = crate::measured::format_value(*upper_bound, unit);
+                    let _ = writeln!(s, "   {name} <= {b} (an upper bound only)");
+                }
             }
         }
         if !f.alternatives.is_empty() {

@@ -90,13 +90,25 @@ pub(crate) fn analyse(id: &str, curves: &Curves, out: &mut Out) -> Option<AllanC
             .min_by(|a, b| a.1.1.total_cmp(&b.1.1))
             .map(|(i, c)| (i, c.1))?;
         let bi = min / 0.664 * 3600.0;
-        out.params.insert(
-            format!("gyro.bias_instability.{name}"),
-            Parameter::estimate(bi, bi * rel(curve[i].2), "deg/h"),
-        );
-        if i + 1 == curve.len() && ax == 0 {
+        // A curve still falling at its longest tau has not reached its floor: the minimum
+        // bounds the bias instability from above and is no estimate of it.
+        let falling = i + 1 == curve.len();
+        let p = match falling {
+            false => Parameter::estimate(bi, bi * rel(curve[i].2), "deg/h"),
+            true => Parameter::UpperBound {
+                upper_bound: bi,
+                unit: "deg/h".into(),
+                why: format!(
+                    "the Allan deviation of {id} still falls at its longest tau ({:.0} s)",
+                    curve[i].0
+                ),
+            },
+        };
+        out.params
+            .insert(format!("gyro.bias_instability.{name}"), p);
+        if falling && ax == 0 {
             out.warnings.push(format!(
-                "Allan deviation of {} still falls at its longest tau ({:.0} s): the bias instability is an upper bound",
+                "Allan deviation of {} still falls at its longest tau ({:.0} s): the bias instability is only bounded from above (no value is given)",
                 id,
                 curve[i].0
             ));
@@ -111,7 +123,46 @@ pub(crate) fn analyse(id: &str, curves: &Curves, out: &mut Out) -> Option<AllanC
 
 #[cfg(test)]
 mod tests {
-    use super::overlapping_adev;
+    use super::{Out, Parameter, analyse, overlapping_adev};
+
+    /// A curve with its floor inside gives a value with an uncertainty; one still falling at
+    /// its longest tau gives only the bound, no value beside its own bound.
+    #[test]
+    fn a_curve_still_falling_bounds_the_instability_and_gives_no_value() {
+        let curve = |floor: bool| -> Vec<(f64, f64, usize)> {
+            let taus = [0.5, 1.0, 2.0, 4.0, 8.0];
+            let at = |t: f64| {
+                if floor && t > 3.0 {
+                    1e-3 * t / 4.0
+                } else {
+                    1e-3 / t.sqrt()
+                }
+            };
+            taus.iter()
+                .map(|&t| (t, at(t), (64.0 / t) as usize))
+                .collect()
+        };
+        for floor in [true, false] {
+            let mut out = Out::default();
+            analyse("gyro_bias", &vec![curve(floor); 3], &mut out).unwrap();
+            let p = &out.params["gyro.bias_instability.x"];
+            match (floor, p) {
+                (true, Parameter::Estimate { value, .. }) => {
+                    assert!(
+                        (value - 1e-3 / 2f64.sqrt() / 0.664 * 3600.0).abs() < 1e-9,
+                        "{value}"
+                    )
+                }
+                (false, Parameter::UpperBound { upper_bound, .. }) => {
+                    let b = 1e-3 / 8f64.sqrt() / 0.664 * 3600.0;
+                    assert!((upper_bound - b).abs() < 1e-9, "{upper_bound}");
+                    assert!(out.warnings[0].contains("bounded from above"));
+                }
+                (floor, p) => panic!("floor {floor}: {p:?}"),
+            }
+            assert_eq!(out.warnings.is_empty(), floor);
+        }
+    }
 
     #[test]
     fn white_noise_falls_as_one_over_sqrt_tau() {
