@@ -369,7 +369,7 @@ fn adopt(args: &Request, x: &mut explain::Explanation) {
     let ids: Vec<String> = x
         .findings
         .iter()
-        .filter(|f| f.defined_in.is_none() && !f.discovered)
+        .filter(|f| f.defined_in.is_none() && !f.discovered && explain::beyond_zero(f))
         .map(|f| f.effect.clone())
         .collect();
     let Some(p) = &args.procedure else { return };

@@ -430,9 +430,23 @@ fn adopt_ids(findings: &[Finding], held: &[String]) -> Option<String> {
     let ids: Vec<&str> = findings
         .iter()
         .filter(|f| f.defined_in.is_none() && !f.discovered && !held.contains(&f.effect))
+        .filter(|f| beyond_zero(f))
         .map(|f| f.effect.as_str())
         .collect();
     (!ids.is_empty()).then(|| format!("with {}", ids.join(", ")))
+}
+
+/// Whether a finding has a value a procedure would gain from: at least one parameter more
+/// than three standard uncertainties from zero (an effect whose every value is within 3u
+/// of zero passed jointly, by its number of columns, and is not asked to be adopted).
+/// A finding without estimated parameters (its form alone) counts as beyond.
+pub fn beyond_zero(f: &Finding) -> bool {
+    let mut est = f
+        .parameters
+        .values()
+        .filter_map(Parameter::value_u)
+        .peekable();
+    est.peek().is_none() || est.any(|(v, u)| v.abs() > 3.0 * u)
 }
 
 /// A run folder explained against the seed model: the findings its own procedure already

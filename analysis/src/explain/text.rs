@@ -177,6 +177,18 @@ pub fn render_text(x: &Explanation) -> String {
             x.already_held.join(", ")
         );
     }
+    let faint: Vec<&str> = (x.findings.iter())
+        .filter(|f| f.defined_in.is_none() && !f.discovered && !super::beyond_zero(f))
+        .filter(|f| !x.already_held.contains(&f.effect))
+        .map(|f| f.effect.as_str())
+        .collect();
+    if !faint.is_empty() {
+        let _ = writeln!(
+            s,
+            "not to adopt (significant together, yet every value within 3 standard uncertainties of zero): {}",
+            faint.join(", ")
+        );
+    }
     let user: Vec<&str> = x
         .findings
         .iter()

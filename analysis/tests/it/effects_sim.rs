@@ -54,6 +54,7 @@ fn within(res: &Results, effect: &str, truth: &[(&str, f64)]) {
                     "{key}: the truth {want:?} was not determined"
                 );
             }
+            Parameter::UpperBound { .. } => panic!("{key}: an effect's parameter as a bound"),
         }
     }
     for (param, _) in truth {

@@ -168,3 +168,33 @@ fn a_loose_file_is_edited_in_place_and_declared_effects_are_extended() {
     .unwrap();
     assert_eq!(again.diff, None);
 }
+
+/// A finding significant only jointly, every value within 3u of zero (a lever arm of
+/// 0.22 +- 0.08 mm on a station that has none), is not asked to be adopted; one value
+/// beyond 3u, or a finding without estimated values, is.
+#[test]
+fn no_adoption_of_values_within_three_uncertainties_of_zero() {
+    use ratecal_analysis::explain::{Finding, beyond_zero};
+    let finding = |params: serde_json::Value| -> Finding {
+        serde_json::from_value(serde_json::json!({
+            "effect": "lever_arm", "explanation": "", "located": [], "parameters": params,
+            "evidence": {
+                "chi2": 12.0, "dof": 3, "p_value": 1e-5, "alpha": 1e-4,
+                "holdout_rms_before": { "accel_mps2": 0.0, "gyro_dps": 0.0 },
+                "holdout_rms_after": { "accel_mps2": 0.0, "gyro_dps": 0.0 },
+                "not_separable_from": []
+            },
+            "rms_after": { "accel_mps2": 0.0, "gyro_dps": 0.0 }
+        }))
+        .unwrap()
+    };
+    let p = |v: f64, u: f64| serde_json::json!({ "value": v, "u": u, "unit": "mm" });
+    let faint = finding(serde_json::json!({
+        "rxx_mm": p(0.22, 0.08), "ryy_mm": p(0.20, 0.075), "rzz_mm": p(-0.25, 0.09),
+        "rxy_mm": { "observable": false, "needs": "accelerate about Z" }
+    }));
+    assert!(!beyond_zero(&faint));
+    let real = finding(serde_json::json!({ "rxx_mm": p(0.22, 0.08), "rzz_mm": p(-0.5, 0.09) }));
+    assert!(beyond_zero(&real));
+    assert!(beyond_zero(&finding(serde_json::json!({}))));
+}

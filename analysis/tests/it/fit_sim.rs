@@ -29,6 +29,7 @@ fn one_seed_every_estimate_within_its_uncertainty() {
             Parameter::Unobservable { .. } => {
                 assert_eq!(name, "gyro.scale.z", "{name} should be observable")
             }
+            Parameter::UpperBound { .. } => panic!("{name}: a calibration parameter as a bound"),
         }
     }
     // The standard plan never rotates about Z, and the result says what would determine it.
