@@ -204,3 +204,40 @@ fn mpu6050_start_up_rest_and_poses_are_found() {
     assert_eq!(imu.len(), raw.len());
     assert_eq!(imu[7][3], raw[7][2] * (9.80665 / 16384.0));
 }
+
+/// A gyro unit slip that no rest shows (`deg/h` for the Ferraris session's deg/s: its
+/// biases at rest become 0.0003 deg/s, a plausible rest) is caught by the hand turns: the
+/// map declares -360 deg about each axis, the gyros would turn a tenth of a degree.
+/// Refused at the unit, the right unit named, nothing written.
+#[test]
+fn a_gyro_unit_slip_is_caught_by_the_declared_turns() {
+    let Some(src) = shared_path("real/imucal/example_ferraris_session.csv") else {
+        return;
+    };
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let map = std::fs::read_to_string(root.join("docs/examples/import/ferraris.yaml")).unwrap();
+    assert!(map.contains("gyro: deg/s }"));
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(
+        tmp.path().join("m.yaml"),
+        map.replace("gyro: deg/s }", "gyro: deg/h }"),
+    )
+    .unwrap();
+    let o = ratecal(
+        &[
+            "import",
+            src.to_str().unwrap(),
+            "--map",
+            "m.yaml",
+            "--out",
+            "run",
+        ],
+        tmp.path(),
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("turn segment `x_rot`"), "{err}");
+    assert!(err.contains("look like deg/s, not deg/h"), "{err}");
+    assert!(err.contains("m.yaml:23:"), "{err}");
+    assert!(!tmp.path().join("run").exists());
+}

@@ -112,10 +112,51 @@ pub fn check(map: &ImportMap, found: &[Found], source: &str) -> Result<(), Box<I
                     return Err(at_map(map, d.at.clone(), ErrorKind::Units, &what, &help));
                 }
             }
-            SegmentKind::Oscillation | SegmentKind::Turn => {}
+            SegmentKind::Turn => check_turn(map, f, decl(f), &lines)?,
+            SegmentKind::Oscillation => {}
         }
     }
     Ok(())
+}
+
+/// A turn whose map states its axis and angle: the gyros integrated over it must turn
+/// about that much (half to twice), as a rate segment must read its rate. A gyro unit off
+/// by 3600 (`deg/h` for deg/s) or 57 turns a 360 deg turn into a tenth of a degree.
+fn check_turn(
+    map: &ImportMap,
+    f: &Found,
+    d: Option<&DeclSegment>,
+    lines: &str,
+) -> Result<(), Box<ImportError>> {
+    let (Some(t), Some(d)) = (&f.turn, d) else {
+        return Ok(());
+    };
+    let (Some((k, sign)), Some(angle)) = (t.axis, t.angle_deg) else {
+        return Ok(());
+    };
+    let s = &f.stretch;
+    let turned = s.mean_w()[k] * sign * (s.t.1 - s.t.0);
+    let ratio = turned / angle;
+    if angle.abs() < 30.0 || (RATE_RATIO.0..=RATE_RATIO.1).contains(&ratio) {
+        return Ok(());
+    }
+    let what = format!(
+        "turn segment `{}` ({lines}): the gyros turn {turned:.3} deg about its axis, the map \
+         declares {angle} deg",
+        f.id
+    );
+    let raw = turned.abs() / (s.t.1 - s.t.0).max(f64::MIN_POSITIVE) / map.gyro.factor;
+    let expect = angle.abs() / (s.t.1 - s.t.0).max(f64::MIN_POSITIVE);
+    let help = match likely_unit(raw, expect, Dim::Rate) {
+        Some(u) if u != map.gyro.unit => format!(
+            "the gyro columns look like {u}, not {}: set units.gyro",
+            map.gyro.unit
+        ),
+        _ => "check units.gyro, the turn's axis and sign (imu.axes), its angle_deg and its \
+              samples (the whole turn, rest to rest)"
+            .into(),
+    };
+    Err(at_map(map, d.at.clone(), ErrorKind::Units, &what, &help))
 }
 
 fn check_up(
