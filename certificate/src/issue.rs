@@ -246,7 +246,7 @@ pub async fn issue(
                  import ... --station S.yaml --out {}` copies the station file into the \
                  folder and seals it (its table's calibration and Type B figures); then \
                  analyze, approve and archive it",
-                dir.display()
+                ratecal_folder::shell::quoted(dir)
             ),
             "{} is an imported recording without a station file: its traceability and \
              uncertainty budget cannot be stated",
@@ -362,7 +362,7 @@ pub async fn issue(
             code = "certificate::not_archived",
             help = format!(
                 "add it first: `ratecal archive add {}` (after `ratecal approve`)",
-                dir.display()
+                ratecal_folder::shell::quoted(dir)
             ),
             "{} (archive id {}) is not in the archive {}",
             dir.display(),

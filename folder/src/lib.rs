@@ -15,6 +15,7 @@ pub mod outputs;
 pub mod read;
 pub mod seal;
 pub mod sealing;
+pub mod shell;
 pub mod state;
 pub mod verify;
 

@@ -75,7 +75,7 @@ pub fn require_intact_replacing(
             code = "verify::never_sealed",
             help = format!(
                 "a run seals its folder when it ends; finish it with `ratecal run --resume {}`",
-                dir.display()
+                crate::shell::quoted(dir)
             ),
             "{} was never sealed: no {command} from it (nothing shows it unaltered)",
             dir.display()
@@ -89,7 +89,7 @@ pub fn require_intact_replacing(
         code = "verify::altered",
         help = format!(
             "`ratecal verify {}` shows what changed; nothing was added to its seal",
-            dir.display()
+            crate::shell::quoted(dir)
         ),
         "{} fails its seal ({}): no {command} from it",
         dir.display(),

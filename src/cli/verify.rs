@@ -28,7 +28,7 @@ pub struct Args {
 fn unsealed(dir: &Path) -> Option<ExitCode> {
     let help = format!(
         "help: `ratecal run --resume {}` finishes it and seals it",
-        dir.display()
+        ratecal_folder::shell::quoted(dir)
     );
     match verify::unsealed(dir)? {
         Unsealed::Committing => {

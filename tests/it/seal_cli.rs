@@ -255,3 +255,26 @@ fn resume_refuses_a_folder_whose_inputs_changed() {
     assert_eq!(code(&o), 1, "{}", text(&o));
     assert!(text(&o).contains("journal.jsonl"), "{}", text(&o));
 }
+
+/// A help line's command names the folder as one shell word: a run folder whose name holds
+/// a space and a quote is quoted, so the suggested `ratecal verify ...` pastes as it reads.
+#[test]
+fn help_commands_quote_the_folder_they_name() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = "it's run 1";
+    let o = mini_run(tmp.path(), out, &[]);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let run = tmp.path().join(out);
+    edit(&run.join("manifest.yaml"), "imu:", "imu:   ");
+    let into = format!("{out}/results.json");
+    let o = ratecal(&["analyze", out, "--out", &into], tmp.path());
+    let err = text(&o);
+    assert_eq!(code(&o), 4, "{err}");
+    let quoted = ratecal_folder::shell::quoted(Path::new(out));
+    assert_eq!(shlex::split(&quoted), Some(vec![out.to_string()]));
+    assert!(
+        err.replace('\n', " ")
+            .contains(&format!("`ratecal verify {quoted}`")),
+        "{err}"
+    );
+}

@@ -100,12 +100,12 @@ impl End<'_> {
                 );
                 outln!(
                     "free space (or raise the file-size limit), then continue with `ratecal run --resume {}`",
-                    dir.display()
+                    ratecal_folder::shell::quoted(dir)
                 );
             } else {
                 outln!(
                     "the recording holds every sample up to {upto}; continue with `ratecal run --resume {}`",
-                    dir.display()
+                    ratecal_folder::shell::quoted(dir)
                 );
             }
         }
@@ -183,7 +183,7 @@ pub fn seal_recorded(
     if status != "completed" {
         outln!(
             "the run {status} before its end; continue it with `ratecal run --resume {}`",
-            dir.display()
+            ratecal_folder::shell::quoted(dir)
         );
     }
     if warnings

@@ -242,7 +242,7 @@ fn execute_prepared(
             miette::miette!(
                 help = format!(
                     "`ratecal run --resume {}` finishes the change",
-                    dir.display()
+                    ratecal_folder::shell::quoted(&dir)
                 ),
                 "cannot commit the resumed run in {}: {e}",
                 dir.display()

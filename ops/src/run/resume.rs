@@ -80,7 +80,10 @@ pub fn prepare(dir: &Path) -> Result<(Resume, FolderLock), Report> {
         }
         State::Sealed => {
             return Err(miette!(
-                help = format!("`ratecal verify {}` checks it", dir.display()),
+                help = format!(
+                    "`ratecal verify {}` checks it",
+                    ratecal_folder::shell::quoted(dir)
+                ),
                 "{} is a completed run, sealed: nothing to resume",
                 dir.display()
             ));
@@ -296,7 +299,7 @@ fn unaltered(dir: &Path) -> Result<(), Report> {
         code = "run::resume_altered",
         help = format!(
             "`ratecal verify {}` shows what changed; start a new run",
-            dir.display()
+            ratecal_folder::shell::quoted(dir)
         ),
         "{} was altered since it was sealed ({}): not resumed",
         dir.display(),

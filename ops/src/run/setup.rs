@@ -145,15 +145,17 @@ pub fn draft(path: &Path, allowed: bool) -> Result<Option<String>, Report> {
         .and_then(|n| ratecal_plan::versions::version_of_file_name(&n.to_string_lossy()))
         .map(|v| v.to_string())
         .unwrap_or_default();
-    let folder = path
+    // `FOLDER@VERSION` as one shell word.
+    let at = path
         .parent()
-        .map(|p| p.display().to_string())
+        .map(|p| format!("{}@{version}", p.display()))
         .unwrap_or_default();
+    let at = ratecal_folder::shell::quoted(Path::new(&at));
     if !allowed {
         return Err(miette!(
             code = "run::unreleased",
             help = format!(
-                "release it (`ratecal release {folder}@{version} --signer NAME --key lab.key`), or run it as a draft with --draft"
+                "release it (`ratecal release {at} --signer NAME --key lab.key`), or run it as a draft with --draft"
             ),
             "{}: version {version} is not released; nothing was run",
             file.display
