@@ -276,7 +276,7 @@ pub struct RunInfo {
 }
 
 /// A stream write that failed, and what was cut so that the stream reads back.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct WriteFailure {
     /// The file (`imu.csv`).
     pub file: String,
@@ -284,6 +284,10 @@ pub struct WriteFailure {
     pub error: String,
     /// Bytes of a partial last line cut from the file.
     pub cut_bytes: u64,
+    /// The stamp of the file's last row, s: where its data end (the run notices the
+    /// failure later, at the next check of its writer).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub data_end_s: Option<f64>,
 }
 
 /// Where a run was interrupted and when it resumed.

@@ -53,6 +53,25 @@ fn a_file_size_limit_aborts_the_run_and_what_is_sealed_reads_back() {
     assert!(imu.lines().all(|l| l.split(',').count() == cols));
     // Only segments whose data was written are recorded.
     assert_eq!(m.segments.len(), 1, "{:?}", m.segments);
+    // The abort names when the data ends, not only when the run noticed: the stamp of
+    // imu.csv's last whole row, in the manifest and in what was printed.
+    let last_t: f64 = imu
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    let end = f
+        .data_end_s
+        .expect("the manifest records where the data ends");
+    assert!((end - last_t).abs() < 1e-6, "{end} vs {last_t}");
+    assert!(
+        out.contains(&format!("the data at t = {end:.3} s: imu.csv ends there")),
+        "{out}"
+    );
 
     let o = ratecal(&["verify", "r"], tmp.path());
     assert_eq!(code(&o), 0, "{}", text(&o));

@@ -88,6 +88,13 @@ impl End<'_> {
                 "the end of the safe stop's wait"
             };
             if let Some(f) = write_failure(dir) {
+                if let Some(end) = f.data_end_s {
+                    outln!(
+                        "  the write failed with the data at t = {end:.3} s: {} ends there (the run noticed it at t = {:.3} s)",
+                        f.file,
+                        a.t
+                    );
+                }
                 outln!(
                     "a write failed ({}: {}): the recording holds every sample written before it; {}",
                     f.file,

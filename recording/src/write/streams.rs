@@ -96,6 +96,8 @@ pub(crate) struct Stream {
     pub(crate) chained: bool,
     written: u64,
     pub(crate) last_t: Option<f64>,
+    /// The stamp of the last row on disk (what a failed write leaves).
+    written_t: Option<f64>,
     /// The first write that failed: the stream takes no more.
     pub(crate) failure: Option<WriteFailure>,
 }
@@ -111,6 +113,7 @@ impl Stream {
             chained: true,
             written,
             last_t: None,
+            written_t: None,
             failure: None,
         }
     }
@@ -213,6 +216,9 @@ impl Stream {
             self.chain.update(&self.buf[..keep]);
         }
         self.written += keep as u64;
+        if let Some(t) = last_row_t(&self.buf[..keep]) {
+            self.written_t = Some(t);
+        }
         self.buf.clear();
         let Some(e) = failed else {
             return Ok(());
@@ -226,6 +232,7 @@ impl Stream {
             file: self.name.clone(),
             error: e.to_string(),
             cut_bytes: cut,
+            data_end_s: self.written_t,
         };
         let err = io::Error::new(e.kind(), format!("{}: {e}", f.file));
         self.failure = Some(f);
@@ -437,5 +444,28 @@ impl Streams {
             self.table.end_row()?;
         }
         Ok(())
+    }
+}
+
+/// The stamp (first field) of the last full row of `rows` (whole rows, each ending in a
+/// line break).
+fn last_row_t(rows: &[u8]) -> Option<f64> {
+    let body = rows.strip_suffix(b"\n")?;
+    let start = body.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+    let row = &body[start..];
+    let end = row.iter().position(|&b| b == b',').unwrap_or(row.len());
+    std::str::from_utf8(&row[..end]).ok()?.trim().parse().ok()
+}
+
+#[cfg(test)]
+mod row_tests {
+    use super::last_row_t;
+
+    #[test]
+    fn the_last_rows_stamp() {
+        assert_eq!(last_row_t(b"1.5,2,3\n2.25,4,5\n"), Some(2.25));
+        assert_eq!(last_row_t(b"7,1\n"), Some(7.0));
+        assert_eq!(last_row_t(b""), None);
+        assert_eq!(last_row_t(b"t,ax\n"), None);
     }
 }
