@@ -29,6 +29,7 @@ mod cli_explain_twin_timing;
 mod cli_report;
 mod cli_size_effect;
 mod crash_cli;
+mod explain_across;
 mod explain_real;
 mod harden_cli;
 mod import_cli;
