@@ -32,6 +32,9 @@ pub struct Fitted {
     pub u: f64,
     /// Unit.
     pub unit: String,
+    /// The output channel it acts on (`ax` ... `gz`), when one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub channel: Option<String>,
     /// Whether explain reported the effect in this recording.
     #[serde(default)]
     pub found: bool,
@@ -172,10 +175,11 @@ fn entries(
         .filter(|&g| f.u(g).is_finite() && f.u(g) > 0.0 && f.theta[g].is_finite())
         .map(|g| {
             let p = lay.param(g);
-            let parameter = match (probe, p.channel) {
-                (Some(_), Some((s, ax))) => {
-                    CHANNELS[if s == Sensor::Accel { ax } else { 3 + ax }].to_string()
-                }
+            let channel = p
+                .channel
+                .map(|(s, ax)| CHANNELS[if s == Sensor::Accel { ax } else { 3 + ax }].to_string());
+            let parameter = match (probe, &channel) {
+                (Some(_), Some(c)) => c.clone(),
                 _ => p.name.to_string(),
             };
             Fitted {
@@ -184,6 +188,7 @@ fn entries(
                 value: f.theta[g],
                 u: f.u(g),
                 unit: p.unit.to_string(),
+                channel,
                 found,
             }
         })

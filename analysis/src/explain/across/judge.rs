@@ -36,8 +36,8 @@ impl Row {
     }
 }
 
-/// Every (effect, parameter) of the members' profiles: its unit and its rows.
-type Table = BTreeMap<(String, String), (String, Vec<Row>)>;
+/// Every (effect, parameter) of the members' profiles: its unit, its channel and its rows.
+type Table = BTreeMap<(String, String), (String, Option<String>, Vec<Row>)>;
 
 fn collect(members: &[Member]) -> Table {
     let mut t: Table = BTreeMap::new();
@@ -45,8 +45,8 @@ fn collect(members: &[Member]) -> Table {
         for f in &m.explanation.profile {
             let e = t
                 .entry((f.effect.clone(), f.parameter.clone()))
-                .or_insert_with(|| (f.unit.clone(), Vec::new()));
-            e.1.push(Row {
+                .or_insert_with(|| (f.unit.clone(), f.channel.clone(), Vec::new()));
+            e.2.push(Row {
                 run: m.run.clone(),
                 serial: m.serial.clone(),
                 value: f.value,
@@ -68,16 +68,8 @@ pub(super) fn judge(members: &[Member], alpha: f64) -> (Vec<PooledOut>, Vec<Outl
         .max(1) as f64;
     let a_rec = alpha / m;
     let a_out = alpha / (m * n_serials);
-    struct Work {
-        key: (String, String),
-        unit: String,
-        rows: Vec<Row>,
-        outliers: Vec<(String, f64, f64)>,
-        clean: Pooled,
-        all: Pooled,
-    }
     let mut work: Vec<Work> = Vec::new();
-    for (key, (unit, rows)) in table {
+    for (key, (unit, channel, rows)) in table {
         let outliers = outliers(&rows, a_out);
         let kept: Vec<Obs> = rows
             .iter()
@@ -92,6 +84,7 @@ pub(super) fn judge(members: &[Member], alpha: f64) -> (Vec<PooledOut>, Vec<Outl
         work.push(Work {
             key,
             unit,
+            channel,
             rows,
             outliers,
             clean,
@@ -103,32 +96,23 @@ pub(super) fn judge(members: &[Member], alpha: f64) -> (Vec<PooledOut>, Vec<Outl
         .map(|w| p_normal(w.clean.mean / w.clean.u))
         .collect();
     let sig = benjamini_hochberg(&p, alpha);
+    let mimic = mimics(&work);
+    let mut verdicts: Vec<&'static str> = Vec::new();
+    for (w, &sig) in work.iter().zip(&sig) {
+        verdicts.push(verdict(w, sig, a_rec, alpha));
+    }
+    // A mimic of a parameter with a verdict is that parameter's shadow, not physics.
+    for (i, m) in mimic.iter().enumerate() {
+        if let Some(j) = m
+            && verdicts[*j] != "none"
+        {
+            verdicts[i] = "none";
+        }
+    }
     let mut effects = Vec::new();
     let mut outliers = Vec::new();
-    for (w, sig) in work.into_iter().zip(sig) {
-        let passes = |r: &Row| p_normal(r.value / r.u) < a_rec;
+    for (w, verdict) in work.into_iter().zip(verdicts) {
         let out_serial = |r: &Row| w.outliers.iter().any(|o| o.0 == r.serial);
-        let kept_pass = w.rows.iter().filter(|r| !out_serial(r)).any(passes);
-        let any_pass = w.rows.iter().any(passes);
-        let kept_serials = distinct(
-            w.rows
-                .iter()
-                .filter(|r| !out_serial(r))
-                .map(|r| r.serial.as_str()),
-        );
-        let consistent =
-            w.clean.dof == 0 || super::super::stats::p_value(w.clean.q, w.clean.dof) >= alpha;
-        let verdict = if is_unit(&w.rows, &passes) {
-            "unit"
-        } else if sig && kept_pass && kept_serials.len() >= 2 && consistent {
-            "model"
-        } else if sig && !kept_pass {
-            "pooled_only"
-        } else if any_pass {
-            "occasional"
-        } else {
-            "none"
-        };
         for (serial, value, u) in &w.outliers {
             outliers.push(Outlier {
                 serial: serial.clone(),
@@ -175,6 +159,98 @@ pub(super) fn judge(members: &[Member], alpha: f64) -> (Vec<PooledOut>, Vec<Outl
     }
     effects.sort_by_key(|e| rank(&e.verdict));
     (effects, outliers)
+}
+
+/// One parameter's rows, outliers and pools.
+struct Work {
+    key: (String, String),
+    unit: String,
+    channel: Option<String>,
+    rows: Vec<Row>,
+    outliers: Vec<(String, f64, f64)>,
+    clean: Pooled,
+    all: Pooled,
+}
+
+/// The verdict of `w` (`sig`: the pool is significant; `a_rec`: a recording's threshold).
+fn verdict(w: &Work, sig: bool, a_rec: f64, alpha: f64) -> &'static str {
+    let passes = |r: &Row| p_normal(r.value / r.u) < a_rec;
+    let out_serial = |r: &Row| w.outliers.iter().any(|o| o.0 == r.serial);
+    let kept: Vec<&Row> = w.rows.iter().filter(|r| !out_serial(r)).collect();
+    let kept_pass = kept.iter().any(|r| passes(r));
+    let kept_serials = distinct(kept.iter().map(|r| r.serial.as_str()));
+    let consistent =
+        w.clean.dof == 0 || super::super::stats::p_value(w.clean.q, w.clean.dof) >= alpha;
+    if is_unit(&w.rows, &passes) {
+        "unit"
+    } else if sig && kept_pass && kept_serials.len() >= 2 && consistent {
+        "model"
+    } else if sig && !kept_pass {
+        "pooled_only"
+    } else if w.rows.iter().any(passes) {
+        "occasional"
+    } else {
+        "none"
+    }
+}
+
+/// Recordings in common below which two parameters are not compared.
+const MIMIC_COMMON: usize = 4;
+/// Correlation of the standardized values at and above which one parameter mimics another.
+const MIMIC_CORR: f64 = 0.9;
+
+/// For each parameter, the stronger parameter it mimics, if any: on the same channel, its
+/// standardized values (value / u) over the recordings both have, neither found there,
+/// correlate with the other's by [`MIMIC_CORR`] or more (where one is in the final model,
+/// the other, fitted beside it, is left nothing) (the recordings cannot tell them apart: a K2 and a
+/// scale asymmetry on attitudes of +-1 g and 0 g). The stronger is the one whose pool
+/// stands out more; a registry or user effect counts 10 % more than a library form.
+fn mimics(work: &[Work]) -> Vec<Option<usize>> {
+    let strength = |w: &Work| {
+        let z = (w.clean.mean / w.clean.u).abs();
+        if w.key.0.starts_with("form_") { z } else { 1.1 * z }
+    };
+    let zs: Vec<BTreeMap<&str, f64>> = work
+        .iter()
+        .map(|w| {
+            (w.rows.iter())
+                .filter(|r| !r.found)
+                .map(|r| (r.run.as_str(), r.value / r.u))
+                .collect()
+        })
+        .collect();
+    (0..work.len())
+        .map(|i| {
+            (0..work.len())
+                .filter(|&j| j != i && work[i].channel.is_some() && work[i].channel == work[j].channel)
+                .filter(|&j| strength(&work[j]) > strength(&work[i]))
+                .filter(|&j| correlation(&zs[i], &zs[j]).is_some_and(|c| c >= MIMIC_CORR))
+                .max_by(|&a, &b| strength(&work[a]).total_cmp(&strength(&work[b])))
+        })
+        .collect()
+}
+
+/// Pearson correlation over the keys both maps hold (`None` under [`MIMIC_COMMON`] of
+/// them, or without variation).
+fn correlation(a: &BTreeMap<&str, f64>, b: &BTreeMap<&str, f64>) -> Option<f64> {
+    let pairs: Vec<(f64, f64)> = a
+        .iter()
+        .filter_map(|(k, x)| b.get(k).map(|y| (*x, *y)))
+        .collect();
+    if pairs.len() < MIMIC_COMMON {
+        return None;
+    }
+    let n = pairs.len() as f64;
+    let (mx, my) = pairs
+        .iter()
+        .fold((0.0, 0.0), |s, p| (s.0 + p.0 / n, s.1 + p.1 / n));
+    let (mut sxy, mut sxx, mut syy) = (0.0, 0.0, 0.0);
+    for (x, y) in &pairs {
+        sxy += (x - mx) * (y - my);
+        sxx += (x - mx) * (x - mx);
+        syy += (y - my) * (y - my);
+    }
+    (sxx > 0.0 && syy > 0.0).then(|| sxy / (sxx * syy).sqrt())
 }
 
 /// Most recurring first.
