@@ -98,6 +98,12 @@ async fn explain_runs(
         }));
     }
     let todo: Vec<usize> = (0..runs.len()).filter(|&i| slots[i].is_none()).collect();
+    errln!(
+        "{} archived run(s): {} explanation(s) kept in the archive, {} to explain",
+        runs.len(),
+        runs.len() - todo.len(),
+        todo.len()
+    );
     let batch = 2 * std::thread::available_parallelism().map_or(1, |n| n.get());
     let scratch = std::env::temp_dir().join(format!("ratecal-explain-{}", std::process::id()));
     for chunk in todo.chunks(batch) {
@@ -134,9 +140,13 @@ async fn explain_runs(
     Ok(slots.into_iter().flatten().collect())
 }
 
-/// A run as the output names it: its own name and its archive id.
+/// A run as the output names it: its own name and its archive id (the id alone for a
+/// recording without a name).
 fn name_of(r: &RunSummary) -> String {
-    format!("{} ({})", r.name, r.id)
+    match r.name.is_empty() {
+        true => r.id.clone(),
+        false => format!("{} ({})", r.name, r.id),
+    }
 }
 
 /// A kept explanation (`None`: unreadable, explained again).

@@ -1,7 +1,8 @@
 //! `ratecal explain RUN RUN...` on fleets written by `ratecal-witness` (a second,
 //! independent implementation of the spec): physics shared by every unit but too weak for
-//! any one recording is found in the pool, physics of one unit is `unit`, a unit far off
-//! the fleet is an outlier, and a fleet with nothing shared pools nothing.
+//! any one recording is found in the pool, physics of one unit is `unit`, a warm-up after
+//! some power-ons is `occasional`, a unit far off the fleet is an outlier, and a fleet with
+//! nothing shared pools nothing.
 
 use crate::support;
 use ratecal_witness::{Hidden, Plan, Scenario, write};
@@ -11,9 +12,9 @@ use support::{code, ratecal, text};
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
-/// The fleet's shared K2 on every axis, ug/g^2: about two standard uncertainties of one
+/// The fleet's shared K2 on every axis, ug/g^2: under two standard uncertainties of one
 /// short recording (explain's threshold is above four).
-const K2: f64 = 24.0;
+const K2: f64 = 16.0;
 
 /// A short standard-shaped recording of unit `serial`, its biases and scales its own
 /// (drawn from the serial's number), the noise from `seed`.
@@ -72,7 +73,7 @@ fn f(v: &Value, k: &str) -> f64 {
 }
 
 #[test]
-fn the_pool_finds_a_weak_shared_k2_a_units_lever_arm_and_an_outlier() {
+fn the_pool_finds_a_weak_shared_k2_a_units_lever_arm_a_warm_up_and_an_outlier() {
     let tmp = tempfile::tempdir().unwrap();
     let mut fleet: Vec<Scenario> = (1..=8)
         .map(|n| unit(&format!("SN{n:03}"), n, 100 + n).with(k2(K2)))
@@ -88,12 +89,23 @@ fn the_pool_finds_a_weak_shared_k2_a_units_lever_arm_and_an_outlier() {
     }
     // One unit whose K2 is five times the fleet's.
     fleet.push(unit("SN200", 200, 300).with(k2(5.0 * K2)));
+    // One unit recorded three times, twice right after power-on (a gyro warm-up).
+    for (seed, warm) in [(401, true), (402, true), (403, false)] {
+        let s = unit("SN300", 300, seed).with(k2(K2));
+        fleet.push(match warm {
+            true => s.with(Hidden::GyroWarmUp {
+                amplitude_dps: [0.03, -0.02, 0.025],
+                tau_s: 100.0,
+            }),
+            false => s,
+        });
+    }
     let runs = write_all(tmp.path(), fleet);
     let (c, v) = explain(&runs);
     assert_eq!(c, 1, "a recording or the pool has a finding");
     let a = &v["across"];
-    assert_eq!(a["recordings"].as_array().unwrap().len(), 12);
-    // No single recording of the fleet found K2 (else it would not be a test of pooling).
+    assert_eq!(a["recordings"].as_array().unwrap().len(), 15);
+    // Hardly any recording of the fleet finds K2 alone (else this would not test pooling).
     let found_k2 = |r: &Value| {
         r["findings"]
             .as_array()
@@ -102,10 +114,11 @@ fn the_pool_finds_a_weak_shared_k2_a_units_lever_arm_and_an_outlier() {
             .any(|f| f == "accel_second_order")
     };
     let recs = a["recordings"].as_array().unwrap();
-    assert!(
-        recs.iter().filter(|r| r["serial"] != "SN200").all(|r| !found_k2(r)),
-        "{a:#}"
-    );
+    let alone = (recs.iter())
+        .filter(|r| r["serial"] != "SN200" && found_k2(r))
+        .count();
+    println!("K2 found alone in {alone} of 14 recordings");
+    assert!(alone <= 2, "{a:#}");
     // The pooled K2: within 3u of the truth on every axis, `pooled_only` or `model`, the
     // five-fold unit left out.
     let k2s = entries(&v, "accel_second_order");
@@ -127,7 +140,7 @@ fn the_pool_finds_a_weak_shared_k2_a_units_lever_arm_and_an_outlier() {
             .collect();
         assert_eq!(left.len(), 1, "{e:#}");
         assert!(left[0].ends_with("-SN200"), "{left:?}");
-        assert_eq!(e["per_recording"].as_array().unwrap().len(), 12);
+        assert_eq!(e["per_recording"].as_array().unwrap().len(), 15);
     }
     // The five-fold unit is among the outliers, on K2.
     let outliers = a["outliers"].as_array().unwrap();
@@ -151,14 +164,32 @@ fn the_pool_finds_a_weak_shared_k2_a_units_lever_arm_and_an_outlier() {
             .all(|e| e["verdict"] != "model" && e["verdict"] != "pooled_only"),
         "{lever:#?}"
     );
+    // The warm-up is occasional: some recordings of one unit, not all.
+    let decay = entries(&v, "form_gyro_decay");
+    assert!(!decay.is_empty(), "{a:#}");
+    assert!(
+        decay.iter().any(|e| e["verdict"] == "occasional"),
+        "{decay:#?}"
+    );
+    assert!(
+        decay
+            .iter()
+            .all(|e| e["verdict"] == "occasional" || e["verdict"] == "none"),
+        "{decay:#?}"
+    );
     // The text output leads with what recurs.
     let mut args = vec!["explain".to_string()];
     args.extend(runs.iter().map(|p| p.display().to_string()));
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let o = ratecal(&args, Path::new(ROOT));
     let out = String::from_utf8_lossy(&o.stdout);
-    assert!(out.starts_with("Across 12 recordings of 10 units:"), "{out}");
-    let k2_at = out.find("accel_second_order.").unwrap_or_else(|| panic!("{out}"));
+    assert!(
+        out.starts_with("Across 15 recordings of 11 units:"),
+        "{out}"
+    );
+    let k2_at = out
+        .find("accel_second_order.")
+        .unwrap_or_else(|| panic!("{out}"));
     assert!(k2_at < out.find("Each recording:").unwrap(), "{out}");
 }
 
@@ -190,17 +221,18 @@ fn a_fleet_with_nothing_shared_pools_nothing() {
 #[test]
 fn err_one_recording_options_with_several_are_refused() {
     let tmp = tempfile::tempdir().unwrap();
-    let runs = write_all(
-        tmp.path(),
-        vec![unit("A", 1, 1), unit("B", 2, 2)],
-    );
+    let runs = write_all(tmp.path(), vec![unit("A", 1, 1), unit("B", 2, 2)]);
     let (a, b) = (runs[0].to_str().unwrap(), runs[1].to_str().unwrap());
     let o = ratecal(
         &["explain", a, b, "--plots", tmp.path().to_str().unwrap()],
         Path::new(ROOT),
     );
     assert_eq!(code(&o), 2, "{}", text(&o));
-    assert!(text(&o).contains("explain::one_recording_only"), "{}", text(&o));
+    assert!(
+        text(&o).contains("explain::one_recording_only"),
+        "{}",
+        text(&o)
+    );
     let missing = tmp.path().join("nothing-here");
     let o = ratecal(&["explain", a, missing.to_str().unwrap()], Path::new(ROOT));
     assert_eq!(code(&o), 2, "{}", text(&o));

@@ -30,6 +30,7 @@ mod cli_report;
 mod cli_size_effect;
 mod crash_cli;
 mod explain_across;
+mod explain_across_archive;
 mod explain_real;
 mod harden_cli;
 mod import_cli;

@@ -29,11 +29,15 @@ fn args() -> Args {
         null: false,
         seed: 1,
         gyro_bias_s: 60.0,
-        k2: 24.0,
+        k2: 16.0,
     };
     let mut it = std::env::args().skip(1);
     while let Some(s) = it.next() {
-        let mut num = || it.next().and_then(|v| v.parse::<f64>().ok()).expect("a number");
+        let mut num = || {
+            it.next()
+                .and_then(|v| v.parse::<f64>().ok())
+                .expect("a number")
+        };
         match s.as_str() {
             "--units" => a.units = num() as u64,
             "--null" => a.null = true,
@@ -43,7 +47,10 @@ fn args() -> Args {
             _ => a.out = PathBuf::from(s),
         }
     }
-    assert!(!a.out.as_os_str().is_empty(), "usage: fleet OUT_DIR [options]");
+    assert!(
+        !a.out.as_os_str().is_empty(),
+        "usage: fleet OUT_DIR [options]"
+    );
     a
 }
 
@@ -78,7 +85,10 @@ fn main() -> std::io::Result<()> {
             1 if !a.null => {
                 for i in 0..3 {
                     let lever = [[30.0, 0.0, 0.0]; 3];
-                    fleet.push(shared(unit(n, seed + 100 * i, &a), a.k2).with(Hidden::LeverArm { r_mm: lever }));
+                    fleet.push(
+                        shared(unit(n, seed + 100 * i, &a), a.k2)
+                            .with(Hidden::LeverArm { r_mm: lever }),
+                    );
                 }
             }
             // Recorded three times, twice right after power-on (a gyro warm-up).

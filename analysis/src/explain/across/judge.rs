@@ -199,17 +199,22 @@ const MIMIC_COMMON: usize = 4;
 /// Correlation of the standardized values at and above which one parameter mimics another.
 const MIMIC_CORR: f64 = 0.9;
 
-/// For each parameter, the stronger parameter it mimics, if any: on the same channel, its
+/// How much stronger (pooled |z|) a parameter must be to take the verdict of one that
+/// mimics it; between these two, both keep theirs: the recordings cannot tell them apart.
+const MIMIC_STRONGER: f64 = 1.5;
+/// Correlation at and above which a library form is the same as a registry effect (its
+/// column: `form_accel_f2` and `accel_second_order`), which then takes the verdict.
+const SAME_CORR: f64 = 0.99;
+
+/// For each parameter, the parameter it mimics, if any: on the same channel, its
 /// standardized values (value / u) over the recordings both have, neither found there,
 /// correlate with the other's by [`MIMIC_CORR`] or more (where one is in the final model,
-/// the other, fitted beside it, is left nothing) (the recordings cannot tell them apart: a K2 and a
-/// scale asymmetry on attitudes of +-1 g and 0 g). The stronger is the one whose pool
-/// stands out more; a registry or user effect counts 10 % more than a library form.
+/// the other, fitted beside it, is left nothing), and the other's pool stands out
+/// [`MIMIC_STRONGER`] times more (a K2 and a scale asymmetry on attitudes of +-1 g and
+/// 0 g); or it is a library form the same as a registry effect ([`SAME_CORR`]).
 fn mimics(work: &[Work]) -> Vec<Option<usize>> {
-    let strength = |w: &Work| {
-        let z = (w.clean.mean / w.clean.u).abs();
-        if w.key.0.starts_with("form_") { z } else { 1.1 * z }
-    };
+    let strength = |w: &Work| (w.clean.mean / w.clean.u).abs();
+    let form = |w: &Work| w.key.0.starts_with("form_");
     let zs: Vec<BTreeMap<&str, f64>> = work
         .iter()
         .map(|w| {
@@ -222,9 +227,17 @@ fn mimics(work: &[Work]) -> Vec<Option<usize>> {
     (0..work.len())
         .map(|i| {
             (0..work.len())
-                .filter(|&j| j != i && work[i].channel.is_some() && work[i].channel == work[j].channel)
-                .filter(|&j| strength(&work[j]) > strength(&work[i]))
-                .filter(|&j| correlation(&zs[i], &zs[j]).is_some_and(|c| c >= MIMIC_CORR))
+                .filter(|&j| {
+                    j != i && work[i].channel.is_some() && work[i].channel == work[j].channel
+                })
+                .filter(|&j| {
+                    let Some(c) = correlation(&zs[i], &zs[j]) else {
+                        return false;
+                    };
+                    let (si, sj) = (strength(&work[i]), strength(&work[j]));
+                    (c >= MIMIC_CORR && sj >= MIMIC_STRONGER * si)
+                        || (c >= SAME_CORR && form(&work[i]) && !form(&work[j]))
+                })
                 .max_by(|&a, &b| strength(&work[a]).total_cmp(&strength(&work[b])))
         })
         .collect()
