@@ -138,7 +138,7 @@ fn across(a: Args, format: ratecal_ops::explain::Format) -> ExitCode {
             without: a.without,
             format,
             allow_changed: a.allow_changed,
-            archive: (a.serial.is_some() || a.model.is_some()).then(|| {
+            archive: (a.serial.is_some() || a.model.is_some()).then_some(
                 ratecal_ops::across_archive::Selection {
                     archive: a.archive,
                     serial: a.serial,
@@ -146,8 +146,8 @@ fn across(a: Args, format: ratecal_ops::explain::Format) -> ExitCode {
                     since: a.since,
                     until: a.until,
                     include_dry_runs: a.include_dry_runs,
-                }
-            }),
+                },
+            ),
         },
     ))
 }

@@ -122,7 +122,7 @@ mod tests {
         assert!((p.mean - 5.0).abs() < 1e-12);
         assert!((p.tau * p.tau - 97.0 / 3.0).abs() < 1e-9, "{}", p.tau);
         assert!((p.i2 - 0.97).abs() < 1e-12);
-        assert!((p.u - ((1.0 + 97.0 / 3.0) / 4.0).sqrt()).abs() < 1e-12);
+        assert!((p.u - ((1.0f64 + 97.0 / 3.0) / 4.0).sqrt()).abs() < 1e-12);
     }
 
     #[test]
