@@ -90,6 +90,7 @@ impl Archive {
             let mut tx = self.pool.begin().await?;
             for other in &replaced {
                 for sql in [
+                    "DELETE FROM explained WHERE run_id = $1",
                     "DELETE FROM run_files WHERE run_id = $1",
                     "DELETE FROM parameters WHERE run_id = $1",
                     "DELETE FROM limits WHERE run_id = $1",

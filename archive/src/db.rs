@@ -48,6 +48,13 @@ fn migrator() -> Migrator {
             include_str!("../migrations/0003_certificate_content.sql").into_sql_str(),
             false,
         ),
+        Migration::new(
+            4,
+            "explained".into(),
+            MigrationType::Simple,
+            include_str!("../migrations/0004_explained.sql").into_sql_str(),
+            false,
+        ),
     ])
 }
 

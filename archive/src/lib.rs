@@ -19,6 +19,7 @@ mod check;
 mod dates;
 mod db;
 mod error;
+mod explained;
 mod export;
 mod ingest;
 mod location;

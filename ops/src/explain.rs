@@ -48,7 +48,7 @@ pub struct Request {
 
 /// The effect files named by `--effects` and `RATECAL_EFFECTS`: files as given, folders
 /// by their `*.effect` files in name order.
-fn effect_files(args: &[PathBuf]) -> Result<Vec<(String, String)>, String> {
+pub(crate) fn effect_files(args: &[PathBuf]) -> Result<Vec<(String, String)>, String> {
     let env: Vec<PathBuf> = std::env::var_os("RATECAL_EFFECTS")
         .map(|v| {
             std::env::split_paths(&v)
@@ -84,7 +84,7 @@ fn effect_files(args: &[PathBuf]) -> Result<Vec<(String, String)>, String> {
         .collect()
 }
 
-fn load_effects(args: &[PathBuf]) -> Result<Vec<&'static UserEffect>, ()> {
+pub(crate) fn load_effects(args: &[PathBuf]) -> Result<Vec<&'static UserEffect>, ()> {
     let files = effect_files(args).map_err(|e| errln!("error: {e}"))?;
     explain::user::load(&files).map_err(|diags| diags.iter().for_each(procedure::report))
 }
@@ -290,7 +290,7 @@ fn compute(
 
 /// A run folder's own procedure (its `plan.json`): the findings it already holds are not
 /// to be added (`already_held`). A folder without one (an import) is left as it is.
-fn held_by_the_run(run: &Path, rec: &Streamed, x: &mut explain::Explanation) {
+pub(crate) fn held_by_the_run(run: &Path, rec: &Streamed, x: &mut explain::Explanation) {
     let plan = std::fs::read_to_string(run.join(ratecal_folder::names::PLAN))
         .ok()
         .and_then(|t| serde_json::from_str::<ratecal_analysis::plan::Plan>(&t).ok());

@@ -14,6 +14,8 @@ macro_rules! errln {
     ($($t:tt)*) => { $crate::console::err(format_args!($($t)*), true) };
 }
 
+pub mod across;
+pub mod across_archive;
 pub mod analyze;
 pub mod archive;
 pub mod certificate;

@@ -21,8 +21,29 @@ pub enum Format {
 #[derive(clap::Args)]
 pub struct Args {
     /// Recording folder (manifest.yaml, imu.csv, table.csv), from any acquisition system.
-    #[arg(value_name = "RUN_DIR")]
-    run: PathBuf,
+    /// Several: each is explained, then the findings are pooled across them (what recurs
+    /// in the model, in a unit, in the pool only; docs/explain.md "Across recordings").
+    #[arg(value_name = "RUN_DIR", required_unless_present_any = ["serial", "model"])]
+    runs: Vec<PathBuf>,
+    /// The archive to select runs from with --serial or --model (a folder or a
+    /// postgres:// URL; default `RATECAL_ARCHIVE`, else ./archive/).
+    #[arg(long, value_name = "DIR_OR_URL")]
+    archive: Option<String>,
+    /// Explain one unit's history: every archived run of this IMU serial.
+    #[arg(long, value_name = "SN", conflicts_with = "model")]
+    serial: Option<String>,
+    /// Explain a model's fleet: every archived run of this IMU model.
+    #[arg(long, value_name = "M")]
+    model: Option<String>,
+    /// With --serial/--model: runs started on or after (YYYY-MM-DD or RFC 3339).
+    #[arg(long, value_name = "DATE")]
+    since: Option<String>,
+    /// With --serial/--model: runs started on or before (a date includes that day).
+    #[arg(long, value_name = "DATE")]
+    until: Option<String>,
+    /// With --serial/--model: dry runs too.
+    #[arg(long)]
+    include_dry_runs: bool,
     /// Procedure whose fits are the nominal model (default: the standard's seed model);
     /// "how to adopt" becomes a diff against its file.
     #[arg(long, value_name = "PROCEDURE")]
@@ -61,19 +82,72 @@ pub struct Args {
 
 /// Runs the subcommand.
 pub fn main(a: Args) -> ExitCode {
+    let format = match a.format {
+        Format::Text => ratecal_ops::explain::Format::Text,
+        Format::Json => ratecal_ops::explain::Format::Json,
+    };
+    let select = a.serial.is_some() || a.model.is_some();
+    if !select && (a.archive.is_some() || a.since.is_some() || a.until.is_some()) {
+        let e = miette::miette!(
+            code = "explain::no_selection",
+            help = "add --serial SN (one unit's history) or --model M (a model's fleet)",
+            "--archive, --since and --until select archived runs, and need --serial or --model"
+        );
+        eprintln!("{e:?}");
+        return ExitCode::from(2);
+    }
+    if a.runs.len() > 1 || select {
+        return across(a, format);
+    }
     ExitCode::from(explain(&Request {
-        run: a.run,
+        run: a.runs.into_iter().next().unwrap_or_default(),
         procedure: a.procedure,
         effects: a.effects,
         without: a.without,
-        format: match a.format {
-            Format::Text => ratecal_ops::explain::Format::Text,
-            Format::Json => ratecal_ops::explain::Format::Json,
-        },
+        format,
         allow_changed: a.allow_changed,
         plots: a.plots,
         draft_effects: a.draft_effects,
         twin: a.twin,
         write_twin: a.write_twin,
     }))
+}
+
+/// Several recordings: explained each, then pooled; the options of one recording's output
+/// files are refused (exit 2).
+fn across(a: Args, format: ratecal_ops::explain::Format) -> ExitCode {
+    let one_only = [
+        ("--plots", a.plots.is_some()),
+        ("--draft-effects", a.draft_effects.is_some()),
+        ("--twin", a.twin.is_some()),
+    ];
+    if let Some((flag, _)) = one_only.iter().find(|(_, given)| *given) {
+        let e = miette::miette!(
+            code = "explain::one_recording_only",
+            help = "explain the recording on its own for {flag}, or leave it out to pool several",
+            "{flag} applies to one recording, not to several"
+        );
+        eprintln!("{e:?}");
+        return ExitCode::from(2);
+    }
+    ExitCode::from(ratecal_ops::across::explain_across(
+        &ratecal_ops::across::Request {
+            runs: a.runs,
+            procedure: a.procedure,
+            effects: a.effects,
+            without: a.without,
+            format,
+            allow_changed: a.allow_changed,
+            archive: (a.serial.is_some() || a.model.is_some()).then_some(
+                ratecal_ops::across_archive::Selection {
+                    archive: a.archive,
+                    serial: a.serial,
+                    model: a.model,
+                    since: a.since,
+                    until: a.until,
+                    include_dry_runs: a.include_dry_runs,
+                },
+            ),
+        },
+    ))
 }

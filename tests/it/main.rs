@@ -29,6 +29,8 @@ mod cli_explain_twin_timing;
 mod cli_report;
 mod cli_size_effect;
 mod crash_cli;
+mod explain_across;
+mod explain_across_archive;
 mod explain_real;
 mod harden_cli;
 mod import_cli;

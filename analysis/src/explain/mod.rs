@@ -17,6 +17,7 @@
 // Numeric loops index the six channels of several arrays at once.
 #![allow(clippy::needless_range_loop)]
 
+pub mod across;
 mod adopt;
 mod alternatives;
 mod change;
@@ -32,6 +33,7 @@ mod observe;
 mod output;
 mod plausible;
 mod probe;
+pub mod profile;
 mod select;
 mod stats;
 mod text;
@@ -71,6 +73,9 @@ pub struct Options {
     pub user: Vec<&'static UserEffect>,
     /// Registry ids left out of the candidates.
     pub without: Vec<String>,
+    /// Also fit every candidate beside the final model ([`profile`]): what explain over
+    /// several recordings pools.
+    pub profile: bool,
 }
 
 impl Default for Options {
@@ -80,6 +85,7 @@ impl Default for Options {
             alpha: 1e-3,
             user: Vec::new(),
             without: Vec::new(),
+            profile: false,
         }
     }
 }
@@ -334,6 +340,14 @@ pub(crate) fn explain_fitted(
             gyro_dps: floor(3..6),
         },
     };
+    let profile = match opts.profile {
+        true => {
+            let mut found: Vec<usize> = steps.iter().map(|s| s.effect).collect();
+            found.extend(discoveries.iter().map(|d| d.step.effect));
+            profile::profile(data, &terms, &start.skip, &found, latitude)
+        }
+        false => Vec::new(),
+    };
     let adopt = adopt_of(&findings);
     let x = Explanation {
         format: FORMAT.into(),
@@ -369,6 +383,7 @@ pub(crate) fn explain_fitted(
             })
             .collect(),
         warnings,
+        profile,
     };
     (x, timing_left)
 }

@@ -284,4 +284,8 @@ pub struct Explanation {
     pub draft_effects: Vec<UserEffectOut>,
     /// What could not be done as asked.
     pub warnings: Vec<String>,
+    /// With [`super::Options::profile`]: every candidate fitted beside the final model,
+    /// what explain over several recordings pools (docs/explain.md, "Across recordings").
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub profile: Vec<super::profile::Fitted>,
 }

@@ -1,0 +1,239 @@
+//! `ratecal explain RUN RUN...` on fleets written by `ratecal-witness` (a second,
+//! independent implementation of the spec): physics shared by every unit but too weak for
+//! any one recording is found in the pool, physics of one unit is `unit`, a warm-up after
+//! some power-ons is `occasional`, a unit far off the fleet is an outlier, and a fleet with
+//! nothing shared pools nothing.
+
+use crate::support;
+use ratecal_witness::{Hidden, Plan, Scenario, write};
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use support::{code, ratecal, text};
+
+const ROOT: &str = env!("CARGO_MANIFEST_DIR");
+
+/// The fleet's shared K2 on every axis, ug/g^2: under two standard uncertainties of one
+/// short recording (explain's threshold is above four).
+const K2: f64 = 16.0;
+
+/// A short standard-shaped recording of unit `serial`, its biases and scales its own
+/// (drawn from the serial's number), the noise from `seed`.
+fn unit(serial: &str, n: u64, seed: u64) -> Scenario {
+    let mut s = Scenario::standard(serial, seed);
+    s.plan = Plan::standard(60.0);
+    let r = |k: u64| (((n * 7 + k) * 2_654_435_761) % 1000) as f64 / 1000.0 - 0.5;
+    s.imu.accel_bias_mps2 = [0.04 * r(1), 0.04 * r(2), 0.04 * r(3)];
+    s.imu.accel_scale_ppm = [2000.0 * r(4), 2000.0 * r(5), 2000.0 * r(6)];
+    s.imu.gyro_bias_dps = [0.1 * r(7), 0.1 * r(8), 0.1 * r(9)];
+    s.imu.gyro_scale_ppm = [3000.0 * r(10), 3000.0 * r(11), 3000.0 * r(12)];
+    s
+}
+
+fn k2(k: f64) -> Hidden {
+    Hidden::AccelSecondOrder {
+        k2_ug_per_g2: [k, k, k],
+    }
+}
+
+/// Writes each scenario into its own folder under `dir`; the folders.
+fn write_all(dir: &Path, fleet: Vec<Scenario>) -> Vec<PathBuf> {
+    fleet
+        .into_iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let p = dir.join(format!("{i:02}-{}", s.name));
+            write(&p, &s).unwrap();
+            p
+        })
+        .collect()
+}
+
+/// `explain RUN... --format json`: exit code and the JSON.
+fn explain(runs: &[PathBuf]) -> (i32, Value) {
+    let mut args = vec!["explain".to_string()];
+    args.extend(runs.iter().map(|p| p.display().to_string()));
+    args.extend(["--format".into(), "json".into()]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let o = ratecal(&args, Path::new(ROOT));
+    let v = serde_json::from_slice(&o.stdout).unwrap_or_else(|e| panic!("{e}: {}", text(&o)));
+    (code(&o), v)
+}
+
+fn entries<'a>(v: &'a Value, effect: &str) -> Vec<&'a Value> {
+    v["across"]["effects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|e| e["effect"] == effect)
+        .collect()
+}
+
+fn f(v: &Value, k: &str) -> f64 {
+    v[k].as_f64().unwrap_or_else(|| panic!("{k} in {v}"))
+}
+
+#[test]
+fn the_pool_finds_a_weak_shared_k2_a_units_lever_arm_a_warm_up_and_an_outlier() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut fleet: Vec<Scenario> = (1..=8)
+        .map(|n| unit(&format!("SN{n:03}"), n, 100 + n).with(k2(K2)))
+        .collect();
+    // One unit recorded three times, each time with the same lever arm.
+    let lever = [[30.0, 0.0, 0.0], [30.0, 0.0, 0.0], [30.0, 0.0, 0.0]];
+    for seed in [201, 202, 203] {
+        fleet.push(
+            unit("SN100", 100, seed)
+                .with(k2(K2))
+                .with(Hidden::LeverArm { r_mm: lever }),
+        );
+    }
+    // One unit whose K2 is five times the fleet's.
+    fleet.push(unit("SN200", 200, 300).with(k2(5.0 * K2)));
+    // One unit recorded three times, twice right after power-on (a gyro warm-up).
+    for (seed, warm) in [(401, true), (402, true), (403, false)] {
+        let s = unit("SN300", 300, seed).with(k2(K2));
+        fleet.push(match warm {
+            true => s.with(Hidden::GyroWarmUp {
+                amplitude_dps: [0.03, -0.02, 0.025],
+                tau_s: 100.0,
+            }),
+            false => s,
+        });
+    }
+    let runs = write_all(tmp.path(), fleet);
+    let (c, v) = explain(&runs);
+    assert_eq!(c, 1, "a recording or the pool has a finding");
+    let a = &v["across"];
+    assert_eq!(a["recordings"].as_array().unwrap().len(), 15);
+    // Hardly any recording of the fleet finds K2 alone (else this would not test pooling).
+    let found_k2 = |r: &Value| {
+        r["findings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|f| f == "accel_second_order")
+    };
+    let recs = a["recordings"].as_array().unwrap();
+    let alone = (recs.iter())
+        .filter(|r| r["serial"] != "SN200" && found_k2(r))
+        .count();
+    println!("K2 found alone in {alone} of 14 recordings");
+    assert!(alone <= 2, "{a:#}");
+    // The pooled K2: within 3u of the truth on every axis, `pooled_only` or `model`, the
+    // five-fold unit left out.
+    let k2s = entries(&v, "accel_second_order");
+    assert_eq!(k2s.len(), 3, "{a:#}");
+    for e in &k2s {
+        let (x, u) = (f(e, "pooled"), f(e, "u"));
+        println!("K2 {}: {x:.2} ± {u:.2} ({})", e["parameter"], e["verdict"]);
+        assert!((x - K2).abs() < 3.0 * u, "{e:#}");
+        assert!(u < K2 / 3.0, "the pool determines it: {e:#}");
+        assert!(
+            e["verdict"] == "pooled_only" || e["verdict"] == "model",
+            "{e:#}"
+        );
+        let left: Vec<&str> = e["left_out"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|r| r.as_str().unwrap())
+            .collect();
+        assert_eq!(left.len(), 1, "{e:#}");
+        assert!(left[0].ends_with("-SN200"), "{left:?}");
+        assert_eq!(e["per_recording"].as_array().unwrap().len(), 15);
+    }
+    // The five-fold unit is among the outliers, on K2.
+    let outliers = a["outliers"].as_array().unwrap();
+    assert!(
+        outliers
+            .iter()
+            .any(|o| o["serial"] == "SN200" && o["effect"] == "accel_second_order"),
+        "{outliers:#?}"
+    );
+    // The lever arm is the unit's: its x coordinates, in every recording of SN100 and no
+    // other serial.
+    let lever = entries(&v, "lever_arm");
+    let rxx = lever
+        .iter()
+        .find(|e| e["parameter"] == "rxx_mm")
+        .unwrap_or_else(|| panic!("{a:#}"));
+    assert_eq!(rxx["verdict"], "unit", "{rxx:#}");
+    assert!(
+        lever
+            .iter()
+            .all(|e| e["verdict"] != "model" && e["verdict"] != "pooled_only"),
+        "{lever:#?}"
+    );
+    // The warm-up is occasional: some recordings of one unit, not all.
+    let decay = entries(&v, "form_gyro_decay");
+    assert!(!decay.is_empty(), "{a:#}");
+    assert!(
+        decay.iter().any(|e| e["verdict"] == "occasional"),
+        "{decay:#?}"
+    );
+    assert!(
+        decay
+            .iter()
+            .all(|e| e["verdict"] == "occasional" || e["verdict"] == "none"),
+        "{decay:#?}"
+    );
+    // The text output leads with what recurs.
+    let mut args = vec!["explain".to_string()];
+    args.extend(runs.iter().map(|p| p.display().to_string()));
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let o = ratecal(&args, Path::new(ROOT));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.starts_with("Across 15 recordings of 11 units:"),
+        "{out}"
+    );
+    let k2_at = out
+        .find("accel_second_order.")
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(k2_at < out.find("Each recording:").unwrap(), "{out}");
+}
+
+#[test]
+fn a_fleet_with_nothing_shared_pools_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let fleet: Vec<Scenario> = (1..=8)
+        .map(|n| unit(&format!("NULL{n:02}"), n, 500 + n))
+        .collect();
+    let runs = write_all(tmp.path(), fleet);
+    let (c, v) = explain(&runs);
+    assert!(c == 0 || c == 1, "{v:#}");
+    let a = &v["across"];
+    let pooled: Vec<&Value> = a["effects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|e| e["verdict"] == "model" || e["verdict"] == "pooled_only")
+        .filter(|e| e["effect"] != "earth_rate")
+        .collect();
+    assert!(pooled.is_empty(), "nothing shared, yet pooled: {pooled:#?}");
+    // Every pooled parameter is listed with its recordings: what is in `effects` has one
+    // value per recording that determines it.
+    for e in a["effects"].as_array().unwrap() {
+        assert!(!e["per_recording"].as_array().unwrap().is_empty(), "{e:#}");
+    }
+}
+
+#[test]
+fn err_one_recording_options_with_several_are_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let runs = write_all(tmp.path(), vec![unit("A", 1, 1), unit("B", 2, 2)]);
+    let (a, b) = (runs[0].to_str().unwrap(), runs[1].to_str().unwrap());
+    let o = ratecal(
+        &["explain", a, b, "--plots", tmp.path().to_str().unwrap()],
+        Path::new(ROOT),
+    );
+    assert_eq!(code(&o), 2, "{}", text(&o));
+    assert!(
+        text(&o).contains("explain::one_recording_only"),
+        "{}",
+        text(&o)
+    );
+    let missing = tmp.path().join("nothing-here");
+    let o = ratecal(&["explain", a, missing.to_str().unwrap()], Path::new(ROOT));
+    assert_eq!(code(&o), 2, "{}", text(&o));
+}
