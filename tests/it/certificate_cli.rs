@@ -1022,6 +1022,84 @@ fn an_amendment_needs_a_reason_takes_a_new_number_and_names_the_one_it_replaces(
     );
 }
 
+/// The crash harness's amendment (issue 38, item 6): `certificate --amend` stopped as
+/// abruptly as a kill before it delivers and before it records, five times, burns no number
+/// and leaves no document at `--out`; the amendment that then completes takes the next
+/// number and replaces the certificate that was issued, not one nobody received.
+#[test]
+fn killed_amendments_burn_no_number_and_leave_no_document() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    mini(dir, "run", &certified_station("2099-12-31"), true);
+    let first = ["--customer", "ACME", "--order", "PO-1"];
+    let o = certificate(dir, "run", &with(&first, &["--out", "first.pdf"]));
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let lab = lab_in(dir);
+    let amend = [
+        "certificate",
+        "run",
+        "--lab",
+        lab.as_str(),
+        "--archive",
+        "archive",
+        "--customer",
+        "ACME Avionics",
+        "--order",
+        "PO-1",
+        "--amend",
+        "--reason",
+        "customer name incomplete",
+        "--out",
+        "amended.pdf",
+    ];
+    for point in [
+        "certificate-before-deliver",
+        "certificate-before-record",
+        "certificate-before-record",
+        "certificate-before-deliver",
+        "certificate-before-record",
+    ] {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_ratecal"))
+            .args(amend)
+            .current_dir(dir)
+            .env("RATECAL_CRASH_AT", point)
+            .output()
+            .unwrap();
+        assert_ne!(code(&o), 0, "{point} did not stop it: {}", text(&o));
+        assert!(
+            !dir.join("amended.pdf").exists(),
+            "a document without a recorded number appeared at --out ({point})"
+        );
+        // The certificate in force is still the first.
+        let o = certificate(dir, "run", &with(&first, &["--format", "json"]));
+        assert_eq!(code(&o), 0, "{point}: {}", text(&o));
+        assert_eq!(json_of(&o)["number"], numbered(1).as_str(), "{point}");
+    }
+    let o = ratecal(&amend, dir);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    assert!(
+        text(&o).contains(&numbered(2)),
+        "a killed amendment burned a number: {}",
+        text(&o)
+    );
+    let o = verify_pdf(dir, "amended.pdf");
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let o = verify_pdf(dir, "first.pdf");
+    assert!(
+        text(&o).contains(&format!("replaced by certificate No. {}", numbered(2))),
+        "{}",
+        text(&o)
+    );
+    // No partial document is left beside the delivered one.
+    let left: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".partial"))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+}
+
 #[test]
 fn a_draft_and_a_dry_run_specimen_take_no_number() {
     let tmp = tempfile::tempdir().unwrap();
