@@ -46,6 +46,32 @@ pub fn format_value(value: f64, unit: &str) -> String {
     }
 }
 
+/// A reading whose uncertainty is not stated (an environmental condition beside its
+/// limit): four significant digits, trailing zeros dropped (`0.02 degC/h`, `101.3 kPa`),
+/// since no `U` says which digits hold.
+pub fn format_reading(value: f64, unit: &str) -> String {
+    let text = if value.is_finite() {
+        short(value, 4)
+    } else {
+        special(value)
+    };
+    if unit.is_empty() {
+        text
+    } else {
+        format!("{text} {unit}")
+    }
+}
+
+/// A coverage factor as a certificate writes it: `2` when it is a whole number, else two
+/// decimals (`2.05`, from the effective degrees of freedom).
+pub fn format_k(k: f64) -> String {
+    if (k - k.round()).abs() < 1e-9 {
+        format!("{k:.0}")
+    } else {
+        format!("{k:.2}")
+    }
+}
+
 /// `value ± u` without a unit (`0.01234 ± 0.00056`, `(3.20 ± 0.41)e-6`).
 pub fn measured_number(value: f64, u: f64) -> String {
     let (v, u, e) = measured_parts(value, u);
@@ -323,6 +349,18 @@ mod tests {
         assert_eq!(v(101.3, "kPa"), "101.3 kPa");
         assert_eq!(v(-8.660729817769845e-6, ""), "-8.66073e-6");
         assert_eq!(v(f64::NAN, "g"), "NaN g");
+    }
+
+    #[test]
+    fn a_reading_without_u_has_four_digits_and_k_is_whole_when_it_is() {
+        use super::{format_k, format_reading as r};
+        assert_eq!(r(0.02000372589853021, "degC/h"), "0.02 degC/h");
+        assert_eq!(r(101.3, "kPa"), "101.3 kPa");
+        assert_eq!(r(20.0, "degC"), "20 degC");
+        assert_eq!(r(12345.678, "s"), "12350 s");
+        assert_eq!(r(f64::NAN, "g"), "NaN g");
+        assert_eq!(format_k(2.0), "2");
+        assert_eq!(format_k(2.0466), "2.05");
     }
 
     #[test]

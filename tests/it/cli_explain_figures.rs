@@ -51,6 +51,17 @@ fn explain_finds_the_lever_arm_and_draws_it_before_and_after() {
         "{run_out}"
     );
     assert_eq!(decimals(v), decimals(u), "{run_out}");
+    // Every conformity line states its k as a certificate does (`k = 2`), and a reading
+    // without U says so at four digits, with no k for a U that is not there.
+    let drift = (run_out.lines())
+        .find(|l| l.contains("environment.temperature_drift ="))
+        .unwrap_or_else(|| panic!("{run_out}"));
+    assert!(drift.contains("= 0.02 degC/h (U not stated)"), "{drift}");
+    assert!(!drift.contains("k ="), "{drift}");
+    let residual = (run_out.lines())
+        .find(|l| l.contains("gyro.residual.std ="))
+        .unwrap();
+    assert!(residual.contains(", k = 2)"), "{residual}");
 
     let o = ratecal(&["explain", "lever", "--plots", "figs"], dir);
     assert_eq!(code(&o), 1, "{}", text(&o));

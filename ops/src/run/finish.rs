@@ -4,7 +4,7 @@
 
 use ed25519_dalek::SigningKey;
 use miette::Report;
-use ratecal_analysis::measured::{format_measured, format_value};
+use ratecal_analysis::measured::{format_k, format_measured, format_reading, format_value};
 use ratecal_analysis::results::RunVerdict;
 use ratecal_folder::RunFolder;
 use ratecal_folder::names::{JOURNAL, MANIFEST, PLAN, RESULTS, SEAL_FILE};
@@ -264,12 +264,20 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
         outln!("acceptance (value ± expanded uncertainty U, k as stated):");
     }
     for a in &results.acceptance {
-        let value = match (a.value, a.expanded_u) {
-            (Some(x), Some(u)) if u > 0.0 => format_measured(x, u, &a.unit),
-            (Some(x), _) => format_value(x, &a.unit),
-            (None, _) => format!("- {}", a.unit),
+        // GUM 7.2.6: U to two digits and the value to match, with its k; a reading whose U
+        // is not stated says so (no k for a U that is not there) at four digits.
+        let (value, k) = match (a.value, a.expanded_u) {
+            (Some(x), Some(u)) if u > 0.0 => (
+                format_measured(x, u, &a.unit),
+                a.k.map(|k| format!(", k = {}", format_k(k)))
+                    .unwrap_or_default(),
+            ),
+            (Some(x), _) => (
+                format!("{} (U not stated)", format_reading(x, &a.unit)),
+                String::new(),
+            ),
+            (None, _) => (format!("- {}", a.unit), String::new()),
         };
-        let k = a.k.map(|k| format!(", k = {k:.2}")).unwrap_or_default();
         outln!(
             "  {:>13}  {} = {value} (limit {} {}{k})",
             a.verdict.label(),
