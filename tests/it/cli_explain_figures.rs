@@ -62,6 +62,14 @@ fn explain_finds_the_lever_arm_and_draws_it_before_and_after() {
         .find(|l| l.contains("gyro.residual.std ="))
         .unwrap();
     assert!(residual.contains(", k = 2)"), "{residual}");
+    // A check made at several points names the point and its segment.
+    let point = (run_out.lines())
+        .find(|l| l.contains("gyro.error ="))
+        .unwrap_or_else(|| panic!("{run_out}"));
+    assert!(
+        point.contains("): at 75 deg/s about the outer axis, segment verify/outer/+75"),
+        "{point}"
+    );
 
     let o = ratecal(&["explain", "lever", "--plots", "figs"], dir);
     assert_eq!(code(&o), 1, "{}", text(&o));

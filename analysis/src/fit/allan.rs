@@ -43,11 +43,20 @@ fn adev_of_angle(theta: &[f64], dt: f64) -> Vec<(f64, f64, usize)> {
 /// dependent additions, four times slower on an hour of 1 kHz samples (the sum differs
 /// from the one-chain sum only by rounding).
 fn second_differences_squared(theta: &[f64], m: usize, terms: usize) -> f64 {
-    let (a, b, c) = (&theta[..terms], &theta[m..m + terms], &theta[2 * m..2 * m + terms]);
+    let (a, b, c) = (
+        &theta[..terms],
+        &theta[m..m + terms],
+        &theta[2 * m..2 * m + terms],
+    );
     let mut s = [0.0f64; 4];
     let (ca, cb, cc) = (a.chunks_exact(4), b.chunks_exact(4), c.chunks_exact(4));
     let mut tail = 0.0;
-    for ((x, y), z) in ca.remainder().iter().zip(cb.remainder()).zip(cc.remainder()) {
+    for ((x, y), z) in ca
+        .remainder()
+        .iter()
+        .zip(cb.remainder())
+        .zip(cc.remainder())
+    {
         let d = z - 2.0 * y + x;
         tail += d * d;
     }

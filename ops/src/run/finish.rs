@@ -278,8 +278,12 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
             ),
             (None, _) => (format!("- {}", a.unit), String::new()),
         };
+        // A check made at several points says which (its name's last parenthesis).
+        let at = (a.name.strip_suffix(')'))
+            .and_then(|n| n.rfind(" (").map(|i| format!(": {}", &n[i + 2..])))
+            .unwrap_or_default();
         outln!(
-            "  {:>13}  {} = {value} (limit {} {}{k})",
+            "  {:>13}  {} = {value} (limit {} {}{k}){at}",
             a.verdict.label(),
             a.quantity,
             a.op,
