@@ -56,7 +56,10 @@ fn explain_finds_the_lever_arm_and_draws_it_before_and_after() {
     let drift = (run_out.lines())
         .find(|l| l.contains("environment.temperature_drift ="))
         .unwrap_or_else(|| panic!("{run_out}"));
-    assert!(drift.contains("= 0.02 degC/h (U not stated)"), "{drift}");
+    assert!(
+        drift.contains("= 0.02 degC/h (limit <= 0.5 degC/h, U not stated)"),
+        "{drift}"
+    );
     assert!(!drift.contains("k ="), "{drift}");
     let residual = (run_out.lines())
         .find(|l| l.contains("gyro.residual.std ="))

@@ -272,10 +272,7 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
                 a.k.map(|k| format!(", k = {}", format_k(k)))
                     .unwrap_or_default(),
             ),
-            (Some(x), _) => (
-                format!("{} (U not stated)", format_reading(x, &a.unit)),
-                String::new(),
-            ),
+            (Some(x), _) => (format_reading(x, &a.unit), ", U not stated".into()),
             (None, _) => (format!("- {}", a.unit), String::new()),
         };
         // A check made at several points says which (its name's last parenthesis).
