@@ -1,0 +1,274 @@
+//! `ratecal explain --model M [RUN...] --twin STATION --write-twin OUT.yaml`: the model's
+//! twin. The station file `STATION` with the fleet's pooled values written into its IMU
+//! effects, through the single recording's twin editor (`crate::twin::corrected`): every
+//! parameter whose verdict is `model` or `pooled_only` (pooled without the outliers), its
+//! uncertainty `sqrt(u^2 + spread^2)`, what a new unit of the model is expected to show
+//! (the pooled value is known to u, a unit lies about it by the spread). The rest of the
+//! file (site, table, the unit's own bias and scale, what the fleet does not share) stays
+//! as written. docs/explain.md, "Across recordings".
+
+use crate::across::Explained;
+use ratecal_analysis::explain::UserEffect;
+use ratecal_analysis::explain::across::{Across, PooledOut};
+use ratecal_analysis::fit::{Source, Streamed};
+use ratecal_analysis::twin::Change;
+use ratecal_physics::Effect;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+/// Where the model's twin is written, and from which station file.
+pub struct Target {
+    /// The station file (or run folder) whose text is edited.
+    pub twin: PathBuf,
+    /// Where the model's twin is written.
+    pub out: PathBuf,
+}
+
+/// The model's twin: JSON key `twin` of explain across.
+#[derive(Debug, Clone, Serialize)]
+pub struct ModelTwin {
+    /// The station file edited, as given.
+    pub station: String,
+    /// The model (`imu.model`) the fleet shares.
+    pub model: String,
+    /// The file written (absent when it was not).
+    pub written: Option<String>,
+    /// The pooled values written: `to` the pooled value, `u` with the spread.
+    pub changes: Vec<Change>,
+    /// Pooled `model`/`pooled_only` parameters not written, and why.
+    pub not_written: Vec<NotWritten>,
+    /// The unified diff from the station file to the model's twin.
+    pub diff: Option<String>,
+}
+
+/// A pooled parameter the station file cannot hold.
+#[derive(Debug, Clone, Serialize)]
+pub struct NotWritten {
+    /// Effect id.
+    pub effect: String,
+    /// Parameter.
+    pub parameter: String,
+    /// Why.
+    pub why: String,
+}
+
+/// A command that stops with this exit code, its diagnostics said.
+type Exit = u8;
+
+fn refuse(code: &str, help: &str, msg: String) -> Exit {
+    let e = miette::miette!(code = code.to_string(), help = help.to_string(), "{msg}");
+    errln!("{e:?}");
+    2
+}
+
+/// `--write-twin` without `--twin` (one recording or several): refused, exit 2.
+pub fn needs_twin(write_twin: Option<&Path>, twin: Option<&Path>) -> Result<(), Exit> {
+    match (write_twin, twin) {
+        (Some(out), None) => Err(refuse(
+            "explain::write_twin_needs_twin",
+            "add --twin STATION: the station file (or run folder) whose text the twin is written into",
+            format!(
+                "--write-twin {} needs --twin: there is no station file to write",
+                out.display()
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// What the model's twin needs before anything is explained: not one unit's history
+/// (`--serial`), recordings of one model, an output that is no run's input. Exit 2.
+pub fn check(
+    target: &Target,
+    runs: &[PathBuf],
+    serial: Option<&str>,
+    model: Option<&str>,
+) -> Result<(), Exit> {
+    if let Some(sn) = serial {
+        return Err(refuse(
+            "explain::model_twin_of_a_serial",
+            "write the model's twin from a fleet: --model M instead of --serial (one unit's twin: explain one recording with --twin --write-twin)",
+            format!("--write-twin writes a model's twin; --serial {sn} selects one unit's history"),
+        ));
+    }
+    let runs_ref: Vec<&Path> = runs.iter().map(PathBuf::as_path).collect();
+    if let Err(e) = ratecal_folder::outputs::refuse_inputs(&target.out, "--write-twin", &runs_ref) {
+        errln!("{e:?}");
+        return Err(2);
+    }
+    let mut models: Vec<(String, String)> = model
+        .map(|m| ("--model".to_string(), m.to_string()))
+        .into_iter()
+        .collect();
+    for dir in runs {
+        // A folder that cannot be read is said when it is explained.
+        if let Ok(rec) = Streamed::open(dir) {
+            let m = rec.manifest().imu.get("model").cloned();
+            models.push((
+                dir.display().to_string(),
+                m.unwrap_or_else(|| "unknown".into()),
+            ));
+        }
+    }
+    one_model(&models).map(|_| ())
+}
+
+/// The one model of `(source, model)` pairs; refused (exit 2) when they differ.
+fn one_model(models: &[(String, String)]) -> Result<String, Exit> {
+    let Some((_, first)) = models.first() else {
+        return Ok("unknown".into());
+    };
+    match models.iter().find(|(_, m)| m != first) {
+        None => Ok(first.clone()),
+        Some((other, m)) => Err(refuse(
+            "explain::model_twin_of_several_models",
+            "a model's twin pools recordings of one imu.model: select them with --model M, or give only folders of that model",
+            format!(
+                "--write-twin writes one model's twin, but {} is {first:?} and {other} is {m:?}",
+                models[0].0
+            ),
+        )),
+    }
+}
+
+/// Writes the model's twin of the pooled fleet; the report (its `written` absent and why,
+/// when it could not be written).
+pub fn write(
+    target: &Target,
+    a: &Across,
+    explained: &[Explained],
+    user: &[&'static UserEffect],
+) -> Result<ModelTwin, Exit> {
+    let models: Vec<(String, String)> = explained
+        .iter()
+        .map(|e| (e.run.clone(), e.model.clone()))
+        .collect();
+    let model = one_model(&models)?;
+    let f = crate::twin::read(&target.twin).map_err(|()| 2u8)?;
+    if !f.station.imu.model.is_empty() && f.station.imu.model != model {
+        errln!(
+            "warning: the station file's imu.model is {:?}, the fleet's {model:?}: its IMU effects are the fleet's, the rest as written",
+            f.station.imu.model
+        );
+    }
+    let (changes, not_written) = changes(a, &f.station, user);
+    let header = header(a, &model, &changes);
+    let mut report = ModelTwin {
+        station: target.twin.display().to_string(),
+        model,
+        written: None,
+        changes,
+        not_written,
+        diff: None,
+    };
+    let written = crate::twin::corrected(&f, &report.changes, &target.out, &header).and_then(
+        |(text, diff)| {
+            ratecal_recording::commit::write_nofollow(&target.out, text.as_bytes())
+                .map(|()| diff)
+                .map_err(|e| e.to_string())
+        },
+    );
+    match written {
+        Ok(diff) => {
+            report.written = Some(target.out.display().to_string());
+            report.diff = Some(diff);
+            Ok(report)
+        }
+        Err(why) => Err(refuse(
+            "explain::twin_not_written",
+            "the pool above stands; fix what is named and run the query again with --write-twin",
+            format!(
+                "the model's twin \"{}\" was not written: {why}",
+                target.out.display()
+            ),
+        )),
+    }
+}
+
+/// Whether a pooled entry goes into the model's twin.
+fn shared(e: &PooledOut) -> bool {
+    e.verdict == "model" || e.verdict == "pooled_only"
+}
+
+/// The changes the fleet makes to the station file, and what it cannot hold.
+fn changes(
+    a: &Across,
+    st: &ratecal_drivers::station::Station,
+    user: &[&'static UserEffect],
+) -> (Vec<Change>, Vec<NotWritten>) {
+    let twin = crate::twin::twin_of(st);
+    let (mut out, mut not) = (Vec::new(), Vec::new());
+    for e in a.effects.iter().filter(|e| shared(e)) {
+        let u_user = user.iter().find(|u| u.id() == e.effect);
+        let fx: Option<&dyn Effect> =
+            ratecal_physics::effect(&e.effect).or_else(|| u_user.map(|u| *u as &dyn Effect));
+        let k = fx.and_then(|fx| fx.params().iter().position(|p| p.name == e.parameter));
+        let (Some(_), Some(k)) = (fx, k) else {
+            not.push(NotWritten {
+                effect: e.effect.clone(),
+                parameter: e.parameter.clone(),
+                why: "a library form, not an effect a station file holds: explain one recording that finds it with --draft-effects, and pool again with --effects".into(),
+            });
+            continue;
+        };
+        let from = twin.values(&e.effect).and_then(|v| v.get(k)).copied();
+        let u = e.u.hypot(e.spread);
+        out.push(Change {
+            effect: e.effect.clone(),
+            parameter: e.parameter.clone(),
+            from: from.unwrap_or(0.0),
+            to: e.pooled,
+            u,
+            unit: e.unit.clone(),
+            standard_errors: (e.pooled - from.unwrap_or(0.0)).abs() / u,
+            added: from.is_none(),
+            defined_in: u_user.map(|u| u.file().to_string()),
+        });
+    }
+    (out, not)
+}
+
+/// The comment the model's twin opens with: where its values come from, each with its
+/// uncertainty (a station file states values only).
+fn header(a: &Across, model: &str, changes: &[Change]) -> String {
+    let units = {
+        let mut v: Vec<&str> = a.recordings.iter().map(|r| r.serial.as_str()).collect();
+        v.sort_unstable();
+        v.dedup();
+        v.len()
+    };
+    let mut s = format!(
+        "# The twin of model {model}: `ratecal explain` pooled {} recordings of {units} units.\n\
+         # IMU effects shared by the fleet (verdict model or pooled_only), each as\n\
+         # pooled ± sqrt(u^2 + spread^2) (the pooled value's u and the spread between units):\n",
+        a.recordings.len()
+    );
+    for c in changes {
+        let e = a
+            .effects
+            .iter()
+            .find(|e| e.effect == c.effect && e.parameter == c.parameter && shared(e));
+        let Some(e) = e else { continue };
+        let left = match e.left_out.is_empty() {
+            true => String::new(),
+            false => format!("; left out: {}", e.left_out.join(", ")),
+        };
+        s.push_str(&format!(
+            "#   {}.{} = {} ± {} {} ({}; pooled u {}, spread {}{left})\n",
+            c.effect,
+            c.parameter,
+            ratecal_drivers::station::number(c.to, c.u),
+            sig2(c.u),
+            c.unit,
+            e.verdict,
+            sig2(e.u),
+            sig2(e.spread),
+        ));
+    }
+    s
+}
+
+/// Two significant digits.
+fn sig2(v: f64) -> String {
+    ratecal_drivers::station::number(v, v)
+}
