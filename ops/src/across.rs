@@ -324,7 +324,7 @@ fn twin_text(t: &crate::across_twin::ModelTwin) -> String {
             "  {}.{}: {} -> {} ± {} {}\n",
             c.effect,
             c.parameter,
-            c.from,
+            ratecal_drivers::station::number(c.from, c.u),
             ratecal_drivers::station::number(c.to, c.u),
             ratecal_drivers::station::number(c.u, c.u),
             c.unit

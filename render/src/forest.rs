@@ -84,13 +84,35 @@ fn num(v: f64) -> String {
     crate::filters::sig(v, 4)
 }
 
+/// The decimals of two significant digits of `u` (`None` without an uncertainty).
+fn decimals(u: f64) -> Option<usize> {
+    (u > 0.0 && u.is_finite()).then(|| (1 - u.log10().floor() as i32).clamp(0, 12) as usize)
+}
+
 /// A value and its uncertainty, the value to two significant digits of the uncertainty.
 fn pm(v: f64, u: f64) -> String {
-    if !(u > 0.0 && u.is_finite()) {
-        return format!("{} ± {}", num(v), num(u));
+    match decimals(u) {
+        Some(d) => format!("{v:.d$} ± {u:.d$}"),
+        None => format!("{} ± {}", num(v), num(u)),
     }
-    let d = (1 - u.log10().floor() as i32).clamp(0, 12) as usize;
-    format!("{v:.d$} ± {u:.d$}")
+}
+
+/// The spread, to the decimals of the pooled value.
+fn spread(e: &PooledOut) -> String {
+    match decimals(e.u) {
+        Some(d) => format!("{:.d$}", e.spread),
+        None => num(e.spread),
+    }
+}
+
+/// A label the labels' column holds: a long one keeps its end (the run's own name).
+fn clip(label: &str) -> String {
+    const MAX: usize = 42;
+    let n = label.chars().count();
+    match n > MAX {
+        true => format!("…{}", label.chars().skip(n - MAX + 1).collect::<String>()),
+        false => label.to_string(),
+    }
 }
 
 /// The fleet's band: the pooled value's u and the spread between units together.
@@ -122,7 +144,7 @@ pub fn forest(e: &PooledOut, outliers: &[Outlier]) -> String {
         pm(e.pooled, e.u),
         e.unit,
         e.verdict,
-        num(e.spread),
+        spread(e),
         100.0 * e.i2
     );
     let _ = write!(
@@ -191,7 +213,7 @@ fn row(
     if left_out {
         note.push_str(" (left out)");
     }
-    let label = format!("{run} · {serial}");
+    let label = clip(&format!("{run} · {serial}"));
     let _ = write!(
         s,
         r##"<g class="recording" data-run="{r}" data-serial="{sn}"><text x="{:.1}" y="{:.1}" text-anchor="end">{l}</text><line x1="{:.1}" y1="{y:.1}" x2="{:.1}" y2="{y:.1}" stroke="{c}"/><circle cx="{:.1}" cy="{y:.1}" r="3.5" fill="{fill}" stroke="{c}" stroke-width="1.5"/><text x="{:.1}" y="{:.1}" fill="{c}">{}{note}</text></g>"##,
