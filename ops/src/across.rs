@@ -113,7 +113,7 @@ fn run(args: &Request) -> Result<u8, Exit> {
 /// without `--write-twin`), and so is a model's twin of one unit's history or of several
 /// models, or written over a run's input: exit 2 before anything is explained. The model's
 /// twin's target, when asked.
-fn outputs_allowed(args: &Request) -> Result<Option<crate::across_twin::Target>, Exit> {
+fn outputs_allowed(args: &Request) -> Result<Option<crate::across_twin::Job>, Exit> {
     use crate::across_twin as twin;
     twin::needs_twin(args.write_twin.as_deref(), args.twin.as_deref())?;
     let one_only = [
@@ -149,13 +149,8 @@ fn outputs_allowed(args: &Request) -> Result<Option<crate::across_twin::Target>,
     };
     let sel = args.archive.as_ref();
     let serial = sel.and_then(|s| s.serial.as_deref());
-    twin::check(
-        &target,
-        &args.runs,
-        serial,
-        sel.and_then(|s| s.model.as_deref()),
-    )?;
-    Ok(Some(target))
+    let model = sel.and_then(|s| s.model.as_deref());
+    twin::prepare(target, &args.runs, serial, model).map(Some)
 }
 
 /// What explain across writes besides its output.
@@ -163,7 +158,7 @@ pub struct Outputs<'a> {
     /// `--plots DIR`.
     pub plots: Option<&'a std::path::Path>,
     /// The model's twin.
-    pub twin: Option<&'a crate::across_twin::Target>,
+    pub twin: Option<&'a crate::across_twin::Job>,
     /// The user effects (a pooled one is written by reference to its file).
     pub user: &'a [&'static UserEffect],
 }
@@ -262,9 +257,6 @@ pub fn report(explained: &[Explained], format: Format, outputs: &Outputs) -> Res
         })
         .collect();
     let a = across::pool(&members, ALPHA);
-    if let Some(dir) = outputs.plots {
-        write_plots(dir, &a)?;
-    }
     let twin = match outputs.twin {
         Some(t) => Some(crate::across_twin::write(t, &a, explained, outputs.user)?),
         None => None,
@@ -273,30 +265,46 @@ pub fn report(explained: &[Explained], format: Format, outputs: &Outputs) -> Res
         .iter()
         .any(|e| !(e.explanation.findings.is_empty() && e.explanation.unexplained.is_empty()));
     let out = match format {
-        Format::Json => {
-            let recs: Vec<serde_json::Value> = explained
-                .iter()
-                .map(|e| {
-                    let mut x = e.explanation.clone();
-                    // Each recording's own values are in `across`: its profile is not repeated.
-                    x.profile.clear();
-                    serde_json::to_value(&x).expect("plain data serializes")
-                })
-                .collect();
-            let mut v = serde_json::json!({
-                "format": explain::FORMAT,
-                "across": a,
-                "explanations": recs,
-            });
-            if let Some(t) = &twin {
-                v["twin"] = serde_json::to_value(t).expect("plain data serializes");
-            }
-            serde_json::to_string_pretty(&v).expect("plain data serializes") + "\n"
-        }
+        Format::Json => json(explained, &a, twin.as_ref()),
         Format::Text => across::render_text(&a) + &twin.as_ref().map(twin_text).unwrap_or_default(),
     };
     crate::console::out(format_args!("{out}"), false);
+    if let Some(dir) = outputs.plots {
+        write_plots(dir, &a)?;
+    }
+    // The pool is shown even when the model's twin could not be written.
+    if let (Some(t), Some(job)) = (&twin, outputs.twin)
+        && let Some(code) = crate::across_twin::say_failed(t, &job.target.out)
+    {
+        return Err(code);
+    }
     Ok(u8::from(found || a.has_finding()))
+}
+
+/// The JSON output: `across`, each recording's explanation, the model's twin.
+fn json(
+    explained: &[Explained],
+    a: &across::Across,
+    twin: Option<&crate::across_twin::ModelTwin>,
+) -> String {
+    let recs: Vec<serde_json::Value> = explained
+        .iter()
+        .map(|e| {
+            let mut x = e.explanation.clone();
+            // Each recording's own values are in `across`: its profile is not repeated.
+            x.profile.clear();
+            serde_json::to_value(&x).expect("plain data serializes")
+        })
+        .collect();
+    let mut v = serde_json::json!({
+        "format": explain::FORMAT,
+        "across": a,
+        "explanations": recs,
+    });
+    if let Some(t) = twin {
+        v["twin"] = serde_json::to_value(t).expect("plain data serializes");
+    }
+    serde_json::to_string_pretty(&v).expect("plain data serializes") + "\n"
 }
 
 /// Writes the forest plots' page into `dir` and names it.

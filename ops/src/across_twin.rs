@@ -39,6 +39,9 @@ pub struct ModelTwin {
     pub not_written: Vec<NotWritten>,
     /// The unified diff from the station file to the model's twin.
     pub diff: Option<String>,
+    /// Why it was not written.
+    #[serde(skip)]
+    pub failed: Option<String>,
 }
 
 /// A pooled parameter the station file cannot hold.
@@ -76,14 +79,23 @@ pub fn needs_twin(write_twin: Option<&Path>, twin: Option<&Path>) -> Result<(), 
     }
 }
 
+/// The model's twin, ready to be written once the fleet is pooled: where, and the station
+/// file read.
+pub struct Job {
+    /// Where from and to.
+    pub target: Target,
+    file: crate::twin::TwinFile,
+}
+
 /// What the model's twin needs before anything is explained: not one unit's history
-/// (`--serial`), recordings of one model, an output that is no run's input. Exit 2.
-pub fn check(
-    target: &Target,
+/// (`--serial`), recordings of one model, an output that is no run's input, a station file
+/// that reads. Exit 2.
+pub fn prepare(
+    target: Target,
     runs: &[PathBuf],
     serial: Option<&str>,
     model: Option<&str>,
-) -> Result<(), Exit> {
+) -> Result<Job, Exit> {
     if let Some(sn) = serial {
         return Err(refuse(
             "explain::model_twin_of_a_serial",
@@ -110,7 +122,9 @@ pub fn check(
             ));
         }
     }
-    one_model(&models).map(|_| ())
+    one_model(&models)?;
+    let file = crate::twin::read(&target.twin).map_err(|()| 2u8)?;
+    Ok(Job { target, file })
 }
 
 /// The one model of `(source, model)` pairs; refused (exit 2) when they differ.
@@ -131,10 +145,10 @@ fn one_model(models: &[(String, String)]) -> Result<String, Exit> {
     }
 }
 
-/// Writes the model's twin of the pooled fleet; the report (its `written` absent and why,
-/// when it could not be written).
+/// Writes the model's twin of the pooled fleet; the report (`written` absent and `failed`
+/// saying why when it could not be written). Recordings of several models: refused, exit 2.
 pub fn write(
-    target: &Target,
+    job: &Job,
     a: &Across,
     explained: &[Explained],
     user: &[&'static UserEffect],
@@ -144,7 +158,7 @@ pub fn write(
         .map(|e| (e.run.clone(), e.model.clone()))
         .collect();
     let model = one_model(&models)?;
-    let f = crate::twin::read(&target.twin).map_err(|()| 2u8)?;
+    let (f, target) = (&job.file, &job.target);
     if !f.station.imu.model.is_empty() && f.station.imu.model != model {
         errln!(
             "warning: the station file's imu.model is {:?}, the fleet's {model:?}: its IMU effects are the fleet's, the rest as written",
@@ -160,8 +174,9 @@ pub fn write(
         changes,
         not_written,
         diff: None,
+        failed: None,
     };
-    let written = crate::twin::corrected(&f, &report.changes, &target.out, &header).and_then(
+    let written = crate::twin::corrected(f, &report.changes, &target.out, &header).and_then(
         |(text, diff)| {
             ratecal_recording::commit::write_nofollow(&target.out, text.as_bytes())
                 .map(|()| diff)
@@ -172,17 +187,23 @@ pub fn write(
         Ok(diff) => {
             report.written = Some(target.out.display().to_string());
             report.diff = Some(diff);
-            Ok(report)
         }
-        Err(why) => Err(refuse(
-            "explain::twin_not_written",
-            "the pool above stands; fix what is named and run the query again with --write-twin",
-            format!(
-                "the model's twin \"{}\" was not written: {why}",
-                target.out.display()
-            ),
-        )),
+        Err(why) => report.failed = Some(why),
     }
+    Ok(report)
+}
+
+/// Says why the model's twin was not written (after the pool's output): exit 2.
+pub fn say_failed(t: &ModelTwin, out: &Path) -> Option<Exit> {
+    let why = t.failed.as_deref()?;
+    Some(refuse(
+        "explain::twin_not_written",
+        "the pool above stands; fix what is named and run the query again with --write-twin",
+        format!(
+            "the model's twin \"{}\" was not written: {why}",
+            out.display()
+        ),
+    ))
 }
 
 /// Whether a pooled entry goes into the model's twin.
