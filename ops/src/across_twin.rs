@@ -293,3 +293,65 @@ fn header(a: &Across, model: &str, changes: &[Change]) -> String {
 fn sig2(v: f64) -> String {
     ratecal_drivers::station::number(v, v)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ratecal_analysis::explain::across::PerRecording;
+
+    fn entry(effect: &str, parameter: &str, verdict: &str) -> PooledOut {
+        PooledOut {
+            effect: effect.into(),
+            parameter: parameter.into(),
+            pooled: 20.0,
+            u: 3.0,
+            spread: 4.0,
+            i2: 0.5,
+            verdict: verdict.into(),
+            per_recording: vec![PerRecording {
+                run: "r".into(),
+                serial: "s".into(),
+                value: 20.0,
+                u: 3.0,
+            }],
+            left_out: vec![],
+            unit: "ug/g^2".into(),
+        }
+    }
+
+    #[test]
+    fn only_what_the_fleet_shares_is_written_with_the_spread_in_its_u() {
+        let st = ratecal_drivers::Station::from_yaml(ratecal_drivers::DEFAULT_STATION_YAML, "d")
+            .unwrap();
+        let a = Across {
+            recordings: vec![],
+            effects: vec![
+                entry("accel_second_order", "x", "model"),
+                entry("accel_second_order", "y", "pooled_only"),
+                entry("lever_arm", "rxx_mm", "unit"),
+                entry("gyro_scale_asymmetry", "x", "occasional"),
+                entry("form_gyro_decay", "gx", "model"),
+            ],
+            outliers: vec![],
+        };
+        let (ch, not) = changes(&a, &st, &[]);
+        let names: Vec<(&str, &str)> = ch
+            .iter()
+            .map(|c| (c.effect.as_str(), c.parameter.as_str()))
+            .collect();
+        assert_eq!(
+            names,
+            [("accel_second_order", "x"), ("accel_second_order", "y")]
+        );
+        assert!(ch.iter().all(|c| c.to == 20.0 && c.u == 5.0 && c.added));
+        assert_eq!(not.len(), 1);
+        assert_eq!(not[0].effect, "form_gyro_decay");
+    }
+
+    #[test]
+    fn recordings_of_two_models_are_refused() {
+        let m = |s: &str, m: &str| (s.to_string(), m.to_string());
+        assert_eq!(one_model(&[m("a", "X"), m("b", "X")]), Ok("X".into()));
+        assert_eq!(one_model(&[m("a", "X"), m("b", "Y")]), Err(2));
+    }
+}
