@@ -125,6 +125,7 @@ pub fn explain(args: &Request) -> u8 {
 }
 
 fn explain_or_exit(args: &Request) -> Result<u8, Exit> {
+    crate::across_twin::needs_twin(args.write_twin.as_deref(), args.twin.as_deref())?;
     // An output never replaces an input (a recording, a seal, a recorded file): exit 2.
     if let Some(out) = &args.write_twin
         && let Err(e) =
@@ -344,7 +345,7 @@ fn write_twin(
         undo(r);
         return Err(format!("the draft effect beside it cannot be written: {e}"));
     }
-    let corrected = crate::twin::corrected(f, &r.changes, out)
+    let corrected = crate::twin::corrected(f, &r.changes, out, "")
         .map_err(|e| format!("the twin cannot be corrected: {e}"))
         .and_then(|(text, diff)| {
             ratecal_recording::commit::write_nofollow(out, text.as_bytes())

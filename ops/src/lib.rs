@@ -16,6 +16,7 @@ macro_rules! errln {
 
 pub mod across;
 pub mod across_archive;
+pub mod across_twin;
 pub mod analyze;
 pub mod archive;
 pub mod certificate;

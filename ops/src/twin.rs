@@ -165,9 +165,15 @@ pub fn twin_of(st: &Station) -> Twin {
 }
 
 /// The corrected station file's text and the unified diff from the twin to it, `out` its
-/// path as given. A user effect is written by reference to its `.effect` file
-/// (`imu.user_effects`), the path relative to `out`'s folder.
-pub fn corrected(f: &TwinFile, changes: &[Change], out: &Path) -> Result<(String, String), String> {
+/// path as given, opening with the comment `header` (empty: none). A user effect is
+/// written by reference to its `.effect` file (`imu.user_effects`), the path relative to
+/// `out`'s folder.
+pub fn corrected(
+    f: &TwinFile,
+    changes: &[Change],
+    out: &Path,
+    header: &str,
+) -> Result<(String, String), String> {
     let sets: Vec<SetValue> = changes
         .iter()
         .map(|c| SetValue {
@@ -182,7 +188,7 @@ pub fn corrected(f: &TwinFile, changes: &[Change], out: &Path) -> Result<(String
             },
         })
         .collect();
-    let text = station::edit(&f.text, &sets)?;
+    let text = header.to_string() + &station::edit(&f.text, &sets)?;
     Station::from_yaml(&text, &out.display().to_string())
         .map_err(|e| format!("the corrected file does not parse: {}", e.message))?;
     let diff = similar::TextDiff::from_lines(&f.text, &text)

@@ -19,6 +19,7 @@ mod context;
 mod error;
 pub mod filters;
 mod finding;
+mod forest;
 mod plots;
 mod process;
 pub mod svg;
@@ -28,6 +29,7 @@ mod views;
 pub use context::CONTEXT_FORMAT;
 pub use error::{RenderError, TemplateError};
 pub use finding::{explain_figures, figure};
+pub use forest::{across_page, forest};
 pub use twin::{twin_figures, twin_residual_figure};
 
 use minijinja::{Environment, UndefinedBehavior, Value};

@@ -62,7 +62,8 @@ pub struct Args {
     #[arg(long)]
     allow_changed: bool,
     /// Also write each finding's before/after figure as `DIR/explain-<effect>.svg` (in a
-    /// ratecal run folder they are written beside explain.json in any case).
+    /// ratecal run folder they are written beside explain.json in any case). Across
+    /// recordings: a forest plot per pooled parameter in `DIR/explain-across.html`.
     #[arg(long, value_name = "DIR")]
     plots: Option<PathBuf>,
     /// Write each discovered finding as a draft effect file `DIR/<effect>.effect`, which
@@ -76,7 +77,9 @@ pub struct Args {
     twin: Option<PathBuf>,
     /// Write the corrected twin there (the input's layout and comments, values changed,
     /// effects added) and print the diff.
-    #[arg(long, value_name = "OUT.yaml", requires = "twin")]
+    /// Across recordings of one model (--model M, or folders of one imu.model): write the
+    /// model's twin, the --twin station file with the fleet's pooled IMU effects.
+    #[arg(long, value_name = "OUT.yaml")]
     write_twin: Option<PathBuf>,
 }
 
@@ -113,23 +116,9 @@ pub fn main(a: Args) -> ExitCode {
     }))
 }
 
-/// Several recordings: explained each, then pooled; the options of one recording's output
-/// files are refused (exit 2).
+/// Several recordings: explained each, then pooled (the options of one recording's output
+/// files are refused there, exit 2).
 fn across(a: Args, format: ratecal_ops::explain::Format) -> ExitCode {
-    let one_only = [
-        ("--plots", a.plots.is_some()),
-        ("--draft-effects", a.draft_effects.is_some()),
-        ("--twin", a.twin.is_some()),
-    ];
-    if let Some((flag, _)) = one_only.iter().find(|(_, given)| *given) {
-        let e = miette::miette!(
-            code = "explain::one_recording_only",
-            help = "explain the recording on its own for {flag}, or leave it out to pool several",
-            "{flag} applies to one recording, not to several"
-        );
-        eprintln!("{e:?}");
-        return ExitCode::from(2);
-    }
     ExitCode::from(ratecal_ops::across::explain_across(
         &ratecal_ops::across::Request {
             runs: a.runs,
@@ -148,6 +137,10 @@ fn across(a: Args, format: ratecal_ops::explain::Format) -> ExitCode {
                     include_dry_runs: a.include_dry_runs,
                 },
             ),
+            plots: a.plots,
+            twin: a.twin,
+            write_twin: a.write_twin,
+            draft_effects: a.draft_effects,
         },
     ))
 }

@@ -48,11 +48,12 @@ fn write_all(dir: &Path, fleet: Vec<Scenario>) -> Vec<PathBuf> {
         .collect()
 }
 
-/// `explain RUN... --format json`: exit code and the JSON.
-fn explain(runs: &[PathBuf]) -> (i32, Value) {
+/// `explain RUN... --format json [EXTRA...]`: exit code and the JSON.
+fn explain(runs: &[PathBuf], extra: &[&str]) -> (i32, Value) {
     let mut args = vec!["explain".to_string()];
     args.extend(runs.iter().map(|p| p.display().to_string()));
     args.extend(["--format".into(), "json".into()]);
+    args.extend(extra.iter().map(|a| a.to_string()));
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let o = ratecal(&args, Path::new(ROOT));
     let v = serde_json::from_slice(&o.stdout).unwrap_or_else(|e| panic!("{e}: {}", text(&o)));
@@ -101,8 +102,20 @@ fn the_pool_finds_a_weak_shared_k2_a_units_lever_arm_a_warm_up_and_an_outlier() 
         });
     }
     let runs = write_all(tmp.path(), fleet);
-    let (c, v) = explain(&runs);
+    // The model's twin and the forest plots are written by the same query.
+    let (plots, twin) = (tmp.path().join("plots"), tmp.path().join("model-twin.yaml"));
+    let extra = [
+        "--plots",
+        plots.to_str().unwrap(),
+        "--twin",
+        STATION,
+        "--write-twin",
+        twin.to_str().unwrap(),
+    ];
+    let (c, v) = explain(&runs, &extra);
     assert_eq!(c, 1, "a recording or the pool has a finding");
+    model_twin_holds_the_pooled_k2(&v, &twin);
+    forest_plots_name_every_recording(&v, &plots.join("explain-across.html"));
     let a = &v["across"];
     assert_eq!(a["recordings"].as_array().unwrap().len(), 15);
     // Hardly any recording of the fleet finds K2 alone (else this would not test pooling).
@@ -193,6 +206,96 @@ fn the_pool_finds_a_weak_shared_k2_a_units_lever_arm_a_warm_up_and_an_outlier() 
     assert!(k2_at < out.find("Each recording:").unwrap(), "{out}");
 }
 
+/// The station file the model's twin is written into.
+const STATION: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/drivers/stations/default.yaml");
+
+/// The model's twin written by the query: the pooled K2 (not the five-fold unit's) within
+/// 3u of the truth, u the pooled u with the spread; a station file `check` runs on.
+fn model_twin_holds_the_pooled_k2(v: &Value, path: &Path) {
+    let t = &v["twin"];
+    assert_eq!(t["written"], path.display().to_string(), "{t:#}");
+    assert_eq!(t["model"], "ratecal-witness", "{t:#}");
+    let yaml = std::fs::read_to_string(path).unwrap();
+    assert!(
+        yaml.starts_with("# The twin of model ratecal-witness"),
+        "{yaml}"
+    );
+    let st = ratecal_drivers::station::Station::from_yaml(&yaml, "model-twin.yaml")
+        .unwrap_or_else(|e| panic!("{e:?}\n{yaml}"));
+    let k2 = ratecal_physics::effect("accel_second_order").unwrap();
+    let written = st.imu.effects.values(k2);
+    for (axis, k) in ["x", "y", "z"].iter().enumerate() {
+        let e = entries(v, "accel_second_order")
+            .into_iter()
+            .find(|e| e["parameter"] == *k)
+            .unwrap_or_else(|| panic!("{v:#}"));
+        let change = (t["changes"].as_array().unwrap().iter())
+            .find(|c| c["effect"] == "accel_second_order" && c["parameter"] == *k)
+            .unwrap_or_else(|| panic!("{t:#}"));
+        let (w, u) = (written[axis], f(change, "u"));
+        println!("model twin K2 {k}: {w} ± {u} (pooled {})", f(e, "pooled"));
+        // The uncertainty written is the pooled u with the spread between units.
+        assert!(
+            (u - f(e, "u").hypot(f(e, "spread"))).abs() < 1e-9,
+            "{change:#}"
+        );
+        // The value is the pool's (to the rounding of two digits of u) ...
+        assert!((w - f(e, "pooled")).abs() <= 0.05 * u, "{w} {e:#}");
+        // ... within 3u of the truth, far from the five-fold unit's.
+        assert!((w - K2).abs() < 3.0 * u, "{w} ± {u}");
+        assert!(w < 2.5 * K2, "{w}");
+    }
+    // Only what the fleet shares: not the lever arm of one unit (the station has none).
+    assert!(!yaml.contains("lever_arm"), "{yaml}");
+    let o = ratecal(
+        &[
+            "check",
+            "procedures/imu-2d-standard",
+            "--station",
+            path.to_str().unwrap(),
+        ],
+        Path::new(ROOT),
+    );
+    assert_eq!(code(&o), 0, "{}", text(&o));
+}
+
+/// The forest plots' page: a plot per pooled entry, every recording named by run and
+/// serial in each, the pooled K2 written.
+fn forest_plots_name_every_recording(v: &Value, page: &Path) {
+    let html = std::fs::read_to_string(page).unwrap_or_else(|e| panic!("{}: {e}", page.display()));
+    let effects = v["across"]["effects"].as_array().unwrap();
+    assert_eq!(html.matches("<svg").count(), effects.len());
+    for e in effects {
+        let id = format!(
+            "<section id=\"{}.{}\">",
+            e["effect"].as_str().unwrap(),
+            e["parameter"].as_str().unwrap()
+        );
+        let section = html
+            .split(&id)
+            .nth(1)
+            .unwrap_or_else(|| panic!("{id}"))
+            .split("</section>")
+            .next()
+            .unwrap();
+        for r in e["per_recording"].as_array().unwrap() {
+            let (run, sn) = (r["run"].as_str().unwrap(), r["serial"].as_str().unwrap());
+            assert!(
+                section.contains(&format!("data-run=\"{run}\" data-serial=\"{sn}\"")),
+                "{id}: {run}"
+            );
+        }
+        if e["effect"] == "accel_second_order" {
+            // The five-fold unit: an outlier, left out.
+            assert!(section.contains("outlier (left out)"), "{section}");
+            let u = f(e, "u");
+            let d = (1 - u.log10().floor() as i32).max(0) as usize;
+            let pooled = format!("{:.d$} ± {u:.d$}", f(e, "pooled"));
+            assert!(section.contains(&pooled), "{pooled}: {section}");
+        }
+    }
+}
+
 #[test]
 fn a_fleet_with_nothing_shared_pools_nothing() {
     let tmp = tempfile::tempdir().unwrap();
@@ -200,7 +303,7 @@ fn a_fleet_with_nothing_shared_pools_nothing() {
         .map(|n| unit(&format!("NULL{n:02}"), n, 500 + n))
         .collect();
     let runs = write_all(tmp.path(), fleet);
-    let (c, v) = explain(&runs);
+    let (c, v) = explain(&runs, &[]);
     assert!(c == 0 || c == 1, "{v:#}");
     let a = &v["across"];
     let pooled: Vec<&Value> = a["effects"]
@@ -223,17 +326,105 @@ fn err_one_recording_options_with_several_are_refused() {
     let tmp = tempfile::tempdir().unwrap();
     let runs = write_all(tmp.path(), vec![unit("A", 1, 1), unit("B", 2, 2)]);
     let (a, b) = (runs[0].to_str().unwrap(), runs[1].to_str().unwrap());
-    let o = ratecal(
-        &["explain", a, b, "--plots", tmp.path().to_str().unwrap()],
-        Path::new(ROOT),
+    let dir = tmp.path().to_str().unwrap();
+    refused(
+        &["explain", a, b, "--draft-effects", dir],
+        "explain::one_recording_only",
     );
-    assert_eq!(code(&o), 2, "{}", text(&o));
-    assert!(
-        text(&o).contains("explain::one_recording_only"),
-        "{}",
-        text(&o)
+    refused(
+        &["explain", a, b, "--twin", STATION],
+        "explain::one_recording_only",
     );
     let missing = tmp.path().join("nothing-here");
     let o = ratecal(&["explain", a, missing.to_str().unwrap()], Path::new(ROOT));
     assert_eq!(code(&o), 2, "{}", text(&o));
+}
+
+/// The command exits 2 (an error, docs/explain.md) with the diagnostic `code` and its help
+/// line, and writes no model's twin.
+fn refused(args: &[&str], diagnostic: &str) {
+    let o = ratecal(args, Path::new(ROOT));
+    assert_eq!(code(&o), 2, "{args:?}: {}", text(&o));
+    assert!(text(&o).contains(diagnostic), "{args:?}: {}", text(&o));
+    assert!(text(&o).contains("help:"), "{args:?}: {}", text(&o));
+    if let Some(i) = args.iter().position(|a| *a == "--write-twin") {
+        let out = Path::new(args[i + 1]);
+        assert!(!out.exists() || out.ends_with("manifest.yaml"), "{args:?}");
+    }
+}
+
+#[test]
+fn err_a_models_twin_of_a_serial_of_several_models_or_without_a_station_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let runs = write_all(tmp.path(), vec![unit("A", 1, 1), unit("B", 2, 2)]);
+    let (a, b) = (runs[0].to_str().unwrap(), runs[1].to_str().unwrap());
+    let out = tmp.path().join("twin.yaml");
+    let out = out.to_str().unwrap();
+    let archive = tmp.path().join("archive");
+    let archive = archive.to_str().unwrap();
+    // One unit's history is no model's.
+    refused(
+        &[
+            "explain",
+            "--archive",
+            archive,
+            "--serial",
+            "A",
+            "--twin",
+            STATION,
+            "--write-twin",
+            out,
+        ],
+        "explain::model_twin_of_a_serial",
+    );
+    // No station file to write into: refused with one recording and with several.
+    refused(
+        &["explain", a, b, "--write-twin", out],
+        "explain::write_twin_needs_twin",
+    );
+    refused(
+        &["explain", a, "--write-twin", out],
+        "explain::write_twin_needs_twin",
+    );
+    // The output may not replace a run's input.
+    let manifest = runs[0].join("manifest.yaml");
+    let before = std::fs::read(&manifest).unwrap();
+    refused(
+        &[
+            "explain",
+            a,
+            b,
+            "--twin",
+            STATION,
+            "--write-twin",
+            manifest.to_str().unwrap(),
+        ],
+        "run_folder::output_is_input",
+    );
+    assert_eq!(std::fs::read(&manifest).unwrap(), before);
+    // Recordings of two models.
+    let text_b = std::fs::read_to_string(runs[1].join("manifest.yaml")).unwrap();
+    let other = text_b.replace("model: \"ratecal-witness\"", "model: \"OTHER-9\"");
+    assert_ne!(other, text_b);
+    std::fs::write(runs[1].join("manifest.yaml"), other).unwrap();
+    refused(
+        &["explain", a, b, "--twin", STATION, "--write-twin", out],
+        "explain::model_twin_of_several_models",
+    );
+    // ... and folders of another model than --model's.
+    refused(
+        &[
+            "explain",
+            a,
+            "--archive",
+            archive,
+            "--model",
+            "OTHER-9",
+            "--twin",
+            STATION,
+            "--write-twin",
+            out,
+        ],
+        "explain::model_twin_of_several_models",
+    );
 }

@@ -156,6 +156,7 @@ fn the_archive_pools_as_the_folders_do_and_keeps_each_explanation() {
     let from_sqlite = cold_and_warm(sqlite.to_str().unwrap(), &folders, || {
         std::fs::remove_dir_all(&store).unwrap();
     });
+    model_twin_from_the_archive(sqlite.to_str().unwrap(), tmp.path(), &from_sqlite);
     let Some(pg) = Cluster::start() else {
         println!("skipped: postgresql not installed");
         return;
@@ -165,6 +166,58 @@ fn the_archive_pools_as_the_folders_do_and_keeps_each_explanation() {
     let from_pg = cold_and_warm(&url, &folders, || {});
     // The same runs (content addresses), the same pool.
     same(&pool(&from_pg), &pool(&from_sqlite));
+}
+
+/// `--model M --twin STATION --write-twin OUT` from the archive (every explanation kept:
+/// pooling only) writes every `model`/`pooled_only` entry of the pool `pool_v`, and
+/// nothing else, into a station file that parses.
+fn model_twin_from_the_archive(loc: &str, tmp: &Path, pool_v: &Value) {
+    let out = tmp.join("model-twin.yaml");
+    let station = format!("{ROOT}/drivers/stations/default.yaml");
+    let (v, err) = explain(&[
+        "--archive",
+        loc,
+        "--model",
+        "ratecal-witness",
+        "--twin",
+        &station,
+        "--write-twin",
+        out.to_str().unwrap(),
+    ]);
+    assert!(err.contains("0 to explain"), "{err}");
+    let shared: Vec<(&str, &str, f64)> = (pool_v["across"]["effects"].as_array().unwrap().iter())
+        .filter(|e| e["verdict"] == "model" || e["verdict"] == "pooled_only")
+        .map(|e| {
+            let p = e["pooled"].as_f64().unwrap();
+            (
+                e["effect"].as_str().unwrap(),
+                e["parameter"].as_str().unwrap(),
+                p,
+            )
+        })
+        .collect();
+    assert!(!shared.is_empty(), "{:#}", pool_v["across"]);
+    let changes = v["twin"]["changes"].as_array().unwrap();
+    assert_eq!(changes.len(), shared.len(), "{:#}", v["twin"]);
+    for (c, (effect, parameter, pooled)) in changes.iter().zip(&shared) {
+        assert_eq!(
+            (c["effect"].as_str(), c["parameter"].as_str()),
+            (Some(*effect), Some(*parameter))
+        );
+        assert!((c["to"].as_f64().unwrap() - pooled).abs() < 1e-9, "{c:#}");
+    }
+    let yaml = std::fs::read_to_string(&out).unwrap();
+    let st = ratecal_drivers::station::Station::from_yaml(&yaml, "model-twin.yaml")
+        .unwrap_or_else(|e| panic!("{e:?}\n{yaml}"));
+    let k2 = ratecal_physics::effect("accel_second_order").unwrap();
+    assert!(
+        st.imu
+            .effects
+            .values(k2)
+            .iter()
+            .all(|k| (*k - 60.0).abs() < 30.0),
+        "{yaml}"
+    );
 }
 
 #[test]

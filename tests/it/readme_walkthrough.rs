@@ -107,7 +107,7 @@ fn exits(comment: &str) -> Vec<i32> {
         return vec![0];
     };
     let codes: Vec<i32> = rest
-        .split(|c: char| c == ':' || c == '(')
+        .split([':', '('])
         .next()
         .unwrap_or("")
         .split(|c: char| !c.is_ascii_digit())
