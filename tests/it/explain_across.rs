@@ -5,7 +5,7 @@
 //! nothing shared pools nothing.
 
 use crate::support;
-use ratecal_witness::{Hidden, Plan, Scenario, write};
+use ratecal_witness::{Hidden, Scenario, write};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use support::{code, ratecal, text};
@@ -16,17 +16,9 @@ const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 /// short recording (explain's threshold is above four).
 const K2: f64 = 16.0;
 
-/// A short standard-shaped recording of unit `serial`, its biases and scales its own
-/// (drawn from the serial's number), the noise from `seed`.
+/// A short standard-shaped recording of unit `serial` ([`Scenario::fleet_unit`]).
 fn unit(serial: &str, n: u64, seed: u64) -> Scenario {
-    let mut s = Scenario::standard(serial, seed);
-    s.plan = Plan::standard(60.0);
-    let r = |k: u64| (((n * 7 + k) * 2_654_435_761) % 1000) as f64 / 1000.0 - 0.5;
-    s.imu.accel_bias_mps2 = [0.04 * r(1), 0.04 * r(2), 0.04 * r(3)];
-    s.imu.accel_scale_ppm = [2000.0 * r(4), 2000.0 * r(5), 2000.0 * r(6)];
-    s.imu.gyro_bias_dps = [0.1 * r(7), 0.1 * r(8), 0.1 * r(9)];
-    s.imu.gyro_scale_ppm = [3000.0 * r(10), 3000.0 * r(11), 3000.0 * r(12)];
-    s
+    Scenario::fleet_unit(serial, n, seed, 60.0)
 }
 
 fn k2(k: f64) -> Hidden {

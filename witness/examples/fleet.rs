@@ -9,7 +9,7 @@
 //!
 //! Then: `ratecal explain OUT_DIR/*/ --format json`.
 
-use ratecal_witness::{Hidden, Plan, Scenario, write};
+use ratecal_witness::{Hidden, Scenario, write};
 use std::path::PathBuf;
 
 /// The options.
@@ -54,17 +54,9 @@ fn args() -> Args {
     a
 }
 
-/// Unit `n`'s recording: its biases and scales drawn from its number (the same in every
-/// recording of it), the noise from `seed`.
+/// Unit `n` of the fleet ([`Scenario::fleet_unit`]), the noise from `seed`.
 fn unit(n: u64, seed: u64, a: &Args) -> Scenario {
-    let mut s = Scenario::standard(&format!("SN{n:03}"), seed);
-    s.plan = Plan::standard(a.gyro_bias_s);
-    let r = |k: u64| (((n * 7 + k) * 2_654_435_761) % 1000) as f64 / 1000.0 - 0.5;
-    s.imu.accel_bias_mps2 = [0.04 * r(1), 0.04 * r(2), 0.04 * r(3)];
-    s.imu.accel_scale_ppm = [2000.0 * r(4), 2000.0 * r(5), 2000.0 * r(6)];
-    s.imu.gyro_bias_dps = [0.1 * r(7), 0.1 * r(8), 0.1 * r(9)];
-    s.imu.gyro_scale_ppm = [3000.0 * r(10), 3000.0 * r(11), 3000.0 * r(12)];
-    s
+    Scenario::fleet_unit(&format!("SN{n:03}"), n, seed, a.gyro_bias_s)
 }
 
 fn k2(k: f64) -> Hidden {

@@ -73,6 +73,21 @@ impl Scenario {
         }
     }
 
+    /// Unit number `n` of a fleet of one model: [`Scenario::standard`] named `serial` with
+    /// a `gyro_bias_s` gyro-bias block, its biases and scale factors its own (drawn from
+    /// `n`, within a tactical unit's spread: 20 mm/s^2, 1000 ppm, 0.05 deg/s, 1500 ppm), the
+    /// noise from `seed`.
+    pub fn fleet_unit(serial: &str, n: u64, seed: u64, gyro_bias_s: f64) -> Scenario {
+        let mut s = Scenario::standard(serial, seed);
+        s.plan = Plan::standard(gyro_bias_s);
+        let r = |k: u64| (((n * 7 + k) * 2_654_435_761) % 1000) as f64 / 1000.0 - 0.5;
+        s.imu.accel_bias_mps2 = [0.04 * r(1), 0.04 * r(2), 0.04 * r(3)];
+        s.imu.accel_scale_ppm = [2000.0 * r(4), 2000.0 * r(5), 2000.0 * r(6)];
+        s.imu.gyro_bias_dps = [0.1 * r(7), 0.1 * r(8), 0.1 * r(9)];
+        s.imu.gyro_scale_ppm = [3000.0 * r(10), 3000.0 * r(11), 3000.0 * r(12)];
+        s
+    }
+
     /// Adds a hidden effect.
     pub fn with(mut self, hidden: Hidden) -> Scenario {
         self.hidden.push(hidden);
