@@ -212,11 +212,14 @@ fn column_norm(x0: f64, x: &[f64]) -> Option<f64> {
     (norm >= f64::MIN_POSITIVE || norm.is_nan()).then_some(norm)
 }
 
-/// `a . b` in four running sums, which the compiler keeps in vector registers (one
-/// running sum is a chain of dependent additions).
+/// `a . b` in sixteen running sums: one running sum is a chain of dependent additions, and
+/// the baseline x86-64 target has two doubles to a vector register, so it takes eight
+/// independent chains to keep the adder busy while each addition's latency passes (the
+/// dot products of the reflections are most of a fold).
 fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut s = [0.0f64; 4];
-    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    const L: usize = 16;
+    let mut s = [0.0f64; L];
+    let (ca, cb) = (a.chunks_exact(L), b.chunks_exact(L));
     let tail: f64 = ca
         .remainder()
         .iter()
@@ -228,7 +231,14 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
             *s += x * y;
         }
     }
-    (s[0] + s[1]) + (s[2] + s[3]) + tail
+    let mut w = L;
+    while w > 1 {
+        w /= 2;
+        for i in 0..w {
+            s[i] += s[i + w];
+        }
+    }
+    s[0] + tail
 }
 
 /// The `cols x cols` upper-triangular factor of a stack of rows: the rows folded into a
