@@ -233,7 +233,7 @@ fn changes(
             continue;
         };
         let from = twin.values(&e.effect).and_then(|v| v.get(k)).copied();
-        let u = e.u.hypot(e.spread);
+        let u = e.fleet_u();
         out.push(Change {
             effect: e.effect.clone(),
             parameter: e.parameter.clone(),
@@ -252,12 +252,7 @@ fn changes(
 /// The comment the model's twin opens with: where its values come from, each with its
 /// uncertainty (a station file states values only).
 fn header(a: &Across, model: &str, changes: &[Change]) -> String {
-    let units = {
-        let mut v: Vec<&str> = a.recordings.iter().map(|r| r.serial.as_str()).collect();
-        v.sort_unstable();
-        v.dedup();
-        v.len()
-    };
+    let units = a.units();
     let mut s = format!(
         "# The twin of model {model}: `ratecal explain` pooled {} recordings of {units} units.\n\
          # IMU effects shared by the fleet (verdict model or pooled_only), each as\n\

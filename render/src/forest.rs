@@ -26,12 +26,7 @@ const RED: &str = PALETTE[1];
 pub fn across_page(a: &Across) -> String {
     let mut s =
         String::from("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n");
-    let units = {
-        let mut v: Vec<&str> = a.recordings.iter().map(|r| r.serial.as_str()).collect();
-        v.sort_unstable();
-        v.dedup();
-        v.len()
-    };
+    let units = a.units();
     let title = format!("Across {} recordings of {units} units", a.recordings.len());
     let _ = write!(
         s,
@@ -89,12 +84,10 @@ fn decimals(u: f64) -> Option<usize> {
     (u > 0.0 && u.is_finite()).then(|| (1 - u.log10().floor() as i32).clamp(0, 12) as usize)
 }
 
-/// A value and its uncertainty, the value to two significant digits of the uncertainty.
+/// A value and its uncertainty as every output writes them (GUM 7.2.6:
+/// `ratecal_analysis::measured`).
 fn pm(v: f64, u: f64) -> String {
-    match decimals(u) {
-        Some(d) => format!("{v:.d$} ± {u:.d$}"),
-        None => format!("{} ± {}", num(v), num(u)),
-    }
+    ratecal_analysis::measured::measured_number(v, u)
 }
 
 /// The spread, to the decimals of the pooled value.
@@ -115,16 +108,11 @@ fn clip(label: &str) -> String {
     }
 }
 
-/// The fleet's band: the pooled value's u and the spread between units together.
-fn fleet_u(e: &PooledOut) -> f64 {
-    e.u.hypot(e.spread)
-}
-
 /// One parameter's forest plot as an `<svg>` element.
 pub fn forest(e: &PooledOut, outliers: &[Outlier]) -> String {
     let rows = &e.per_recording;
     let pw = W - LABELS - VALUES;
-    let bands = [e.pooled - fleet_u(e), e.pooled + fleet_u(e)];
+    let bands = [e.pooled - e.fleet_u(), e.pooled + e.fleet_u()];
     let ends = rows
         .iter()
         .flat_map(|r| [r.value - r.u, r.value + r.u])

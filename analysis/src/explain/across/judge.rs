@@ -275,7 +275,7 @@ fn rank(verdict: &str) -> usize {
 }
 
 /// The distinct values, in order of first appearance.
-fn distinct<'a>(it: impl Iterator<Item = &'a str>) -> Vec<&'a str> {
+pub(super) fn distinct<'a>(it: impl Iterator<Item = &'a str>) -> Vec<&'a str> {
     let mut out: Vec<&str> = Vec::new();
     for s in it {
         if !out.contains(&s) {

@@ -102,7 +102,21 @@ pub struct Outlier {
     pub u: f64,
 }
 
+impl PooledOut {
+    /// Where a unit of the fleet is expected to lie about the pooled value: its standard
+    /// uncertainty and the spread between units together, `sqrt(u^2 + spread^2)` (what the
+    /// forest plot's wide band shows and the model's twin writes as u).
+    pub fn fleet_u(&self) -> f64 {
+        self.u.hypot(self.spread)
+    }
+}
+
 impl Across {
+    /// How many units (distinct serials) the pooled recordings are of.
+    pub fn units(&self) -> usize {
+        judge::distinct(self.recordings.iter().map(|r| r.serial.as_str())).len()
+    }
+
     /// Whether the pool has a finding: any verdict but `none`.
     pub fn has_finding(&self) -> bool {
         self.effects.iter().any(|e| e.verdict != "none")

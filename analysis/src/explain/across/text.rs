@@ -25,12 +25,7 @@ const HEADINGS: [(&str, &str); 4] = [
 /// The text output of explain across recordings.
 pub fn render_text(a: &Across) -> String {
     let mut s = String::new();
-    let serials = {
-        let mut v: Vec<&str> = a.recordings.iter().map(|r| r.serial.as_str()).collect();
-        v.sort_unstable();
-        v.dedup();
-        v.len()
-    };
+    let serials = a.units();
     let _ = writeln!(
         s,
         "Across {} recordings of {serials} units:",
