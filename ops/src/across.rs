@@ -173,42 +173,23 @@ pub struct Context {
     pub plan: Option<ratecal_analysis::plan::Plan>,
 }
 
-/// Explains every (name, folder) in parallel (a worker per core, each taking the next
-/// recording), in the order given; the first error is said and ends the command (exit 2).
+/// Explains every (name, folder) in parallel (rayon's pool, which each explanation's own
+/// passes share), in the order given; the first error in that order is said and ends the
+/// command (exit 2).
 pub fn explain_all(jobs: &[(String, PathBuf)], cx: &Context) -> Result<Vec<Explained>, Exit> {
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let slots: Vec<std::sync::Mutex<Option<Result<Explained, String>>>> =
-        jobs.iter().map(|_| std::sync::Mutex::new(None)).collect();
-    let workers = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .min(jobs.len())
-        .max(1);
-    std::thread::scope(|s| {
-        for _ in 0..workers {
-            s.spawn(|| {
-                loop {
-                    let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                    let Some((name, dir)) = jobs.get(i) else {
-                        break;
-                    };
-                    let r = explain_one(name, dir, cx);
-                    *slots[i].lock().expect("not poisoned") = Some(r);
-                }
-            });
-        }
-    });
-    let mut out = Vec::new();
-    for slot in slots {
-        match slot.into_inner().expect("not poisoned") {
-            Some(Ok(x)) => out.push(x),
-            Some(Err(e)) => {
+    use rayon::prelude::*;
+    let done: Vec<Result<Explained, String>> = jobs
+        .par_iter()
+        .map(|(name, dir)| explain_one(name, dir, cx))
+        .collect();
+    done.into_iter()
+        .map(|r| {
+            r.map_err(|e| {
                 errln!("{e}");
-                return Err(2);
-            }
-            None => return Err(2),
-        }
-    }
-    Ok(out)
+                2
+            })
+        })
+        .collect()
 }
 
 /// One recording explained with its profile.
