@@ -161,12 +161,19 @@ fn parse(body: &str) -> Option<Explained> {
 }
 
 /// The analysis a kept explanation is valid for: the ratecal version, and the options
-/// that change the result (the procedure's name, version and text hash, the user effects'
-/// files and texts, the effects left out).
+/// that change the result (the procedure's name, version and resolved content, so that a
+/// text changed under one version with `--allow-changed` is explained again; the user
+/// effects' files and texts, the effects left out).
 pub fn key(cx: &Context, effects: &[(String, String)]) -> String {
     let mut s = format!("ratecal {}\n", env!("CARGO_PKG_VERSION"));
     if let Some(p) = &cx.plan {
-        s.push_str(&format!("procedure {} {}\n", p.name, p.version));
+        let content = serde_json::to_string(p).unwrap_or_default();
+        s.push_str(&format!(
+            "procedure {} {} {}\n",
+            p.name,
+            p.version,
+            ratecal_folder::hashes::sha256_hex(content.as_bytes())
+        ));
     }
     for (file, text) in effects {
         s.push_str(&format!("effect {file}\n{text}\n"));
