@@ -441,11 +441,16 @@ fn adopt_of(findings: &[Finding]) -> Option<String> {
     adopt_ids(findings, &[])
 }
 
+/// A finding a procedure declares by name (`with ...`): a registry effect, neither a user
+/// file's nor discovered, that the run's procedure does not hold (`held`) already.
+pub(crate) fn declarable(f: &Finding, held: &[String]) -> bool {
+    f.defined_in.is_none() && !f.discovered && !held.contains(&f.effect)
+}
+
 fn adopt_ids(findings: &[Finding], held: &[String]) -> Option<String> {
     let ids: Vec<&str> = findings
         .iter()
-        .filter(|f| f.defined_in.is_none() && !f.discovered && !held.contains(&f.effect))
-        .filter(|f| beyond_zero(f))
+        .filter(|f| declarable(f, held) && beyond_zero(f))
         .map(|f| f.effect.as_str())
         .collect();
     (!ids.is_empty()).then(|| format!("with {}", ids.join(", ")))

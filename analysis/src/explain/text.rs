@@ -178,8 +178,7 @@ pub fn render_text(x: &Explanation) -> String {
         );
     }
     let faint: Vec<&str> = (x.findings.iter())
-        .filter(|f| f.defined_in.is_none() && !f.discovered && !super::beyond_zero(f))
-        .filter(|f| !x.already_held.contains(&f.effect))
+        .filter(|f| super::declarable(f, &x.already_held) && !super::beyond_zero(f))
         .map(|f| f.effect.as_str())
         .collect();
     if !faint.is_empty() {
