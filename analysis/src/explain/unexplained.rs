@@ -135,7 +135,15 @@ pub(crate) fn leftover(
                 ));
             }
         }
-        forms.sort_by(|a, b| b.0.total_cmp(&a.0).then(b.1.total_cmp(&a.1)));
+        // Largest share first, then the strongest test; forms that tie (on six faces f^2
+        // and |f| are one column) in the channel's and the expression's order, not in the
+        // order their last bits of rounding happen to give.
+        forms.sort_by(|a, b| {
+            (sig9(b.0).total_cmp(&sig9(a.0)))
+                .then(sig9(b.1).total_cmp(&sig9(a.1)))
+                .then_with(|| a.2.channel.cmp(&b.2.channel))
+                .then_with(|| a.2.expression.cmp(&b.2.expression))
+        });
         forms.truncate(MOST_FORMS);
         // Where it shows: the segments whose residual the strongest test's probe removes
         // most, in units of the channel's noise.
@@ -170,4 +178,29 @@ pub(crate) fn leftover(
         });
     }
     out
+}
+
+/// `x` to nine significant digits: what a sort compares where values equal but for their
+/// rounding must tie.
+fn sig9(x: f64) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    let scale = 10f64.powi(8 - x.abs().log10().floor() as i32);
+    (x * scale).round() / scale
+}
+
+#[cfg(test)]
+mod tests {
+    use super::sig9;
+
+    #[test]
+    fn values_equal_but_for_rounding_tie_and_others_keep_their_order() {
+        let a = 1089.123456789;
+        assert_eq!(sig9(a), sig9(a * (1.0 + 4e-16)));
+        assert_eq!(sig9(1.0), sig9(1.0 - 1e-15));
+        assert!(sig9(1089.1235) > sig9(1089.1234));
+        assert!(sig9(-2.5e-7) < sig9(-2.4e-7));
+        assert_eq!(sig9(0.0), 0.0);
+    }
 }
