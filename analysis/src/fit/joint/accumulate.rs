@@ -2,6 +2,7 @@
 //! regressors from the kinematic signals at each stamp, and per output channel the
 //! triangular factor of `[X y]` plus one-second block sums.
 
+use super::rest::{Positions, Rest, stack};
 use super::tri::Tri;
 use super::{Layout, channel};
 use nalgebra::{DMatrix, DVector};
@@ -94,11 +95,7 @@ impl SegAcc {
     pub(crate) fn merge(&mut self, later: SegAcc) {
         self.blocks_changed();
         for (c, r) in later.r.into_iter().enumerate() {
-            let w = r.ncols();
-            let mut m = DMatrix::zeros(self.r[c].nrows() + r.nrows(), w);
-            m.view_mut((0, 0), self.r[c].shape()).copy_from(&self.r[c]);
-            m.view_mut((self.r[c].nrows(), 0), r.shape()).copy_from(&r);
-            self.r[c] = super::tri::triangle(m, w);
+            self.r[c] = stack(&self.r[c], &r);
         }
         self.blocks.extend(later.blocks);
         self.n += later.n;
@@ -133,6 +130,10 @@ pub(crate) struct Accumulator<'l> {
     resting: [Vec<usize>; 6],
     /// Samples since the resting columns' values were last added to the block sums.
     pending: usize,
+    /// Per sensor, the rows at rest folded once for its three channels ([`Rest`]).
+    rest: [Rest; 2],
+    /// Samples folded.
+    n: usize,
 }
 
 impl<'l> Accumulator<'l> {
@@ -169,6 +170,8 @@ impl<'l> Accumulator<'l> {
             resting: std::array::from_fn(|c| positions(c, false)),
             varying,
             pending: 0,
+            rest: Default::default(),
+            n: 0,
         }
     }
 
@@ -249,8 +252,6 @@ impl<'l> Accumulator<'l> {
             self.write_row(c, !at_rest);
             let last = self.rows[c].len() - 1;
             self.rows[c][last] = out[c];
-            let changed = at_rest.then_some(self.moving[c].as_slice());
-            self.tris[c].push_changed(&self.rows[c], changed);
             let (row, sx) = (&self.rows[c], &mut self.cur.sx[c]);
             if at_rest {
                 for &k in &self.moving[c][..self.moving[c].len() - 1] {
@@ -263,10 +264,31 @@ impl<'l> Accumulator<'l> {
             }
             self.cur.sy[c] += out[c];
         }
+        for s in 0..2 {
+            let ch = 3 * s..3 * s + 3;
+            let at = Positions {
+                moving: &self.moving[ch.clone()],
+                resting: &self.resting[ch.clone()],
+            };
+            let shared = match at_rest {
+                true => self.rest[s].take(&self.rows[ch.clone()], &at),
+                false => {
+                    self.rest[s].interrupt(&at);
+                    false
+                }
+            };
+            if !shared {
+                for c in ch {
+                    let changed = at_rest.then_some(self.moving[c].as_slice());
+                    self.tris[c].push_changed(&self.rows[c], changed);
+                }
+            }
+        }
         // The resting columns were added whole for a sample that changed the motion.
         self.pending += usize::from(at_rest);
         self.cur.t += t;
         self.cur.n += 1;
+        self.n += 1;
     }
 
     /// The segment's contribution.
@@ -276,13 +298,26 @@ impl<'l> Accumulator<'l> {
             self.cur.t /= self.cur.n as f64;
             self.blocks.push(self.cur);
         }
-        let n = self.tris[0].n;
-        let mut it = self.tris.into_iter().map(Tri::finish);
+        for s in 0..2 {
+            let ch = 3 * s..3 * s + 3;
+            self.rest[s].interrupt(&Positions {
+                moving: &self.moving[ch.clone()],
+                resting: &self.resting[ch],
+            });
+        }
+        let rest = &self.rest;
+        let mut it = self.tris.into_iter().enumerate().map(|(c, t)| {
+            let r = t.finish();
+            match rest[c / 3].factor(c % 3) {
+                Some(f) => stack(&r, f),
+                None => r,
+            }
+        });
         SegAcc {
             seg: self.seg,
             r: std::array::from_fn(|_| it.next().expect("six channels")),
             blocks: self.blocks,
-            n,
+            n: self.n,
             columns: Default::default(),
         }
     }

@@ -9,6 +9,7 @@
 
 mod accumulate;
 mod noise;
+mod rest;
 mod solve;
 mod terms;
 mod tri;
