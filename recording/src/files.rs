@@ -25,8 +25,19 @@ pub enum FileState {
 
 /// Streaming SHA-256 and size of a regular file (a symlink is followed); refuses anything
 /// else without opening it.
+///
+/// A large file hashed once by this process is not hashed again while its identity, size,
+/// modification and status-change times are the ones it was hashed with (`digests`): a
+/// command that checks a folder's seal before its work and again before it writes reads a
+/// recording once. No write to a file leaves its status-change time as it was; a file
+/// changed in the last seconds is not kept, as the clock that stamps it is coarse (a later
+/// write in the same tick would leave the times as they were).
 pub fn sha256_file(path: &Path) -> io::Result<(String, u64)> {
     regular(path)?;
+    let before = digests::stamp(path);
+    if let Some(hit) = before.as_ref().and_then(digests::get) {
+        return Ok(hit);
+    }
     let mut f = std::fs::File::open(path)?;
     let mut hasher = Sha256::new();
     let mut buf = vec![0u8; 256 * 1024];
@@ -41,7 +52,76 @@ pub fn sha256_file(path: &Path) -> io::Result<(String, u64)> {
         hasher.update(&buf[..n]);
         size += n as u64;
     }
-    Ok((hex::encode(hasher.finalize()), size))
+    let out = (hex::encode(hasher.finalize()), size);
+    if let Some(b) = before
+        && digests::stamp(path).as_ref() == Some(&b)
+        && b.len == size
+    {
+        digests::put(b, &out);
+    }
+    Ok(out)
+}
+
+/// The digests of large files this process has hashed, by what identifies their content.
+mod digests {
+    use std::path::Path;
+    use std::sync::Mutex;
+
+    /// Files smaller than this are hashed every time (a cache would save nothing).
+    const LARGE: u64 = 1 << 20;
+    /// Digests kept at most.
+    const KEPT: usize = 16;
+
+    /// What a file's content is known by: device, inode, size, modification and
+    /// status-change times (ns).
+    #[derive(Debug, Clone, PartialEq)]
+    pub(super) struct Stamp {
+        id: (u64, u64),
+        pub len: u64,
+        times: (i64, i64, i64, i64),
+    }
+
+    static KNOWN: Mutex<Vec<(Stamp, (String, u64))>> = Mutex::new(Vec::new());
+
+    #[cfg(unix)]
+    pub(super) fn stamp(path: &Path) -> Option<Stamp> {
+        use std::os::unix::fs::MetadataExt;
+        let m = std::fs::metadata(path).ok()?;
+        (m.len() >= LARGE).then(|| Stamp {
+            id: (m.dev(), m.ino()),
+            len: m.len(),
+            times: (m.mtime(), m.mtime_nsec(), m.ctime(), m.ctime_nsec()),
+        })
+    }
+
+    #[cfg(not(unix))]
+    pub(super) fn stamp(_: &Path) -> Option<Stamp> {
+        None
+    }
+
+    pub(super) fn get(s: &Stamp) -> Option<(String, u64)> {
+        let known = KNOWN.lock().ok()?;
+        known.iter().find(|k| &k.0 == s).map(|k| k.1.clone())
+    }
+
+    /// Seconds since a file last changed for its digest to be kept.
+    const SETTLED_S: i64 = 2;
+
+    pub(super) fn put(s: Stamp, d: &(String, u64)) {
+        let now = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_secs() as i64);
+        if s.times.0.max(s.times.2) > now - SETTLED_S {
+            return;
+        }
+        if let Ok(mut known) = KNOWN.lock() {
+            known.retain(|k| k.0.id != s.id);
+            if known.len() >= KEPT {
+                known.remove(0);
+            }
+            known.push((s, d.clone()));
+        }
+    }
 }
 
 /// `Ok` when `path` is (or a symlink leads to) a regular file; otherwise an error saying
@@ -199,6 +279,32 @@ fn kind_of(m: &std::fs::Metadata) -> &'static str {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A settled large file's digest is kept, and a write of the same length (the times
+    /// change) is hashed again.
+    #[cfg(unix)]
+    #[test]
+    fn a_kept_digest_is_dropped_when_the_file_changes() {
+        let tmp = tempfile::tempdir().unwrap();
+        let p = tmp.path().join("imu.csv");
+        let (a, b) = (vec![7u8; 2 << 20], vec![8u8; 2 << 20]);
+        std::fs::write(&p, &a).unwrap();
+        let fresh = sha256_file(&p).unwrap();
+        assert_eq!(fresh.0, crate::sha256_hex(&a));
+        assert!(
+            digests::get(&digests::stamp(&p).unwrap()).is_none(),
+            "just written"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(2100));
+        assert_eq!(sha256_file(&p).unwrap(), fresh);
+        assert_eq!(
+            digests::get(&digests::stamp(&p).unwrap()),
+            Some(fresh.clone())
+        );
+        std::fs::write(&p, &b).unwrap();
+        let (sha, n) = sha256_file(&p).unwrap();
+        assert_eq!((sha, n), (crate::sha256_hex(&b), 2 << 20));
+    }
 
     #[test]
     fn hashes_stream_and_follow_symlinks() {

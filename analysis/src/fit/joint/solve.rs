@@ -108,27 +108,20 @@ pub(crate) fn solve(req: &FitRequest) -> Fit {
     for &(g, v) in &req.fixed {
         theta[g] = v;
     }
-    // Per channel: the factor over the fitted segments, observations net of fixed terms.
-    let facs: Vec<DMatrix<f64>> = (0..6)
-        .map(|c| {
-            let w = lay.by_channel[c].len() + 1;
-            let mut f = match req.merged {
-                Some(m) => m[c].clone(),
-                None => merged(req.segs(c), c, w),
-            };
-            for (k, &g) in lay.by_channel[c].iter().enumerate() {
-                if theta[g] != 0.0 {
-                    let col = f.column(k) * theta[g];
-                    let mut y = f.column_mut(w - 1);
-                    y -= col;
-                }
-            }
-            f
-        })
-        .collect();
     let n: [usize; 6] = std::array::from_fn(|c| req.segs(c).iter().map(|s| s.n).sum());
     let mut cols: Vec<usize> = req.cols.clone();
     cols.retain(|g| !req.fixed.iter().any(|f| f.0 == *g));
+    // Per channel: the factor over the fitted segments, reduced to the model's columns and
+    // the observations net of fixed terms.
+    let facs: Vec<Reduced> = (0..6)
+        .map(|c| {
+            let w = lay.by_channel[c].len() + 1;
+            match req.merged {
+                Some(m) => Reduced::of(&m[c], lay, c, &cols, &theta),
+                None => Reduced::of(&merged(req.segs(c), c, w), lay, c, &cols, &theta),
+            }
+        })
+        .collect();
     let mut unobservable = Vec::new();
     // Weights: equal first, then 1 / sigma^2 from the first solution.
     let mut w = [1.0f64; 6];
@@ -136,7 +129,7 @@ pub(crate) fn solve(req: &FitRequest) -> Fit {
     let mut rss = [0.0; 6];
     let mut bread = DMatrix::zeros(0, 0);
     for pass in 0..2 {
-        let stack = |cols: &[usize]| stacked(&facs, lay, cols, &w);
+        let stack = |cols: &[usize]| stacked(&facs, cols, &w);
         let mut r = stack(&cols);
         let dropped = rank_deficient(&r, cols.len());
         if !dropped.is_empty() {
@@ -160,19 +153,17 @@ pub(crate) fn solve(req: &FitRequest) -> Fit {
             full[g] = est[l];
         }
         for c in 0..6 {
-            let k = lay.by_channel[c].len();
+            let f = &facs[c];
+            let k = f.cols.len();
             let mut v = DVector::zeros(k + 1);
-            for (i, &g) in lay.by_channel[c].iter().enumerate() {
-                if cols.contains(&g) {
-                    v[i] = full[g];
+            for (i, g) in f.cols.iter().enumerate() {
+                if cols.contains(g) {
+                    v[i] = full[*g];
                 }
             }
             v[k] = -1.0;
-            rss[c] = (&facs[c] * v).norm_squared();
-            let pc = lay.by_channel[c]
-                .iter()
-                .filter(|g| cols.contains(g))
-                .count();
+            rss[c] = (&f.r * v).norm_squared();
+            let pc = f.cols.iter().filter(|g| cols.contains(g)).count();
             let dof = n[c].saturating_sub(pc).max(1) as f64;
             let sigma = (rss[c] / dof).sqrt();
             // The first pass only weighs the channels: their noise is the second's.
@@ -212,12 +203,11 @@ pub(crate) fn solve(req: &FitRequest) -> Fit {
             .iter()
             .map(|g| cols.iter().position(|x| x == g))
             .collect();
-        let k = local.len();
-        let xr = facs[c].view((0, 0), (k + 1, k)).clone_owned();
-        let mut xl = DMatrix::zeros(k + 1, p);
-        for (i, l) in local.iter().enumerate() {
-            if let Some(l) = l {
-                xl.set_column(*l, &xr.column(i));
+        let f = &facs[c];
+        let mut xl = DMatrix::zeros(f.r.nrows(), p);
+        for (i, g) in f.cols.iter().enumerate() {
+            if let Some(l) = cols.iter().position(|x| x == g) {
+                xl.set_column(l, &f.r.column(i));
             }
         }
         let nz = &noise[c];
@@ -245,27 +235,59 @@ pub(crate) fn solve(req: &FitRequest) -> Fit {
     }
 }
 
+/// One channel's factor over the fitted segments reduced to the model's columns (`cols`,
+/// global, in the channel's order) and the observation net of the fixed terms, last: the
+/// factor of those columns of the rows, so a model of a few columns is solved from a few
+/// rows per channel, not from the layout's width.
+struct Reduced {
+    r: DMatrix<f64>,
+    cols: Vec<usize>,
+}
+
+impl Reduced {
+    fn of(f: &DMatrix<f64>, lay: &Layout, c: usize, model: &[usize], theta: &DVector<f64>) -> Self {
+        let by = &lay.by_channel[c];
+        let k = by.len();
+        let keep: Vec<usize> = (0..k).filter(|&i| model.contains(&by[i])).collect();
+        let mut m = DMatrix::zeros(f.nrows(), keep.len() + 1);
+        for (j, &i) in keep.iter().enumerate() {
+            m.set_column(j, &f.column(i));
+        }
+        let mut y = f.column(k).into_owned();
+        for (i, &g) in by.iter().enumerate() {
+            if theta[g] != 0.0 {
+                y -= f.column(i) * theta[g];
+            }
+        }
+        m.set_column(keep.len(), &y);
+        Reduced {
+            r: triangle(m, keep.len() + 1),
+            cols: keep.into_iter().map(|i| by[i]).collect(),
+        }
+    }
+}
+
 /// The weighted stack of every channel's factor over `cols`, triangulated.
-fn stacked(facs: &[DMatrix<f64>], lay: &Layout, cols: &[usize], w: &[f64; 6]) -> DMatrix<f64> {
+fn stacked(facs: &[Reduced], cols: &[usize], w: &[f64; 6]) -> DMatrix<f64> {
     let p = cols.len();
-    let rows: usize = facs.iter().map(|f| f.nrows()).sum();
+    let rows: usize = facs.iter().map(|f| f.r.nrows()).sum();
     let mut m = DMatrix::zeros(rows.max(p + 1), p + 1);
     let mut at = 0;
     for c in 0..6 {
         let f = &facs[c];
-        let k = lay.by_channel[c].len();
+        let k = f.cols.len();
         let s = w[c].sqrt();
-        for (i, g) in lay.by_channel[c].iter().enumerate() {
+        for (i, g) in f.cols.iter().enumerate() {
             if let Some(l) = cols.iter().position(|x| x == g) {
-                for r in 0..f.nrows() {
-                    m[(at + r, l)] = f[(r, i)] * s;
+                for r in 0..f.r.nrows() {
+                    m[(at + r, l)] = f.r[(r, i)] * s;
                 }
             }
         }
-        for r in 0..f.nrows() {
-            m[(at + r, p)] = f[(r, k)] * s;
+        for r in 0..f.r.nrows() {
+            m[(at + r, p)] = f.r[(r, k)] * s;
         }
-        at += f.nrows();
+        at += f.r.nrows();
     }
     triangle(m, p + 1)
 }
