@@ -135,30 +135,30 @@ fn explain_or_exit(args: &Request) -> Result<u8, Exit> {
         return Err(2);
     }
     // A folder whose seal fails (or a run never sealed) is not explained, and its seal
-    // gains nothing (exit 4, as `report`).
-    if let Err(e) = ratecal_folder::verify::require_intact(&args.run, "explanation") {
-        errln!("{e:?}");
-        return Err(4);
-    }
-    // The IMU stream is read a window at a time (`fit::Streamed`), as `analyze` reads it.
-    let rec = Streamed::open(&args.run).map_err(|e| {
-        errln!("{:?}", miette::Report::new(e));
-        2
-    })?;
-    // A ratecal run folder gains explain.json: its lock first, so a second writer is
-    // refused at once (exit 2, an error as spec/cli.md has it for explain).
-    let in_run = rec.manifest().run.is_some();
-    let _lock = match in_run {
-        true => Some(
-            ratecal_folder::lock::acquire(&args.run, &ratecal_folder::sealing::command_line())
-                .map_err(|e| {
-                    errln!("{e:?}");
-                    2
-                })?,
-        ),
-        false => None,
+    // gains nothing (exit 4, as `report`). The seal is checked beside the reading: nothing
+    // is shown or written before it has passed, and its failure outranks any other.
+    // A corrected twin is written as the explanation is computed: its seal check comes first.
+    let run = args.run.clone();
+    let check = move || {
+        ratecal_folder::verify::require_intact(&run, "explanation").map_err(|e| format!("{e:?}"))
     };
-    let (mut x, twin, twin_failed) = compute(args, &rec)?;
+    let failed = |e: String| {
+        errln!("{e}");
+        Err(4)
+    };
+    let computed = if args.write_twin.is_some() {
+        check().or_else(failed)?;
+        open_and_compute(args)
+    } else {
+        let seal = std::thread::spawn(check);
+        let computed = open_and_compute(args);
+        (seal.join())
+            .unwrap_or_else(|_| Err("the seal check failed".into()))
+            .or_else(failed)?;
+        computed
+    };
+    let (rec, _lock, (mut x, twin, twin_failed)) = computed?;
+    let in_run = rec.manifest().run.is_some();
     adopt(args, &mut x);
     let drafts = drafts(args, in_run, &mut x);
     let mut value = serde_json::to_value(&x).expect("plain data serializes");
@@ -227,6 +227,42 @@ fn explain_or_exit(args: &Request) -> Result<u8, Exit> {
                 || !x.unexplained.is_empty(),
         ),
     })
+}
+
+/// The recording opened (a ratecal run folder locked) and explained.
+fn open_and_compute(
+    args: &Request,
+) -> Result<
+    (
+        Streamed,
+        Option<ratecal_folder::lock::FolderLock>,
+        (
+            explain::Explanation,
+            Option<ratecal_analysis::twin::TwinReport>,
+            Option<String>,
+        ),
+    ),
+    Exit,
+> {
+    // The IMU stream is read a window at a time (`fit::Streamed`), as `analyze` reads it.
+    let rec = Streamed::open(&args.run).map_err(|e| {
+        errln!("{:?}", miette::Report::new(e));
+        2
+    })?;
+    // A ratecal run folder gains explain.json: its lock first, so a second writer is
+    // refused at once (exit 2, an error as spec/cli.md has it for explain).
+    let lock = match rec.manifest().run.is_some() {
+        true => Some(
+            ratecal_folder::lock::acquire(&args.run, &ratecal_folder::sealing::command_line())
+                .map_err(|e| {
+                    errln!("{e:?}");
+                    2
+                })?,
+        ),
+        false => None,
+    };
+    let computed = compute(args, &rec)?;
+    Ok((rec, lock, computed))
 }
 
 /// The explanation, against the nominal model or the station's twin (with the corrected

@@ -121,8 +121,8 @@ pub(crate) struct Accumulator<'l> {
     block_end: f64,
     /// The signals `parts` were last filled from, time and temperature left out.
     filled: Option<Signals>,
-    /// Layout indices of the effects whose regressors change at rest.
-    varying: Vec<usize>,
+    /// The effects whose regressors change at rest, with their columns.
+    varying: Vec<(&'l dyn ratecal_physics::Effect, std::ops::Range<usize>)>,
     /// Per channel, the positions in its row that change at rest (the observation's
     /// included, last), ascending.
     moving: [Vec<usize>; 6],
@@ -168,7 +168,9 @@ impl<'l> Accumulator<'l> {
             filled: None,
             moving: std::array::from_fn(|c| positions(c, true)),
             resting: std::array::from_fn(|c| positions(c, false)),
-            varying,
+            varying: (varying.iter())
+                .map(|&e| (layout.effects[e], layout.columns_of(e)))
+                .collect(),
             pending: 0,
             rest: Default::default(),
             n: 0,
@@ -238,8 +240,8 @@ impl<'l> Accumulator<'l> {
         (motion.t_s, motion.dtemp_c) = (0.0, 0.0);
         let at_rest = self.filled == Some(motion);
         if at_rest {
-            for &e in &self.varying {
-                layout.effects[e].regressors(sig, &mut self.parts[layout.columns_of(e)]);
+            for (fx, cols) in &self.varying {
+                fx.regressors(sig, &mut self.parts[cols.clone()]);
             }
         } else {
             self.settle();
