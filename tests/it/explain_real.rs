@@ -163,6 +163,16 @@ fn mpu6050_hand_held_session_reports_nothing_implausible() {
     // Its hand-held poses have no known attitude: left out, and said so.
     let w = x["warnings"].to_string();
     assert!(w.contains("attitude: unknown"), "{w}");
+    // Nothing was compared with a model: no residual of zero, no "explains the recording".
+    assert_eq!(x["segments_used"], 0, "{x}");
+    let o = ratecal(&["explain", "run"], tmp.path());
+    let t = text(&o);
+    assert!(t.contains("nothing to explain from"), "{t}");
+    assert!(t.contains("ratecal analyze"), "{t}");
+    assert!(
+        !t.contains("nothing found") && !t.contains("0.000e0"),
+        "{t}"
+    );
 }
 
 #[test]

@@ -193,7 +193,7 @@ pub(crate) fn explain_fitted(
     start.skip.extend(observed.skip.iter().copied());
     let all: Vec<usize> = (0..data.accs.len()).collect();
     let (sa, sg) = seed_segments(m, data);
-    if sa.is_empty() || sg.is_empty() {
+    if (sa.is_empty() || sg.is_empty()) && !data.accs.is_empty() {
         warnings.push(
             "the recording lacks static or rate segments: the nominal model is fitted on every segment"
                 .into(),
@@ -353,6 +353,7 @@ pub(crate) fn explain_fitted(
         format: FORMAT.into(),
         recording: opts.path.clone(),
         nominal: nominal_out,
+        segments_used: data.accs.len(),
         findings,
         final_,
         held_out: data

@@ -247,6 +247,10 @@ pub struct Explanation {
     pub recording: String,
     /// The nominal model.
     pub nominal: Nominal,
+    /// Segments the models were fitted to (those with samples and a known attitude or
+    /// motion): none, and nothing was compared with a model (every figure is empty).
+    #[serde(default)]
+    pub segments_used: usize,
     /// Effects found, in the order they were selected.
     pub findings: Vec<Finding>,
     /// The final model.

@@ -16,6 +16,21 @@ fn rms(r: &Rms) -> String {
 pub fn render_text(x: &Explanation) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "explain {}", x.recording);
+    if x.segments_used == 0 {
+        let _ = writeln!(
+            s,
+            "nominal model ({}: {}): not compared with the recording\n\n\
+             nothing to explain from: no segment of the recording has a known attitude or a \
+             table's motion to compare the model with (see the warnings below); a session of \
+             hand-held poses is calibrated by `ratecal analyze`",
+            x.nominal.model,
+            x.nominal.terms.join(", ")
+        );
+        for w in &x.warnings {
+            let _ = writeln!(s, "warning: {w}");
+        }
+        return s;
+    }
     let _ = writeln!(
         s,
         "nominal model ({}: {}): residual RMS {}",
