@@ -229,21 +229,18 @@ fn explain_or_exit(args: &Request) -> Result<u8, Exit> {
     })
 }
 
+/// What [`compute`] gives: the explanation, the twin's report, and why the corrected twin
+/// was not written.
+type Computed = (
+    explain::Explanation,
+    Option<ratecal_analysis::twin::TwinReport>,
+    Option<String>,
+);
+
 /// The recording opened (a ratecal run folder locked) and explained.
 fn open_and_compute(
     args: &Request,
-) -> Result<
-    (
-        Streamed,
-        Option<ratecal_folder::lock::FolderLock>,
-        (
-            explain::Explanation,
-            Option<ratecal_analysis::twin::TwinReport>,
-            Option<String>,
-        ),
-    ),
-    Exit,
-> {
+) -> Result<(Streamed, Option<ratecal_folder::lock::FolderLock>, Computed), Exit> {
     // The IMU stream is read a window at a time (`fit::Streamed`), as `analyze` reads it.
     let rec = Streamed::open(&args.run).map_err(|e| {
         errln!("{:?}", miette::Report::new(e));
@@ -267,17 +264,7 @@ fn open_and_compute(
 
 /// The explanation, against the nominal model or the station's twin (with the corrected
 /// twin written when asked).
-fn compute(
-    args: &Request,
-    rec: &Streamed,
-) -> Result<
-    (
-        explain::Explanation,
-        Option<ratecal_analysis::twin::TwinReport>,
-        Option<String>,
-    ),
-    Exit,
-> {
+fn compute(args: &Request, rec: &Streamed) -> Result<Computed, Exit> {
     let mut user = load_effects(&args.effects).map_err(|()| 2)?;
     let nominal = match &args.procedure {
         None => NominalModel::seed(),
