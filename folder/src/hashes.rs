@@ -3,12 +3,9 @@
 //! longer parses is "altered".
 
 use ratecal_recording::Manifest;
-use sha2::{Digest, Sha256};
 
-/// Lowercase hex SHA-256 of bytes.
-pub fn sha256_hex(bytes: &[u8]) -> String {
-    hex::encode(Sha256::digest(bytes))
-}
+/// Lowercase hex SHA-256 of bytes: the recording crate's, which every seal uses.
+pub use ratecal_recording::sha256_hex;
 
 /// What a file in the run folder is now, as far as its recorded hash goes.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -16,21 +16,32 @@ fn rms(r: &Rms) -> String {
 pub fn render_text(x: &Explanation) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "explain {}", x.recording);
-    if x.segments_used == 0 {
-        let _ = writeln!(
-            s,
-            "nominal model ({}: {}): not compared with the recording\n\n\
-             nothing to explain from: no segment of the recording has a known attitude or a \
-             table's motion to compare the model with (see the warnings below); a session of \
-             hand-held poses is calibrated by `ratecal analyze`",
-            x.nominal.model,
-            x.nominal.terms.join(", ")
-        );
-        for w in &x.warnings {
-            let _ = writeln!(s, "warning: {w}");
-        }
-        return s;
+    match x.segments_used {
+        0 => nothing_compared(&mut s, x),
+        _ => compared(&mut s, x),
     }
+    for w in &x.warnings {
+        let _ = writeln!(s, "warning: {w}");
+    }
+    s
+}
+
+/// What a recording with no segment to compare the model with gets: why, and what does
+/// calibrate it.
+fn nothing_compared(s: &mut String, x: &Explanation) {
+    let _ = writeln!(
+        s,
+        "nominal model ({}: {}): not compared with the recording\n\n\
+         nothing to explain from: no segment of the recording has a known attitude or a \
+         table's motion to compare the model with (see the warnings below); a session of \
+         hand-held poses is calibrated by `ratecal analyze`",
+        x.nominal.model,
+        x.nominal.terms.join(", ")
+    );
+}
+
+/// The comparison: the nominal model, the findings, the final model and what is left.
+fn compared(s: &mut String, x: &Explanation) {
     let _ = writeln!(
         s,
         "nominal model ({}: {}): residual RMS {}",
@@ -223,8 +234,4 @@ pub fn render_text(x: &Explanation) -> String {
             d.effect, d.file
         );
     }
-    for w in &x.warnings {
-        let _ = writeln!(s, "warning: {w}");
-    }
-    s
 }

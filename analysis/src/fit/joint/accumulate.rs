@@ -268,10 +268,7 @@ impl<'l> Accumulator<'l> {
         }
         for s in 0..2 {
             let ch = 3 * s..3 * s + 3;
-            let at = Positions {
-                moving: &self.moving[ch.clone()],
-                resting: &self.resting[ch.clone()],
-            };
+            let at = Positions::sensor(&self.moving, &self.resting, s);
             let shared = match at_rest {
                 true => self.rest[s].take(&self.rows[ch.clone()], &at),
                 false => {
@@ -301,11 +298,7 @@ impl<'l> Accumulator<'l> {
             self.blocks.push(self.cur);
         }
         for s in 0..2 {
-            let ch = 3 * s..3 * s + 3;
-            self.rest[s].interrupt(&Positions {
-                moving: &self.moving[ch.clone()],
-                resting: &self.resting[ch],
-            });
+            self.rest[s].interrupt(&Positions::sensor(&self.moving, &self.resting, s));
         }
         let rest = &self.rest;
         let mut it = self.tris.into_iter().enumerate().map(|(c, t)| {

@@ -43,6 +43,21 @@ pub(super) struct Positions<'a> {
     pub resting: &'a [Vec<usize>],
 }
 
+impl<'a> Positions<'a> {
+    /// Sensor `s`'s three channels' positions, of the six channels' `moving` and `resting`.
+    pub(super) fn sensor(
+        moving: &'a [Vec<usize>; 6],
+        resting: &'a [Vec<usize>; 6],
+        s: usize,
+    ) -> Self {
+        let ch = 3 * s..3 * s + 3;
+        Positions {
+            moving: &moving[ch.clone()],
+            resting: &resting[ch],
+        }
+    }
+}
+
 #[derive(Debug)]
 struct Stretch {
     /// `(channel, position)` whose value each shared function takes, after the ones column.
@@ -146,11 +161,10 @@ fn multiple(v: &[f64], w: &[f64]) -> Option<f64> {
         .iter()
         .enumerate()
         .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))?;
-    let a = if *wr == 0.0 {
+    if *wr == 0.0 {
         return v.iter().all(|x| *x == 0.0).then_some(0.0);
-    } else {
-        v[r] / wr
-    };
+    }
+    let a = v[r] / wr;
     v.iter().zip(w).all(|(v, w)| close(*v, a * w)).then_some(a)
 }
 
