@@ -7,34 +7,96 @@ use crate::results::{AllanCurve, Parameter};
 /// Overlapping Allan deviation of `y` sampled every `dt`, at octave cluster sizes
 /// `m = 1, 2, 4, ...` up to a quarter of the series: `(tau, adev, clusters)`.
 pub fn overlapping_adev(y: &[f64], dt: f64) -> Vec<(f64, f64, usize)> {
-    adev_of_angle(&integrated(y.to_vec(), dt), dt)
+    adev_of_rates(vec![y.to_vec()], dt)
 }
 
-/// The integrated angle `theta` of a rate series (`theta[0] = 0`), in the series' own
-/// memory.
-fn integrated(mut y: Vec<f64>, dt: f64) -> Vec<f64> {
-    y.push(0.0);
-    y.rotate_right(1);
+/// A block's kept gyro samples per axis, in the chunks its windows kept (in order): a
+/// long block's windows are passed side by side, and a 1 kHz hour is 29 MB an axis, so
+/// the chunks are never copied into one.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Series {
+    chunks: Vec<[Vec<f64>; 3]>,
+}
+
+impl Series {
+    /// A window's kept samples, after those already held.
+    pub(crate) fn push(&mut self, chunk: [Vec<f64>; 3]) {
+        self.chunks.push(chunk);
+    }
+
+    /// The samples of the windows that follow.
+    pub(crate) fn append(&mut self, later: Series) {
+        self.chunks.extend(later.chunks);
+    }
+}
+
+/// The curve of a rate series held in chunks, integrated in their own memory: sample `i`
+/// becomes the angle `theta[i + 1]` (`theta[0] = 0` is left implicit, so nothing grows).
+fn adev_of_rates(mut chunks: Vec<Vec<f64>>, dt: f64) -> Vec<(f64, f64, usize)> {
+    chunks.retain(|c| !c.is_empty());
     let mut acc = 0.0;
-    for v in &mut y[1..] {
+    for v in chunks.iter_mut().flatten() {
         acc += *v * dt;
         *v = acc;
     }
-    y
+    adev_of_angle(&Chunked::new(&chunks), dt)
 }
 
-/// The curve from the integrated angle `theta` (`theta[0] = 0`).
-fn adev_of_angle(theta: &[f64], dt: f64) -> Vec<(f64, f64, usize)> {
-    let n = theta.len() - 1;
+/// One series read across its chunks.
+struct Chunked<'a> {
+    chunks: &'a [Vec<f64>],
+    /// Where each chunk starts in the series.
+    starts: Vec<usize>,
+    len: usize,
+}
+
+impl<'a> Chunked<'a> {
+    fn new(chunks: &'a [Vec<f64>]) -> Self {
+        let mut starts = Vec::with_capacity(chunks.len());
+        let mut len = 0;
+        for c in chunks {
+            starts.push(len);
+            len += c.len();
+        }
+        Chunked {
+            chunks,
+            starts,
+            len,
+        }
+    }
+
+    /// The series from index `i` to the end of the chunk that holds it.
+    fn from(&self, i: usize) -> &'a [f64] {
+        let c = self.starts.partition_point(|&s| s <= i) - 1;
+        &self.chunks[c][i - self.starts[c]..]
+    }
+
+    fn at(&self, i: usize) -> f64 {
+        self.from(i)[0]
+    }
+}
+
+/// The curve from the integrated angle `theta[k] = c[k - 1]`, `theta[0] = 0`.
+fn adev_of_angle(c: &Chunked, dt: f64) -> Vec<(f64, f64, usize)> {
+    let n = c.len;
     let mut out = Vec::new();
     let mut m = 1;
     while 4 * m <= n {
         let tau = m as f64 * dt;
         let terms = n + 1 - 2 * m;
-        let mut s = 0.0;
-        for k in 0..terms {
-            let d = theta[k + 2 * m] - 2.0 * theta[k + m] + theta[k];
-            s += d * d;
+        // k = 0, where theta[k] is the implicit zero, then the rest in order, a run at
+        // a time within which none of the three samples leaves its chunk.
+        let d0 = c.at(2 * m - 1) - 2.0 * c.at(m - 1);
+        let mut s = d0 * d0;
+        let mut k = 1;
+        while k < terms {
+            let (a, b, e) = (c.from(k - 1), c.from(k + m - 1), c.from(k + 2 * m - 1));
+            let run = a.len().min(b.len()).min(e.len()).min(terms - k);
+            for ((a, b), e) in a[..run].iter().zip(&b[..run]).zip(&e[..run]) {
+                let d = e - 2.0 * b + a;
+                s += d * d;
+            }
+            k += run;
         }
         out.push((tau, (s / (2.0 * tau * tau * terms as f64)).sqrt(), n / m));
         m *= 2;
@@ -44,14 +106,20 @@ fn adev_of_angle(theta: &[f64], dt: f64) -> Vec<(f64, f64, usize)> {
 
 /// The three gyro curves of a block from its kept samples per axis (treated as
 /// contiguous), sampled every `dt`: the costly part of the Allan analysis, free of `Out`
-/// so that it can run while the fits do. Each series is integrated in place, so a long
-/// 1 kHz block holds its three series and nothing more.
+/// so that it can run while the fits do, the three axes side by side. Each series is
+/// integrated in place, so a long 1 kHz block holds its three series and nothing more.
 pub(crate) type Curves = Vec<Vec<(f64, f64, usize)>>;
 
-pub(crate) fn curves(series: [Vec<f64>; 3], dt: f64) -> Curves {
-    series
-        .into_iter()
-        .map(|y| adev_of_angle(&integrated(y, dt), dt))
+pub(crate) fn curves(series: Series, dt: f64) -> Curves {
+    use rayon::prelude::*;
+    let mut axes: [Vec<Vec<f64>>; 3] = Default::default();
+    for chunk in series.chunks {
+        for (ax, c) in axes.iter_mut().zip(chunk) {
+            ax.push(c);
+        }
+    }
+    axes.into_par_iter()
+        .map(|chunks| adev_of_rates(chunks, dt))
         .collect()
 }
 

@@ -53,6 +53,11 @@ pub struct Options {
     /// Most IMU rows of a static segment held at once (its outlier test runs within each
     /// window of that many rows); a moving segment's windows are an eighth of it.
     pub window_rows: usize,
+    /// Whether the windows of a segment longer than one window are passed side by side
+    /// (the default), their sums joined in order; `false` passes them one after another.
+    /// The results agree to rounding (the joined factors and block sums are summed in
+    /// another order).
+    pub parallel_windows: bool,
     /// The Type B figures the station states: with them every reported parameter gets its
     /// GUM budget (results.json `budgets`) and the checks on parameters are judged with
     /// its `U` and `k`; without, with the fit's Type A uncertainty at k = 2.
@@ -67,6 +72,7 @@ impl Default for Options {
             path: String::new(),
             with: Vec::new(),
             window_rows: segment::WINDOW_ROWS,
+            parallel_windows: true,
             stated: None,
         }
     }
@@ -124,7 +130,7 @@ pub fn analyze_source<S: Source>(
     let declared = models::declared(plan, &opts.with);
     let thermal = sel.temp_requested && src.has_temp();
     let design = models::Design::new(&sel, &declared, thermal, &mut out);
-    let (mut sums, accs) = pass_segments(src, &design.layout, opts.window_rows, |i| {
+    let (mut sums, accs) = pass_segments(src, &design.layout, opts, |i| {
         let prep = sel.prep.iter().find(|p| p.0 == i).map(|p| p.1);
         (prep, sel.allan == Some(i), sel.unused.contains(&i))
     })?;
@@ -301,6 +307,7 @@ pub(crate) fn accumulate_all<S: Source>(
                 window_rows: segment::WINDOW_ROWS,
                 span,
                 retime,
+                windows: None,
             });
         }
     }
@@ -356,14 +363,15 @@ impl Context {
 const PIECE_ROWS: usize = 65_536;
 
 /// Passes every segment once over `layout` (in parallel, longest first so that the work
-/// stealing balances), the thermal terms referred to the recording's mean temperature;
+/// stealing balances; a long segment's windows side by side, joined in order, unless
+/// `opts` says otherwise), the thermal terms referred to the recording's mean temperature;
 /// `what(i)` says how segment `i` is prepared, whether it is the Allan block and whether a
 /// verification segment. Summaries in manifest order; accumulations of the segments with
 /// samples.
 fn pass_segments<S: Source>(
     src: &S,
     layout: &Layout,
-    window_rows: usize,
+    opts: &Options,
     what: impl Fn(usize) -> (Option<prep::PrepOptions>, bool, bool) + Sync,
 ) -> Result<(Vec<Summary>, Vec<SegAcc>), S::Error> {
     use rayon::prelude::*;
@@ -373,32 +381,61 @@ fn pass_segments<S: Source>(
         rate_hz,
         t_ref_c,
     } = Context::of(src, layout)?;
-    let dur = |i: usize| m.segments[i].t_end - m.segments[i].t_start;
-    let mut order: Vec<usize> = (0..m.segments.len()).collect();
-    order.sort_by(|a, b| dur(*b).total_cmp(&dur(*a)));
-    let passed: Vec<(Summary, SegAcc)> = order
+    let mut jobs = Vec::new();
+    for i in 0..m.segments.len() {
+        let (prep, allan, verify) = what(i);
+        let job = segment::Job {
+            seg: i,
+            geo: &geos[i],
+            layout,
+            t_ref_c,
+            prep,
+            allan,
+            verify,
+            rate_hz,
+            window_rows: opts.window_rows,
+            span: None,
+            retime: Retime::default(),
+            windows: None,
+        };
+        // A long segment's windows side by side (a verification segment's statistics
+        // are kept whole).
+        let k = segment::windows(src, &job);
+        match opts.parallel_windows && k > 1 && !verify {
+            true => jobs.extend((0..k).map(|w| segment::Job {
+                windows: Some((w, w + 1)),
+                ..job
+            })),
+            false => jobs.push(job),
+        }
+    }
+    // Longest first, so that the work stealing balances.
+    let dur = |j: &segment::Job| {
+        let seg = &m.segments[j.seg];
+        let windows = j.windows.map_or(1, |_| segment::windows(src, j));
+        (seg.t_end - seg.t_start) / windows as f64
+    };
+    let mut order: Vec<usize> = (0..jobs.len()).collect();
+    order.sort_by(|&a, &b| dur(&jobs[b]).total_cmp(&dur(&jobs[a])));
+    let mut passed: Vec<(usize, (Summary, SegAcc))> = order
         .par_iter()
-        .map(|&i| {
-            let (prep, allan, verify) = what(i);
-            let job = segment::Job {
-                seg: i,
-                geo: &geos[i],
-                layout,
-                t_ref_c,
-                prep,
-                allan,
-                verify,
-                rate_hz,
-                window_rows,
-                span: None,
-                retime: Retime::default(),
-            };
-            segment::pass(src, &job)
-        })
+        .map(|&j| segment::pass(src, &jobs[j]).map(|p| (j, p)))
         .collect::<Result<_, _>>()?;
-    let (mut sums, mut accs): (Vec<Summary>, Vec<SegAcc>) = passed.into_iter().unzip();
-    sums.sort_by_key(|s| s.seg);
-    accs.sort_by_key(|a| a.seg);
+    // The pieces of a segment in order, joined.
+    passed.sort_by_key(|p| p.0);
+    let (mut sums, mut accs): (Vec<Summary>, Vec<SegAcc>) = (Vec::new(), Vec::new());
+    for (_, (sum, acc)) in passed {
+        match (sums.last_mut(), accs.last_mut()) {
+            (Some(s), Some(a)) if s.seg == sum.seg => {
+                s.merge(sum);
+                a.merge(acc);
+            }
+            _ => {
+                sums.push(sum);
+                accs.push(acc);
+            }
+        }
+    }
     accs.retain(|a| a.n > 0);
     Ok((sums, accs))
 }

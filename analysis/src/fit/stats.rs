@@ -108,6 +108,12 @@ impl Inflation {
         self.white_ss += var * (nb - 1) as f64;
     }
 
+    /// Adds another stretch's sums (as [`Inflation::add`] of it would).
+    pub(crate) fn merge(&mut self, other: &Inflation) {
+        self.batch_ss += other.batch_ss;
+        self.white_ss += other.white_ss;
+    }
+
     /// The variance factor, never below 1.
     pub(crate) fn factor(&self) -> f64 {
         if self.white_ss > 0.0 {

@@ -139,3 +139,48 @@ fn windows_hand_every_row_once_and_the_temperature_plot_is_the_same() {
         whole.imu.len()
     );
 }
+
+/// A long segment's windows passed side by side (the default) and one after another: the
+/// same rows in the same windows, judged by the same outlier test and low-passed with the
+/// same margins, so the same numbers but for the order of a few sums (the factors of the
+/// windows stacked, a block cut by a window's edge joined again). The Allan curve is taken
+/// from the same samples in the same order: equal to the last bit.
+#[test]
+fn windows_side_by_side_give_the_numbers_of_one_pass() {
+    let mut spec = SimSpec::tactical(24);
+    spec.temp = Some((22.0, 3.0));
+    let tmp = sim(&spec);
+    let streamed = fit::Streamed::open(tmp.path()).unwrap();
+    let opts = |parallel_windows: bool| fit::Options {
+        outliers: Some(Outliers::Sigma(3.0)),
+        lowpass: Some((4, 5.0)),
+        with: vec!["gyro_thermal_drift".into()],
+        // 12,000 rows of gyro block in 1,500-row windows, whose edges fall inside seconds.
+        window_rows: 1_500,
+        parallel_windows,
+        ..Default::default()
+    };
+    let one = fit::analyze_source(&streamed, None, &opts(false)).unwrap();
+    let side = fit::analyze_source(&streamed, None, &opts(true)).unwrap();
+    let worst = agree(&one, &side, 1e-9);
+    eprintln!("worst difference {worst:.2e} u");
+    // The uncertainties too: the noise analysis reads the one-second blocks.
+    for name in one.parameters.keys() {
+        if let (Some((_, ua)), Some((_, ub))) = (one.value(name), side.value(name)) {
+            assert!((ua - ub).abs() <= 1e-9 * ua, "{name}: u {ua} vs {ub}");
+        }
+    }
+    assert_eq!(one.segments, side.segments);
+    assert_eq!(one.warnings, side.warnings);
+    assert_eq!(one.sync, side.sync);
+    let (a, b) = (one.allan.unwrap(), side.allan.unwrap());
+    assert_eq!(a.tau_s, b.tau_s);
+    assert_eq!(a.adev_dps, b.adev_dps);
+    // Every number of the residuals, relative to the channel's spread.
+    assert_eq!(one.residuals.len(), side.residuals.len());
+    for (x, y) in one.residuals.iter().zip(&side.residuals) {
+        assert_eq!((&x.segment, &x.channel, x.n), (&y.segment, &y.channel, y.n));
+        assert!((x.mean - y.mean).abs() <= 1e-9 * x.std, "{x:?} vs {y:?}");
+        assert!((x.std - y.std).abs() <= 1e-9 * x.std, "{x:?} vs {y:?}");
+    }
+}

@@ -16,12 +16,29 @@ pub(crate) const BLOCK_S: f64 = 1.0;
 pub(crate) struct Block {
     /// Mean stamp, s.
     pub t: f64,
+    /// The end of the block's second on its segment's grid, s.
+    pub end: f64,
     /// Samples.
     pub n: usize,
     /// Per channel, the sum of each of its regressors.
     pub sx: [Vec<f64>; 6],
     /// Per channel, the sum of the observations.
     pub sy: [f64; 6],
+}
+
+impl Block {
+    /// Adds the samples of `b`, the rest of the same second.
+    fn join(&mut self, b: Block) {
+        let n = (self.n + b.n) as f64;
+        self.t = (self.t * self.n as f64 + b.t * b.n as f64) / n;
+        self.n += b.n;
+        for c in 0..6 {
+            for (s, x) in self.sx[c].iter_mut().zip(&b.sx[c]) {
+                *s += x;
+            }
+            self.sy[c] += b.sy[c];
+        }
+    }
 }
 
 /// What a segment contributes to any fit.
@@ -92,12 +109,20 @@ impl SegAcc {
 
     /// Adds the accumulation of a later piece of the same segment: the factors stacked and
     /// triangulated again, the blocks and counts joined.
+    /// A block the two pieces share (one second cut by the pieces' boundary, both on one
+    /// grid) is joined again.
     pub(crate) fn merge(&mut self, later: SegAcc) {
         self.blocks_changed();
         for (c, r) in later.r.into_iter().enumerate() {
             self.r[c] = stack(&self.r[c], &r);
         }
-        self.blocks.extend(later.blocks);
+        let mut blocks = later.blocks.into_iter().peekable();
+        if let (Some(a), Some(b)) = (self.blocks.last_mut(), blocks.peek())
+            && a.end == b.end
+        {
+            a.join(blocks.next().expect("peeked"));
+        }
+        self.blocks.extend(blocks);
         self.n += later.n;
     }
 }
@@ -134,6 +159,9 @@ pub(crate) struct Accumulator<'l> {
     rest: [Rest; 2],
     /// Samples folded.
     n: usize,
+    /// Whether the first sample's block is found on the grid from `block_end` on (a later
+    /// piece of a segment), not taken to be the first.
+    align: bool,
 }
 
 impl<'l> Accumulator<'l> {
@@ -174,12 +202,20 @@ impl<'l> Accumulator<'l> {
             pending: 0,
             rest: Default::default(),
             n: 0,
+            align: false,
         }
+    }
+
+    /// The samples to come are a later piece of the segment: their blocks lie on the grid
+    /// of its start, as in one pass over the whole segment.
+    pub(crate) fn continue_grid(&mut self) {
+        self.align = true;
     }
 
     fn new_block(layout: &Layout) -> Block {
         Block {
             t: 0.0,
+            end: f64::NAN,
             n: 0,
             sx: std::array::from_fn(|c| vec![0.0; layout.by_channel[c].len()]),
             sy: [0.0; 6],
@@ -228,9 +264,18 @@ impl<'l> Accumulator<'l> {
         if out.iter().any(|v| !v.is_finite()) {
             return;
         }
+        if self.align {
+            // The grid's seconds one by one, as the pass over the whole segment steps
+            // them when no second is empty.
+            while t > self.block_end {
+                self.block_end += BLOCK_S;
+            }
+            self.align = false;
+        }
         if t > self.block_end && self.cur.n > 0 {
             self.settle();
             self.cur.t /= self.cur.n as f64;
+            self.cur.end = self.block_end;
             let full = std::mem::replace(&mut self.cur, Self::new_block(layout));
             self.blocks.push(full);
             self.block_end += BLOCK_S * ((t - self.block_end) / BLOCK_S).ceil().max(1.0);
@@ -295,6 +340,7 @@ impl<'l> Accumulator<'l> {
         self.settle();
         if self.cur.n > 0 {
             self.cur.t /= self.cur.n as f64;
+            self.cur.end = self.block_end;
             self.blocks.push(self.cur);
         }
         for s in 0..2 {

@@ -19,7 +19,7 @@ use super::joint::{Accumulator, Layout, SegAcc};
 use super::prep::{self, PrepOptions};
 use super::source::{ImuView, Source};
 use super::stats::median_step;
-use crate::recording::{Segment, TableStream};
+use crate::recording::{Segment, SegmentKind, TableStream};
 use crate::results::SyncReport;
 use kin::Kin;
 pub use kin::Retime;
@@ -59,6 +59,11 @@ pub(crate) struct Job<'a> {
     pub span: Option<(f64, f64)>,
     /// The samples' known timing error against the feedback.
     pub retime: Retime,
+    /// Only the windows `[a, b)` of the segment's [`windows`], when a long segment's
+    /// windows are passed side by side (their summaries joined by [`Summary::merge`],
+    /// their accumulations by `SegAcc::merge`): every window is read, cleaned and filtered
+    /// exactly as in one pass over the whole segment.
+    pub windows: Option<(usize, usize)>,
 }
 
 /// What is left of a segment once its rows have passed.
@@ -80,14 +85,61 @@ pub(crate) struct Summary {
     pub warnings: Vec<String>,
     /// Mean feedback angles (outer, inner) at the IMU stamps, deg.
     pub mean_angles_deg: (f64, f64),
+    /// The feedback angles' sums behind the means.
+    angle_sums: (f64, f64),
     /// Median IMU step of the first window, s.
     pub step_s: f64,
     /// Per output channel (`ax ay az gx gy gz`), outputs against references (prepared only).
     pub channels: [ChannelStats; 6],
     /// The kept gyro outputs per axis, in order (the Allan block only).
-    pub allan: Option<[Vec<f64>; 3]>,
+    pub allan: Option<super::allan::Series>,
     /// Raw outputs against references over every row, for the sanity checks.
     pub raw: RawSums,
+}
+
+/// How a segment's pass is cut: the span it covers, its windows (count) and the margin
+/// each window reads on both sides for a low-pass, s.
+#[derive(Debug, Clone, Copy)]
+struct Cut {
+    s0: f64,
+    s1: f64,
+    k: usize,
+    margin: f64,
+}
+
+impl Cut {
+    fn of<S: Source>(src: &S, job: &Job) -> Cut {
+        let seg = &src.manifest().segments[job.seg];
+        // A static segment's signals are one set (or its feedback's, without per-row
+        // copies); a moving segment keeps them per row.
+        let moving = seg.kind != SegmentKind::Static;
+        let per = if moving {
+            job.window_rows / MOVING_DIVISOR
+        } else {
+            job.window_rows
+        }
+        .max(1) as f64;
+        let (s0, s1) = job.span.unwrap_or((seg.t_start, seg.t_end));
+        let k = (((s1 - s0) * job.rate_hz / per).ceil() as usize).max(1);
+        let margin = match job.prep.and_then(|p| p.lowpass) {
+            Some((_, fc)) if k > 1 && fc > 0.0 => MARGIN_PERIODS / fc,
+            _ => 0.0,
+        };
+        // Without two feedback samples there is no reference to fit against.
+        let k = if src.table().t.len() < 2 { 0 } else { k };
+        Cut { s0, s1, k, margin }
+    }
+
+    /// Window `i`'s own span.
+    fn window(&self, i: usize) -> (f64, f64) {
+        let at = |i: usize| self.s0 + (self.s1 - self.s0) * i as f64 / self.k as f64;
+        (at(i), if i + 1 == self.k { self.s1 } else { at(i + 1) })
+    }
+}
+
+/// How many windows the pass over `job`'s segment reads (0 without table feedback).
+pub(crate) fn windows<S: Source>(src: &S, job: &Job) -> usize {
+    Cut::of(src, job).k
 }
 
 /// Runs the pass over one segment.
@@ -95,24 +147,17 @@ pub(crate) fn pass<S: Source>(src: &S, job: &Job) -> Result<(Summary, SegAcc), S
     let m = src.manifest();
     let seg = &m.segments[job.seg];
     let mut kin = Kin::new(src.table(), seg, job.geo, m.station.site, job.retime);
-    let moving = kin.rest.is_none() && !kin.still;
-    let per = if moving {
-        job.window_rows / MOVING_DIVISOR
-    } else {
-        job.window_rows
+    let cut = Cut::of(src, job);
+    let (a, b) = job.windows.map_or((0, cut.k), |(a, b)| (a, b.min(cut.k)));
+    let mut acc = Accumulator::new(job.seg, cut.s0, job.layout);
+    if a > 0 {
+        // A later piece of the segment: its blocks keep the whole segment's grid.
+        acc.continue_grid();
     }
-    .max(1) as f64;
-    let (s0, s1) = job.span.unwrap_or((seg.t_start, seg.t_end));
-    let dur = s1 - s0;
-    let k = ((dur * job.rate_hz / per).ceil() as usize).max(1);
-    let margin = match job.prep.and_then(|p| p.lowpass) {
-        Some((_, fc)) if k > 1 && fc > 0.0 => MARGIN_PERIODS / fc,
-        _ => 0.0,
-    };
     let mut w = Window {
         job,
         seg,
-        acc: Accumulator::new(job.seg, s0, job.layout),
+        acc,
         sum: Summary {
             seg: job.seg,
             rows: 0,
@@ -122,32 +167,66 @@ pub(crate) fn pass<S: Source>(src: &S, job: &Job) -> Result<(Summary, SegAcc), S
             sync: SyncReport::default(),
             warnings: Vec::new(),
             mean_angles_deg: (0.0, 0.0),
+            angle_sums: (0.0, 0.0),
             step_s: f64::NAN,
             channels: Default::default(),
             allan: (job.allan && job.prep.is_some()).then(Default::default),
             raw: RawSums::default(),
         },
-        angle_sums: (0.0, 0.0),
     };
-    // Without two feedback samples there is no reference to fit against.
-    let k = if src.table().t.len() < 2 { 0 } else { k };
-    for i in 0..k {
-        let at = |i: usize| s0 + dur * i as f64 / k as f64;
-        let (c0, c1) = (at(i), if i + 1 == k { s1 } else { at(i + 1) });
-        let (r0, r1) = ((c0 - margin).max(seg.t_start), (c1 + margin).min(seg.t_end));
+    for i in a..b {
+        let (c0, c1) = cut.window(i);
+        let (r0, r1) = (
+            (c0 - cut.margin).max(seg.t_start),
+            (c1 + cut.margin).min(seg.t_end),
+        );
         // Only the segment's own end is inclusive: a piece ends where the next begins.
-        let last = i + 1 == k && s1 >= seg.t_end;
+        let last = i + 1 == cut.k && cut.s1 >= seg.t_end;
         src.rows(r0, r1, |v| w.window(&mut kin, v, c0, c1, last))?;
     }
-    let Window {
-        acc,
-        mut sum,
-        angle_sums,
-        ..
-    } = w;
-    let n = sum.rows.max(1) as f64;
-    sum.mean_angles_deg = (angle_sums.0 / n, angle_sums.1 / n);
+    let Window { acc, mut sum, .. } = w;
+    sum.mean_angles();
     Ok((sum, acc.finish()))
+}
+
+impl Summary {
+    /// The mean angles from their sums.
+    fn mean_angles(&mut self) {
+        let n = self.rows.max(1) as f64;
+        self.mean_angles_deg = (self.angle_sums.0 / n, self.angle_sums.1 / n);
+    }
+
+    /// Adds the summary of the windows that follow this one's in the same segment.
+    pub(crate) fn merge(&mut self, later: Summary) {
+        debug_assert_eq!(self.seg, later.seg);
+        // A piece's first window warns as the segment's first would: only the first's count.
+        if self.rows == 0 {
+            self.warnings.extend(later.warnings);
+        }
+        if self.step_s.is_nan() {
+            self.step_s = later.step_s;
+        }
+        self.rows += later.rows;
+        self.outliers += later.outliers;
+        self.temp_range = match (self.temp_range, later.temp_range) {
+            (Some(a), Some(b)) => Some((a.0.min(b.0), a.1.max(b.1))),
+            (a, b) => a.or(b),
+        };
+        let (s, l) = (&mut self.sync, &later.sync);
+        s.max_gap_s = s.max_gap_s.max(l.max_gap_s);
+        s.max_sync_error_s = s.max_sync_error_s.max(l.max_sync_error_s);
+        s.max_angle_error_deg = s.max_angle_error_deg.max(l.max_angle_error_deg);
+        self.angle_sums.0 += later.angle_sums.0;
+        self.angle_sums.1 += later.angle_sums.1;
+        self.mean_angles();
+        for (c, l) in self.channels.iter_mut().zip(&later.channels) {
+            c.merge(l);
+        }
+        if let (Some(a), Some(b)) = (&mut self.allan, later.allan) {
+            a.append(b);
+        }
+        self.raw.merge(&later.raw);
+    }
 }
 
 /// A window's references per output channel: one set at rest, else per row.
@@ -186,7 +265,6 @@ struct Window<'a> {
     seg: &'a Segment,
     acc: Accumulator<'a>,
     sum: Summary,
-    angle_sums: (f64, f64),
 }
 
 impl Window<'_> {
@@ -312,10 +390,10 @@ impl Window<'_> {
             }
         }
         if let Some(series) = &mut self.sum.allan {
-            for (ax, s) in series.iter_mut().enumerate() {
-                let o = &outputs[3 + ax];
-                s.extend((ca..cb).filter(|&i| keep_g[i]).map(|i| o[i]));
-            }
+            let kept: Vec<usize> = (ca..cb).filter(|&i| keep_g[i]).collect();
+            series.push(std::array::from_fn(|ax| {
+                kept.iter().map(|&i| outputs[3 + ax][i]).collect()
+            }));
         }
     }
 
@@ -332,7 +410,7 @@ impl Window<'_> {
         let acc_i = prep::rate_derivative(&tab.t, &tab.inner_rate, j);
         let max_acc = acc_o.abs().max(acc_i.abs());
         sync.max_angle_error_deg = sync.max_angle_error_deg.max(gap * gap / 8.0 * max_acc);
-        self.angle_sums.0 += tab.outer[j] + w * prep::unwrap(tab.outer[j + 1] - tab.outer[j]);
-        self.angle_sums.1 += tab.inner[j] + w * prep::unwrap(tab.inner[j + 1] - tab.inner[j]);
+        self.sum.angle_sums.0 += tab.outer[j] + w * prep::unwrap(tab.outer[j + 1] - tab.outer[j]);
+        self.sum.angle_sums.1 += tab.inner[j] + w * prep::unwrap(tab.inner[j + 1] - tab.inner[j]);
     }
 }

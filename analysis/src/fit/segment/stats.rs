@@ -49,6 +49,21 @@ impl ChannelStats {
         self.inflation.add(&d, keep);
     }
 
+    /// Adds the sums of later samples of the same channel (Chan's rule for the spread).
+    pub(super) fn merge(&mut self, later: &ChannelStats) {
+        if later.n == 0 {
+            return;
+        }
+        let (na, nb) = (self.n as f64, later.n as f64);
+        let delta = later.mean_d - self.mean_d;
+        self.m2_d += later.m2_d + delta * delta * na * nb / (na + nb);
+        self.mean_d += delta * nb / (na + nb);
+        self.n += later.n;
+        self.sum_out += later.sum_out;
+        self.sum_ref += later.sum_ref;
+        self.inflation.merge(&later.inflation);
+    }
+
     /// Sample standard deviation of `out - ref`.
     pub(crate) fn std_d(&self) -> f64 {
         if self.n < 2 {
@@ -90,6 +105,18 @@ impl RawSums {
             self.soo[c] += o * o;
             self.sor[c] += o * r;
             self.srr[c] += r * r;
+        }
+    }
+
+    /// Adds the sums of later rows.
+    pub(super) fn merge(&mut self, later: &RawSums) {
+        self.n += later.n;
+        for c in 0..6 {
+            self.so[c] += later.so[c];
+            self.sr[c] += later.sr[c];
+            self.soo[c] += later.soo[c];
+            self.sor[c] += later.sor[c];
+            self.srr[c] += later.srr[c];
         }
     }
 
