@@ -76,32 +76,71 @@ impl<'a> Chunked<'a> {
     }
 }
 
+/// Cluster sizes swept together over the series: each sum is a chain of additions that
+/// waits on the one before, so four independent ones keep the adder busy.
+const SWEPT: usize = 4;
+
 /// The curve from the integrated angle `theta[k] = c[k - 1]`, `theta[0] = 0`.
 fn adev_of_angle(c: &Chunked, dt: f64) -> Vec<(f64, f64, usize)> {
     let n = c.len;
-    let mut out = Vec::new();
-    let mut m = 1;
-    while 4 * m <= n {
-        let tau = m as f64 * dt;
-        let terms = n + 1 - 2 * m;
-        // k = 0, where theta[k] is the implicit zero, then the rest in order, a run at
-        // a time within which none of the three samples leaves its chunk.
-        let d0 = c.at(2 * m - 1) - 2.0 * c.at(m - 1);
-        let mut s = d0 * d0;
-        let mut k = 1;
-        while k < terms {
-            let (a, b, e) = (c.from(k - 1), c.from(k + m - 1), c.from(k + 2 * m - 1));
-            let run = a.len().min(b.len()).min(e.len()).min(terms - k);
-            for ((a, b), e) in a[..run].iter().zip(&b[..run]).zip(&e[..run]) {
-                let d = e - 2.0 * b + a;
-                s += d * d;
-            }
-            k += run;
+    let ms: Vec<usize> = std::iter::successors(Some(1usize), |m| Some(m * 2))
+        .take_while(|m| 4 * m <= n)
+        .collect();
+    let terms = |m: usize| n + 1 - 2 * m;
+    let mut sums = vec![0.0; ms.len()];
+    for (group, s) in ms.chunks(SWEPT).zip(sums.chunks_mut(SWEPT)) {
+        // k = 0, where theta[k] is the implicit zero, then the rest in order: every sum
+        // adds its terms in the order of k, whichever sizes are swept beside it.
+        for (s, &m) in s.iter_mut().zip(group) {
+            let d0 = c.at(2 * m - 1) - 2.0 * c.at(m - 1);
+            *s = d0 * d0;
         }
-        out.push((tau, (s / (2.0 * tau * tau * terms as f64)).sqrt(), n / m));
-        m *= 2;
+        let common = terms(group[group.len() - 1]);
+        match <[usize; SWEPT]>::try_from(group) {
+            Ok(g) => {
+                let mut four = [0.0; SWEPT];
+                four.copy_from_slice(s);
+                sweep(c, g, &mut four, 1, common);
+                s.copy_from_slice(&four);
+            }
+            Err(_) => {
+                for (s, &m) in s.iter_mut().zip(group) {
+                    sweep(c, [m], std::array::from_mut(s), 1, common);
+                }
+            }
+        }
+        for (s, &m) in s.iter_mut().zip(group) {
+            sweep(c, [m], std::array::from_mut(s), common, terms(m));
+        }
     }
-    out
+    let curve = ms.iter().zip(&sums).map(|(&m, &s)| {
+        let tau = m as f64 * dt;
+        let adev = (s / (2.0 * tau * tau * terms(m) as f64)).sqrt();
+        (tau, adev, n / m)
+    });
+    curve.collect()
+}
+
+/// Adds to `s[j]` the squared second differences at cluster size `ms[j]` for `k` in
+/// `[k, end)`, in order, a run at a time within which no sample read leaves its chunk.
+fn sweep<const N: usize>(c: &Chunked, ms: [usize; N], s: &mut [f64; N], mut k: usize, end: usize) {
+    while k < end {
+        let a = c.from(k - 1);
+        let b: [&[f64]; N] = std::array::from_fn(|j| c.from(k + ms[j] - 1));
+        let e: [&[f64]; N] = std::array::from_fn(|j| c.from(k + 2 * ms[j] - 1));
+        let lens = b.iter().chain(&e).map(|x| x.len());
+        let run = lens.fold((end - k).min(a.len()), usize::min);
+        let a = &a[..run];
+        let b = b.map(|x| &x[..run]);
+        let e = e.map(|x| &x[..run]);
+        for (i, a) in a.iter().enumerate() {
+            for j in 0..N {
+                let d = e[j][i] - 2.0 * b[j][i] + a;
+                s[j] += d * d;
+            }
+        }
+        k += run;
+    }
 }
 
 /// The three gyro curves of a block from its kept samples per axis (treated as
@@ -192,6 +231,60 @@ pub(crate) fn analyse(id: &str, curves: &Curves, out: &mut Out) -> Option<AllanC
 #[cfg(test)]
 mod tests {
     use super::{Out, Parameter, analyse, overlapping_adev};
+
+    /// The textbook sum, one cluster size at a time over one contiguous angle series.
+    fn textbook(y: &[f64], dt: f64) -> Vec<(f64, f64, usize)> {
+        let mut theta = vec![0.0];
+        for v in y {
+            theta.push(theta[theta.len() - 1] + v * dt);
+        }
+        let n = y.len();
+        let mut out = Vec::new();
+        let mut m = 1;
+        while 4 * m <= n {
+            let (tau, terms) = (m as f64 * dt, n + 1 - 2 * m);
+            let mut s = 0.0;
+            for k in 0..terms {
+                let d = theta[k + 2 * m] - 2.0 * theta[k + m] + theta[k];
+                s += d * d;
+            }
+            out.push((tau, (s / (2.0 * tau * tau * terms as f64)).sqrt(), n / m));
+            m *= 2;
+        }
+        out
+    }
+
+    /// Held in uneven chunks (empty ones among them) and swept four sizes at a time, the
+    /// curve is the textbook one to the last bit: every sum adds the same terms in the
+    /// same order.
+    #[test]
+    fn chunked_and_swept_curve_is_the_textbook_one_to_the_bit() {
+        let mut x = 0.37f64;
+        let y: Vec<f64> = (0..20_011)
+            .map(|i| {
+                x = (x * 3.9 * (1.0 - x)).clamp(1e-9, 1.0 - 1e-9);
+                0.2 + 1e-3 * (x - 0.5) + 1e-7 * i as f64
+            })
+            .collect();
+        let want = textbook(&y, 0.01);
+        let cuts = [0, 3, 3, 1_000, 7_777, 7_778, 15_000, y.len()];
+        let chunks = |ax: usize| -> Vec<Vec<f64>> {
+            cuts.windows(2)
+                .map(|w| y[w[0]..w[1]].iter().map(|v| v + ax as f64).collect())
+                .collect()
+        };
+        let mut series = super::Series::default();
+        let per_axis: [Vec<Vec<f64>>; 3] = std::array::from_fn(chunks);
+        for i in 0..cuts.len() - 1 {
+            series.push(std::array::from_fn(|ax| per_axis[ax][i].clone()));
+        }
+        let got = super::curves(series, 0.01);
+        assert_eq!(got[0], want);
+        assert_eq!(got[0].len(), 13);
+        assert_eq!(overlapping_adev(&y, 0.01), want);
+        let shifted: Vec<f64> = y.iter().map(|v| v + 2.0).collect();
+        assert_eq!(got[2], textbook(&shifted, 0.01));
+    }
 
     /// A curve with its floor inside gives a value with an uncertainty; one still falling at
     /// its longest tau gives only the bound, no value beside its own bound.

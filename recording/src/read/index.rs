@@ -51,7 +51,6 @@ pub(super) struct Times<'a> {
     pub backwards: Option<(usize, f64, f64)>,
     /// Gaps and jitter of the stamps.
     pub cadence: crate::Cadence,
-    block_first: Option<f64>,
     /// Segment starts, ascending.
     starts: &'a [f64],
     first_at: Vec<f64>,
@@ -66,7 +65,6 @@ impl<'a> Times<'a> {
             last: f64::NAN,
             backwards: None,
             cadence: crate::Cadence::default(),
-            block_first: None,
             starts,
             first_at: vec![f64::INFINITY; starts.len()],
             next: 0,
@@ -86,7 +84,6 @@ impl<'a> Times<'a> {
             self.first_at[self.next] = t;
             self.next += 1;
         }
-        self.block_first.get_or_insert(t);
         self.last = t;
         self.rows += 1;
     }
@@ -146,30 +143,54 @@ impl StreamIndex {
     }
 }
 
-/// Block by block through the range parser; `None` when it gives up somewhere.
+/// Blocks parsed at once by [`fast_entries`]: 16 MB of CSV, whose stamps are 2 MB.
+const BATCH: usize = 64;
+
+/// Block by block through the range parser, the blocks of a batch parsed side by side
+/// (two threads) and their stamps then seen in order; `None` when it gives up somewhere.
 fn fast_entries(
     path: &Path,
     only_t: &Layout,
     len: u64,
     times: &mut Times,
 ) -> Option<Vec<(u64, f64)>> {
+    let starts: Vec<u64> = (only_t.data_start..len).step_by(BLOCK as usize).collect();
+    let stamps = |a: u64| -> Option<Vec<f64>> {
+        let mut s = Stamps(Vec::new());
+        scan::scan_range(path, only_t, a, (a + BLOCK).min(len), &mut s).ok()?;
+        Some(s.0)
+    };
     let mut entries = Vec::new();
-    let mut a = only_t.data_start;
-    while a < len {
-        let b = (a + BLOCK).min(len);
-        times.block_first = None;
-        scan::scan_range(path, only_t, a, b, times).ok()?;
-        if let Some(t) = times.block_first {
-            let at = if entries.is_empty() {
-                only_t.data_start
-            } else {
-                a
-            };
-            entries.push((at, t));
+    for batch in starts.chunks(BATCH) {
+        let (one, two) = batch.split_at(batch.len() / 2);
+        let (one, two) = std::thread::scope(|sc| {
+            let h = sc.spawn(|| two.iter().map(|&a| stamps(a)).collect::<Option<Vec<_>>>());
+            let one = one.iter().map(|&a| stamps(a)).collect::<Option<Vec<_>>>();
+            (one, h.join().expect("index thread"))
+        });
+        for (&a, block) in batch.iter().zip(one?.into_iter().chain(two?)) {
+            if let Some(&t) = block.first() {
+                let at = if entries.is_empty() {
+                    only_t.data_start
+                } else {
+                    a
+                };
+                entries.push((at, t));
+            }
+            block.into_iter().for_each(|t| times.see(t));
         }
-        a = b;
     }
     Some(entries)
+}
+
+/// The stamps the range parser hands over, in order.
+struct Stamps(Vec<f64>);
+
+impl RowSink for Stamps {
+    #[inline]
+    fn push(&mut self, r: &[f64; MAX_SLOTS]) {
+        self.0.push(r[0]);
+    }
 }
 
 /// The exact reader over the whole file (it is read once, whole: a file the fast path
