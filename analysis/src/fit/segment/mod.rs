@@ -173,6 +173,7 @@ pub(crate) fn pass<S: Source>(src: &S, job: &Job) -> Result<(Summary, SegAcc), S
             allan: (job.allan && job.prep.is_some()).then(Default::default),
             raw: RawSums::default(),
         },
+        step: None,
     };
     for i in a..b {
         let (c0, c1) = cut.window(i);
@@ -265,6 +266,16 @@ struct Window<'a> {
     seg: &'a Segment,
     acc: Accumulator<'a>,
     sum: Summary,
+    /// The feedback step the last stamp fell in.
+    step: Option<Step>,
+}
+
+/// What the synchronisation reads of one feedback step: its angles' increments, deg.
+#[derive(Debug, Clone, Copy)]
+struct Step {
+    j: usize,
+    d_outer: f64,
+    d_inner: f64,
 }
 
 impl Window<'_> {
@@ -352,6 +363,11 @@ impl Window<'_> {
             }
         }
         // The raw rows against their references, for the sanity checks.
+        // At rest the references are the window's one set (they do not read the time).
+        let raw_ref = |i: usize| match (&refs, constant) {
+            (Refs::PerRow(_), _) | (_, Some(_)) => [0, 1, 2, 3, 4, 5].map(|c| refs.at(c, i)),
+            _ => reference(&sig_at(i)),
+        };
         for i in ca..cb {
             let out = [0, 1, 2, 3, 4, 5].map(|c| {
                 if c < 3 {
@@ -360,7 +376,7 @@ impl Window<'_> {
                     v.gyro[c - 3][i]
                 }
             });
-            self.sum.raw.add(out, reference(&sig_at(i)));
+            self.sum.raw.add(out, raw_ref(i));
         }
         // The window's own rows, into the fit and the sums.
         let temp_at = |i: usize| v.temp.map_or(f64::NAN, |x| x[i]);
@@ -400,17 +416,28 @@ impl Window<'_> {
     /// The synchronisation of the stamp `t` in feedback step `j` at fraction `w`.
     fn see_sync(&mut self, tab: &TableStream, j: usize, w: f64, t: f64) {
         let (t0, t1) = (tab.t[j], tab.t[j + 1]);
-        let gap = t1 - t0;
+        // What depends on the feedback step alone, once a step (a 1 kHz IMU sees each
+        // 100 Hz step ten times).
+        if self.step.is_none_or(|s| s.j != j) {
+            let gap = t1 - t0;
+            let acc_o = prep::rate_derivative(&tab.t, &tab.outer_rate, j);
+            let acc_i = prep::rate_derivative(&tab.t, &tab.inner_rate, j);
+            let max_acc = acc_o.abs().max(acc_i.abs());
+            let sync = &mut self.sum.sync;
+            sync.max_gap_s = sync.max_gap_s.max(gap);
+            sync.max_angle_error_deg = sync.max_angle_error_deg.max(gap * gap / 8.0 * max_acc);
+            self.step = Some(Step {
+                j,
+                d_outer: prep::unwrap(tab.outer[j + 1] - tab.outer[j]),
+                d_inner: prep::unwrap(tab.inner[j + 1] - tab.inner[j]),
+            });
+        }
+        let step = self.step.expect("set above");
         let sync = &mut self.sum.sync;
-        sync.max_gap_s = sync.max_gap_s.max(gap);
         sync.max_sync_error_s = sync
             .max_sync_error_s
             .max((t - t0).abs().min((t1 - t).abs()));
-        let acc_o = prep::rate_derivative(&tab.t, &tab.outer_rate, j);
-        let acc_i = prep::rate_derivative(&tab.t, &tab.inner_rate, j);
-        let max_acc = acc_o.abs().max(acc_i.abs());
-        sync.max_angle_error_deg = sync.max_angle_error_deg.max(gap * gap / 8.0 * max_acc);
-        self.sum.angle_sums.0 += tab.outer[j] + w * prep::unwrap(tab.outer[j + 1] - tab.outer[j]);
-        self.sum.angle_sums.1 += tab.inner[j] + w * prep::unwrap(tab.inner[j + 1] - tab.inner[j]);
+        self.sum.angle_sums.0 += tab.outer[j] + w * step.d_outer;
+        self.sum.angle_sums.1 += tab.inner[j] + w * step.d_inner;
     }
 }
