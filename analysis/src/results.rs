@@ -541,6 +541,15 @@ pub struct SyncReport {
     pub max_angle_error_deg: f64,
 }
 
+impl SyncReport {
+    /// Widens the largest gap and errors to cover `other`'s too.
+    pub(crate) fn widen(&mut self, other: &SyncReport) {
+        self.max_gap_s = self.max_gap_s.max(other.max_gap_s);
+        self.max_sync_error_s = self.max_sync_error_s.max(other.max_sync_error_s);
+        self.max_angle_error_deg = self.max_angle_error_deg.max(other.max_angle_error_deg);
+    }
+}
+
 /// Residual statistics of one channel over one segment (observed minus model).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ResidualStats {

@@ -41,7 +41,10 @@ pub(crate) fn verify(
         let seg = &m.segments[*i];
         let w = match (seg.kind, &seg.axis, seg.rate_dps) {
             (SegmentKind::Rate, Some(ax), Some(r)) => Where::Rate(ax.clone(), r),
-            _ => Where::Attitude(s.mean_angles_deg.0, s.mean_angles_deg.1),
+            _ => {
+                let (outer, inner) = s.mean_angles_deg();
+                Where::Attitude(outer, inner)
+            }
         };
         wh.insert(seg.id.clone(), w);
         if seg.kind == SegmentKind::Static

@@ -140,9 +140,7 @@ pub fn analyze_source<S: Source>(
         ..Default::default()
     };
     for s in sums.iter_mut().filter(|s| s.prepared) {
-        sync.max_gap_s = sync.max_gap_s.max(s.sync.max_gap_s);
-        sync.max_sync_error_s = sync.max_sync_error_s.max(s.sync.max_sync_error_s);
-        sync.max_angle_error_deg = sync.max_angle_error_deg.max(s.sync.max_angle_error_deg);
+        sync.widen(&s.sync);
         out.warnings.append(&mut s.warnings);
     }
 
@@ -399,27 +397,26 @@ fn pass_segments<S: Source>(
             windows: None,
         };
         // A long segment's windows side by side (a verification segment's statistics
-        // are kept whole).
+        // are kept whole), each weighed by the time it covers.
+        let dur = m.segments[i].t_end - m.segments[i].t_start;
         let k = segment::windows(src, &job);
         match opts.parallel_windows && k > 1 && !verify {
-            true => jobs.extend((0..k).map(|w| segment::Job {
-                windows: Some((w, w + 1)),
-                ..job
+            true => jobs.extend((0..k).map(|w| {
+                let piece = segment::Job {
+                    windows: Some((w, w + 1)),
+                    ..job
+                };
+                (piece, dur / k as f64)
             })),
-            false => jobs.push(job),
+            false => jobs.push((job, dur)),
         }
     }
     // Longest first, so that the work stealing balances.
-    let dur = |j: &segment::Job| {
-        let seg = &m.segments[j.seg];
-        let windows = j.windows.map_or(1, |_| segment::windows(src, j));
-        (seg.t_end - seg.t_start) / windows as f64
-    };
     let mut order: Vec<usize> = (0..jobs.len()).collect();
-    order.sort_by(|&a, &b| dur(&jobs[b]).total_cmp(&dur(&jobs[a])));
+    order.sort_by(|&a, &b| jobs[b].1.total_cmp(&jobs[a].1));
     let mut passed: Vec<(usize, (Summary, SegAcc))> = order
         .par_iter()
-        .map(|&j| segment::pass(src, &jobs[j]).map(|p| (j, p)))
+        .map(|&j| segment::pass(src, &jobs[j].0).map(|p| (j, p)))
         .collect::<Result<_, _>>()?;
     // The pieces of a segment in order, joined.
     passed.sort_by_key(|p| p.0);

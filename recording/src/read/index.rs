@@ -104,13 +104,6 @@ impl<'a> Times<'a> {
     }
 }
 
-impl RowSink for Times<'_> {
-    #[inline]
-    fn push(&mut self, r: &[f64; MAX_SLOTS]) {
-        self.see(r[0]);
-    }
-}
-
 impl StreamIndex {
     /// Indexes `dir`'s file of stream `S`, feeding every time stamp to `times`.
     pub fn build<S: Stream>(dir: &Path, times: &mut Times) -> Result<Self, RecordingError> {

@@ -83,9 +83,7 @@ pub(crate) struct Summary {
     pub sync: SyncReport,
     /// What could not be done as asked.
     pub warnings: Vec<String>,
-    /// Mean feedback angles (outer, inner) at the IMU stamps, deg.
-    pub mean_angles_deg: (f64, f64),
-    /// The feedback angles' sums behind the means.
+    /// The feedback angles (outer, inner) summed over the IMU stamps, deg.
     angle_sums: (f64, f64),
     /// Median IMU step of the first window, s.
     pub step_s: f64,
@@ -166,7 +164,6 @@ pub(crate) fn pass<S: Source>(src: &S, job: &Job) -> Result<(Summary, SegAcc), S
             temp_range: None,
             sync: SyncReport::default(),
             warnings: Vec::new(),
-            mean_angles_deg: (0.0, 0.0),
             angle_sums: (0.0, 0.0),
             step_s: f64::NAN,
             channels: Default::default(),
@@ -185,16 +182,15 @@ pub(crate) fn pass<S: Source>(src: &S, job: &Job) -> Result<(Summary, SegAcc), S
         let last = i + 1 == cut.k && cut.s1 >= seg.t_end;
         src.rows(r0, r1, |v| w.window(&mut kin, v, c0, c1, last))?;
     }
-    let Window { acc, mut sum, .. } = w;
-    sum.mean_angles();
+    let Window { acc, sum, .. } = w;
     Ok((sum, acc.finish()))
 }
 
 impl Summary {
-    /// The mean angles from their sums.
-    fn mean_angles(&mut self) {
+    /// Mean feedback angles (outer, inner) at the IMU stamps, deg.
+    pub(crate) fn mean_angles_deg(&self) -> (f64, f64) {
         let n = self.rows.max(1) as f64;
-        self.mean_angles_deg = (self.angle_sums.0 / n, self.angle_sums.1 / n);
+        (self.angle_sums.0 / n, self.angle_sums.1 / n)
     }
 
     /// Adds the summary of the windows that follow this one's in the same segment.
@@ -213,13 +209,9 @@ impl Summary {
             (Some(a), Some(b)) => Some((a.0.min(b.0), a.1.max(b.1))),
             (a, b) => a.or(b),
         };
-        let (s, l) = (&mut self.sync, &later.sync);
-        s.max_gap_s = s.max_gap_s.max(l.max_gap_s);
-        s.max_sync_error_s = s.max_sync_error_s.max(l.max_sync_error_s);
-        s.max_angle_error_deg = s.max_angle_error_deg.max(l.max_angle_error_deg);
+        self.sync.widen(&later.sync);
         self.angle_sums.0 += later.angle_sums.0;
         self.angle_sums.1 += later.angle_sums.1;
-        self.mean_angles();
         for (c, l) in self.channels.iter_mut().zip(&later.channels) {
             c.merge(l);
         }
