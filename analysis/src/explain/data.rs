@@ -25,7 +25,7 @@ pub(crate) struct Data {
     pub probes: Vec<(usize, &'static Probe)>,
     /// Layout index of the Earth's rate as explain tries it ([`super::earth`]).
     pub earth: usize,
-    /// The channels' factors merged over the segment sets fitted so far: explain fits
+    /// What fits over each segment set share, for the sets fitted so far: explain fits
     /// hundreds of models over a handful of sets.
     pub merged: Merged,
     /// The timing error the signals were evaluated with: the timing columns
@@ -78,7 +78,7 @@ pub(crate) fn has_table_feedback(m: &crate::recording::Manifest) -> bool {
 pub(crate) type Merged = std::sync::Mutex<
     Vec<(
         (Vec<usize>, Vec<usize>),
-        std::sync::Arc<Vec<nalgebra::DMatrix<f64>>>,
+        std::sync::Arc<crate::fit::joint::Pooled>,
     )>,
 >;
 
@@ -187,7 +187,7 @@ impl Data {
         &self,
         accel: &[usize],
         gyro: &[usize],
-    ) -> std::sync::Arc<Vec<nalgebra::DMatrix<f64>>> {
+    ) -> std::sync::Arc<crate::fit::joint::Pooled> {
         let key = (accel.to_vec(), gyro.to_vec());
         if let Some(m) = self
             .merged
@@ -207,7 +207,7 @@ impl Data {
             merged: None,
             wander: crate::fit::joint::WanderRule::Estimated,
         };
-        let m = std::sync::Arc::new(crate::fit::joint::merge(&req));
+        let m = std::sync::Arc::new(crate::fit::joint::Pooled::of(&req));
         let mut cache = self.merged.lock().expect("not poisoned");
         if cache.len() >= 16 {
             cache.remove(0);

@@ -101,7 +101,7 @@ pub(crate) fn fit_with(
         terms,
         accel,
         gyro,
-        Some(&merged),
+        Some(merged.as_ref()),
         wander,
     );
     tilt_as_nuisance(data, &mut f);

@@ -73,8 +73,11 @@ impl SegAcc {
     pub(crate) fn block_sums(&self, c: usize, nonzero: &[(usize, f64)]) -> Vec<f64> {
         let cols = self.columns(c);
         let mut s = cols.sy.clone();
+        let n = s.len();
+        // Column-major: a column is a slice (no strided iterator in the loop).
+        let sx = cols.sx.as_slice();
         for &(k, th) in nonzero {
-            for (s, x) in s.iter_mut().zip(cols.sx.column(k).iter()) {
+            for (s, x) in s.iter_mut().zip(&sx[k * n..(k + 1) * n]) {
                 *s -= x * th;
             }
         }

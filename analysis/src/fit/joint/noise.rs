@@ -128,36 +128,57 @@ pub(crate) fn random_walk_gram(
     local: &[Option<usize>],
     p: usize,
 ) -> DMatrix<f64> {
+    // The channel's columns in the model: the model holds few of them, so the walk is
+    // summed over those alone and scattered into the model's `p x p` at the end.
+    let used = used_columns(local);
+    let ks: Vec<usize> = used.iter().map(|u| u.0).collect();
+    let small = walk_lower(accs, c, &ks);
+    let at: Vec<(usize, usize)> = (used.iter().enumerate())
+        .map(|(i, &(_, l))| (i, l))
+        .collect();
+    scatter_lower(&small, &at, p)
+}
+
+/// `(column within the channel, model column)` of the channel's columns the model holds.
+pub(crate) fn used_columns(local: &[Option<usize>]) -> Vec<(usize, usize)> {
+    (local.iter().enumerate())
+        .filter_map(|(k, l)| Some((k, (*l)?)))
+        .collect()
+}
+
+/// The walk's Gram over channel `c`'s columns `ks`, lower triangle only: entry `(i, j)` is
+/// the same sum of the same products in the same order whichever other columns are
+/// asked for, so a Gram over all of a channel's columns holds every model's.
+pub(crate) fn walk_lower(accs: &[&SegAcc], c: usize, ks: &[usize]) -> DMatrix<f64> {
     // (time, segment, block) in time order.
     let mut blocks: Vec<(f64, usize, usize)> = (accs.iter().enumerate())
         .flat_map(|(s, a)| a.blocks.iter().enumerate().map(move |(i, b)| (b.t, s, i)))
         .collect();
     blocks.sort_by(|a, b| a.0.total_cmp(&b.0));
     let sums: Vec<&DMatrix<f64>> = accs.iter().map(|a| a.block_regressors(c)).collect();
-    // The channel's columns in the model: the model holds few of them, so the walk is
-    // summed over those alone and scattered into the model's `p x p` at the end.
-    let used: Vec<(usize, usize)> = local
-        .iter()
-        .enumerate()
-        .filter_map(|(k, l)| Some((k, (*l)?)))
-        .collect();
-    let u = used.len();
+    let u = ks.len();
     let mut small = DMatrix::zeros(u, u);
     let mut suffix = DVector::zeros(u);
     // Walk backwards: suffix sums of the regressors after each gap.
     for w in (1..blocks.len()).rev() {
         let (t, s, b) = blocks[w];
-        for (i, &(k, _)) in used.iter().enumerate() {
+        for (i, &k) in ks.iter().enumerate() {
             suffix[i] += sums[s][(b, k)];
         }
         let gap = t - blocks[w - 1].0;
         small.syger(gap, &suffix, &suffix, 1.0);
     }
+    small
+}
+
+/// A `p x p` symmetric matrix from the lower triangle `lower`: `at` pairs a row of
+/// `lower` with a model column.
+pub(crate) fn scatter_lower(lower: &DMatrix<f64>, at: &[(usize, usize)], p: usize) -> DMatrix<f64> {
     let mut m = DMatrix::zeros(p, p);
-    for (i, &(_, li)) in used.iter().enumerate() {
-        for (j, &(_, lj)) in used.iter().enumerate() {
+    for &(i, li) in at {
+        for &(j, lj) in at {
             // `syger` fills the lower triangle only.
-            m[(li, lj)] = if i >= j { small[(i, j)] } else { small[(j, i)] };
+            m[(li, lj)] = if i >= j { lower[(i, j)] } else { lower[(j, i)] };
         }
     }
     m

@@ -22,9 +22,9 @@ pub(crate) struct FitRequest<'a> {
     pub accel: Vec<&'a SegAcc>,
     /// Segments fitted for the gyros.
     pub gyro: Vec<&'a SegAcc>,
-    /// The channels' factors over exactly these segments, when the caller keeps them
-    /// ([`merge`]): many models over the same segments then share one merge.
-    pub merged: Option<&'a [DMatrix<f64>]>,
+    /// What every fit over exactly these segments shares, when the caller keeps it
+    /// ([`Pooled`]): many models over the same segments then share one merge.
+    pub merged: Option<&'a Pooled>,
     /// How the covariance takes the wandering bias.
     pub wander: WanderRule,
 }
@@ -76,11 +76,31 @@ impl FitRequest<'_> {
     }
 }
 
-/// Every channel's factor over the request's segments, for [`FitRequest::merged`].
-pub(crate) fn merge(req: &FitRequest) -> Vec<DMatrix<f64>> {
-    (0..6)
-        .map(|c| merged(req.segs(c), c, req.layout.by_channel[c].len() + 1))
-        .collect()
+/// What every fit over one set of segments shares ([`FitRequest::merged`]): each
+/// channel's factor over them, and the random walk's Gram over all of a channel's columns
+/// (made at the first fit that asks for it), of which a model's is a part.
+#[derive(Debug)]
+pub(crate) struct Pooled {
+    factors: Vec<DMatrix<f64>>,
+    walks: [std::sync::OnceLock<DMatrix<f64>>; 6],
+}
+
+impl Pooled {
+    /// The request's segments merged per channel.
+    pub(crate) fn of(req: &FitRequest) -> Self {
+        Pooled {
+            factors: (0..6)
+                .map(|c| merged(req.segs(c), c, req.layout.by_channel[c].len() + 1))
+                .collect(),
+            walks: Default::default(),
+        }
+    }
+
+    /// Channel `c`'s walk Gram (lower triangle) over `segs`, the segments it was made of.
+    fn walk(&self, segs: &[&SegAcc], c: usize, width: usize) -> &DMatrix<f64> {
+        let all: Vec<usize> = (0..width).collect();
+        self.walks[c].get_or_init(|| noise::walk_lower(segs, c, &all))
+    }
 }
 
 /// The channel's factor over a set of segments.
@@ -117,7 +137,7 @@ pub(crate) fn solve(req: &FitRequest) -> Fit {
         .map(|c| {
             let w = lay.by_channel[c].len() + 1;
             match req.merged {
-                Some(m) => Reduced::of(&m[c], lay, c, &cols, &theta),
+                Some(m) => Reduced::of(&m.factors[c], lay, c, &cols, &theta),
                 None => Reduced::of(&merged(req.segs(c), c, w), lay, c, &cols, &theta),
             }
         })
@@ -214,7 +234,13 @@ pub(crate) fn solve(req: &FitRequest) -> Fit {
         let white = nz.sigma * nz.sigma * nz.phi;
         meat += (xl.transpose() * &xl) * (w[c] * w[c] * white);
         if nz.q > 0.0 && req.wander != WanderRule::WhiteOnly {
-            let m = noise::random_walk_gram(req.segs(c), c, &local, p);
+            let m = match req.merged {
+                Some(pool) => {
+                    let full = pool.walk(req.segs(c), c, local.len());
+                    noise::scatter_lower(full, &noise::used_columns(&local), p)
+                }
+                None => noise::random_walk_gram(req.segs(c), c, &local, p),
+            };
             meat += m * (w[c] * w[c] * nz.q);
         }
     }

@@ -92,7 +92,7 @@ pub(crate) fn fit_terms_merged(
     terms: &Terms,
     accel: &[usize],
     gyro: &[usize],
-    merged: Option<&[nalgebra::DMatrix<f64>]>,
+    merged: Option<&super::Pooled>,
     wander: WanderRule,
 ) -> (Fit, Vec<usize>) {
     let mut cols = Vec::new();
