@@ -68,6 +68,18 @@ struct BlockColumns {
 }
 
 impl SegAcc {
+    /// An accumulation of these blocks alone (no factor): for tests of what reads blocks.
+    #[cfg(test)]
+    pub(crate) fn of_blocks(seg: usize, blocks: Vec<Block>) -> SegAcc {
+        SegAcc {
+            seg,
+            r: Default::default(),
+            n: blocks.iter().map(|b| b.n).sum(),
+            blocks,
+            columns: Default::default(),
+        }
+    }
+
     /// Per block of channel `c`, the sum of its residuals under the channel's coefficients
     /// `nonzero` (`(column within the channel, coefficient)`, the zero ones left out).
     pub(crate) fn block_sums(&self, c: usize, nonzero: &[(usize, f64)]) -> Vec<f64> {
@@ -156,6 +168,8 @@ pub(crate) struct Accumulator<'l> {
     moving: [Vec<usize>; 6],
     /// Per channel, the positions that keep their value at rest.
     resting: [Vec<usize>; 6],
+    /// Per channel, `(position, layout column)` of the regressors that change at rest.
+    fetch: [Vec<(usize, usize)>; 6],
     /// Samples since the resting columns' values were last added to the block sums.
     pending: usize,
     /// Per sensor, the rows at rest folded once for its three channels ([`Rest`]).
@@ -197,6 +211,13 @@ impl<'l> Accumulator<'l> {
             cur: Self::new_block(layout),
             block_end: t_start + BLOCK_S,
             filled: None,
+            fetch: std::array::from_fn(|c| {
+                let k = positions(c, true);
+                k[..k.len() - 1]
+                    .iter()
+                    .map(|&k| (k, layout.by_channel[c][k]))
+                    .collect()
+            }),
             moving: std::array::from_fn(|c| positions(c, true)),
             resting: std::array::from_fn(|c| positions(c, false)),
             varying: (varying.iter())
@@ -239,23 +260,27 @@ impl<'l> Accumulator<'l> {
         self.pending = 0;
     }
 
-    /// Writes channel `c`'s columns into its row from `parts`: all of them, or only those
-    /// that change at rest.
-    fn write_row(&mut self, c: usize, all: bool) {
+    /// Writes channel `c`'s columns into its row from `parts`, every one of them, and adds
+    /// them to the block's sums.
+    fn write_row(&mut self, c: usize) {
         let (sensor, ax) = channel(c);
         let cols = &self.layout.by_channel[c];
-        let row = &mut self.rows[c];
-        match all {
-            true => {
-                for (k, &g) in cols.iter().enumerate() {
-                    row[k] = self.parts[g].of(sensor)[ax];
-                }
-            }
-            false => {
-                for &k in &self.moving[c][..self.moving[c].len() - 1] {
-                    row[k] = self.parts[cols[k]].of(sensor)[ax];
-                }
-            }
+        let (row, sx) = (&mut self.rows[c], &mut self.cur.sx[c]);
+        for (k, &g) in cols.iter().enumerate() {
+            row[k] = self.parts[g].of(sensor)[ax];
+            sx[k] += row[k];
+        }
+    }
+
+    /// At rest: writes channel `c`'s columns that change at rest into its row from
+    /// `parts`, and adds them to the block's sums.
+    fn write_moving(&mut self, c: usize) {
+        let (sensor, ax) = channel(c);
+        let (row, sx) = (&mut self.rows[c], &mut self.cur.sx[c]);
+        for &(k, g) in &self.fetch[c] {
+            let v = self.parts[g].of(sensor)[ax];
+            row[k] = v;
+            sx[k] += v;
         }
     }
 
@@ -299,19 +324,12 @@ impl<'l> Accumulator<'l> {
             self.filled = Some(motion);
         }
         for c in 0..6 {
-            self.write_row(c, !at_rest);
+            match at_rest {
+                true => self.write_moving(c),
+                false => self.write_row(c),
+            }
             let last = self.rows[c].len() - 1;
             self.rows[c][last] = out[c];
-            let (row, sx) = (&self.rows[c], &mut self.cur.sx[c]);
-            if at_rest {
-                for &k in &self.moving[c][..self.moving[c].len() - 1] {
-                    sx[k] += row[k];
-                }
-            } else {
-                for (s, v) in sx.iter_mut().zip(&row[..last]) {
-                    *s += v;
-                }
-            }
             self.cur.sy[c] += out[c];
         }
         for s in 0..2 {

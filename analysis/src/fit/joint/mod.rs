@@ -16,7 +16,7 @@ mod tri;
 
 pub(crate) use accumulate::{Accumulator, SegAcc, seg_rss};
 pub(crate) use noise::Whitener;
-pub(crate) use solve::{Fit, FitRequest, WanderRule, Pooled, rss_on, solve};
+pub(crate) use solve::{Fit, FitRequest, Pooled, WanderRule, rss_on, solve};
 pub(crate) use terms::{Terms, excitation, excites, fit_terms, fit_terms_merged, latitude_of};
 
 use ratecal_physics::effects::{Effect, Param, Sensor};

@@ -4,7 +4,7 @@
 //! slowly varying regressors are judged against the low-frequency noise.
 
 use super::accumulate::SegAcc;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 
 /// The noise model of one channel.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -146,9 +146,11 @@ pub(crate) fn used_columns(local: &[Option<usize>]) -> Vec<(usize, usize)> {
         .collect()
 }
 
-/// The walk's Gram over channel `c`'s columns `ks`, lower triangle only: entry `(i, j)` is
-/// the same sum of the same products in the same order whichever other columns are
-/// asked for, so a Gram over all of a channel's columns holds every model's.
+/// The walk's Gram over channel `c`'s columns `ks` (read its lower triangle): the sum over
+/// the gaps between blocks, in time order, of the gap times the outer product of the
+/// regressor sums after it. The suffix sums are laid out one gap to a column and the sum
+/// is one matrix product, so a Gram over all of a channel's columns (every model's Gram
+/// is a part of it) costs what a product of that size does.
 pub(crate) fn walk_lower(accs: &[&SegAcc], c: usize, ks: &[usize]) -> DMatrix<f64> {
     // (time, segment, block) in time order.
     let mut blocks: Vec<(f64, usize, usize)> = (accs.iter().enumerate())
@@ -157,19 +159,35 @@ pub(crate) fn walk_lower(accs: &[&SegAcc], c: usize, ks: &[usize]) -> DMatrix<f6
     blocks.sort_by(|a, b| a.0.total_cmp(&b.0));
     let sums: Vec<&DMatrix<f64>> = accs.iter().map(|a| a.block_regressors(c)).collect();
     let u = ks.len();
-    let mut small = DMatrix::zeros(u, u);
-    let mut suffix = DVector::zeros(u);
+    let mut gram = DMatrix::zeros(u, u);
+    // A chunk of gaps at a time, column `j` the suffix sums after one gap (and the same
+    // times the gap): the product of a chunk is added to the Gram, and the chunk's columns
+    // stay few (an hour at 1 kHz has 3,600 gaps of 80 columns a channel).
+    let mut after = DMatrix::zeros(u, WALK_CHUNK);
+    let mut weighed = DMatrix::zeros(u, WALK_CHUNK);
+    let mut suffix = vec![0.0; u];
+    let mut j = 0;
     // Walk backwards: suffix sums of the regressors after each gap.
     for w in (1..blocks.len()).rev() {
         let (t, s, b) = blocks[w];
+        let gap = t - blocks[w - 1].0;
         for (i, &k) in ks.iter().enumerate() {
             suffix[i] += sums[s][(b, k)];
+            after[(i, j)] = suffix[i];
+            weighed[(i, j)] = gap * suffix[i];
         }
-        let gap = t - blocks[w - 1].0;
-        small.syger(gap, &suffix, &suffix, 1.0);
+        j += 1;
+        if j == WALK_CHUNK || w == 1 {
+            let (a, g) = (after.columns(0, j), weighed.columns(0, j));
+            gram.gemm(1.0, &a, &g.transpose(), 1.0);
+            j = 0;
+        }
     }
-    small
+    gram
 }
+
+/// Gaps per product of the walk's Gram ([`walk_lower`]).
+const WALK_CHUNK: usize = 512;
 
 /// A `p x p` symmetric matrix from the lower triangle `lower`: `at` pairs a row of
 /// `lower` with a model column.
@@ -177,7 +195,7 @@ pub(crate) fn scatter_lower(lower: &DMatrix<f64>, at: &[(usize, usize)], p: usiz
     let mut m = DMatrix::zeros(p, p);
     for &(i, li) in at {
         for &(j, lj) in at {
-            // `syger` fills the lower triangle only.
+            // One triangle for both: the product is symmetric only up to rounding.
             m[(li, lj)] = if i >= j { lower[(i, j)] } else { lower[(j, i)] };
         }
     }
@@ -225,5 +243,79 @@ impl Whitener {
                 nu * inv_s
             })
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::joint::accumulate::Block;
+
+    /// Blocks of one segment at times `t`, channel 3's five regressor sums drawn from `f`.
+    fn segment(seg: usize, t: impl Iterator<Item = f64>, f: impl Fn(f64, usize) -> f64) -> SegAcc {
+        let blocks = t
+            .map(|t| {
+                let mut sx: [Vec<f64>; 6] = Default::default();
+                sx[3] = (0..5).map(|k| f(t, k)).collect();
+                Block {
+                    t,
+                    end: t.ceil(),
+                    n: 100,
+                    sx,
+                    sy: [0.0; 6],
+                }
+            })
+            .collect();
+        SegAcc::of_blocks(seg, blocks)
+    }
+
+    #[test]
+    fn the_walk_gram_is_the_textbook_sum_over_the_gaps_in_time_order() {
+        // Two segments whose blocks interleave in time, over more gaps than a chunk.
+        let a = segment(0, (0..900).map(|i| 0.5 + i as f64), |t, k| {
+            (t * 0.01 * (k + 1) as f64).sin() * 10f64.powi(k as i32)
+        });
+        let b = segment(1, (0..400).map(|i| 0.25 + 2.0 * i as f64), |t, k| {
+            1.0 + t * k as f64 - 3.0 * (k == 4) as u8 as f64
+        });
+        let accs = [&a, &b];
+        // The textbook: every block in time order, the suffix sums after each gap.
+        let mut all: Vec<(f64, Vec<f64>)> = (accs.iter())
+            .flat_map(|s| s.blocks.iter().map(|b| (b.t, b.sx[3].clone())))
+            .collect();
+        all.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let ks = [0, 2, 4];
+        let mut want = DMatrix::<f64>::zeros(3, 3);
+        for w in 1..all.len() {
+            let s: Vec<f64> = ks
+                .iter()
+                .map(|&k| all[w..].iter().map(|b| b.1[k]).sum())
+                .collect();
+            let gap = all[w].0 - all[w - 1].0;
+            for i in 0..3 {
+                for j in 0..3 {
+                    want[(i, j)] += gap * s[i] * s[j];
+                }
+            }
+        }
+        let got = walk_lower(&accs, 3, &ks);
+        for i in 0..3 {
+            for j in 0..=i {
+                let tol = 1e-12 * (want[(i, i)] * want[(j, j)]).sqrt();
+                assert!(
+                    (got[(i, j)] - want[(i, j)]).abs() <= tol,
+                    "{i} {j}: {got} {want}"
+                );
+            }
+        }
+        // A Gram over all five columns holds the three columns' (what a pooled fit reads).
+        let full = walk_lower(&accs, 3, &[0, 1, 2, 3, 4]);
+        let part = scatter_lower(&full, &[(0, 0), (2, 1), (4, 2)], 3);
+        let small = scatter_lower(&got, &[(0, 0), (1, 1), (2, 2)], 3);
+        assert!(
+            (&part - &small).norm() <= 1e-12 * small.norm(),
+            "{part} {small}"
+        );
+        assert_eq!(part, part.transpose());
     }
 }

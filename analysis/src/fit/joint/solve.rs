@@ -82,7 +82,7 @@ impl FitRequest<'_> {
 #[derive(Debug)]
 pub(crate) struct Pooled {
     factors: Vec<DMatrix<f64>>,
-    walks: [std::sync::OnceLock<DMatrix<f64>>; 6],
+    walks: std::sync::OnceLock<Vec<DMatrix<f64>>>,
 }
 
 impl Pooled {
@@ -96,10 +96,23 @@ impl Pooled {
         }
     }
 
-    /// Channel `c`'s walk Gram (lower triangle) over `segs`, the segments it was made of.
-    fn walk(&self, segs: &[&SegAcc], c: usize, width: usize) -> &DMatrix<f64> {
-        let all: Vec<usize> = (0..width).collect();
-        self.walks[c].get_or_init(|| noise::walk_lower(segs, c, &all))
+    /// Every channel's walk Gram (lower triangle) over the request's segments (those the
+    /// pool was made of).
+    fn walks(&self, req: &FitRequest) -> &[DMatrix<f64>] {
+        self.walks.get_or_init(|| {
+            let one = |c: usize| {
+                let all: Vec<usize> = (0..req.layout.by_channel[c].len()).collect();
+                noise::walk_lower(req.segs(c), c, &all)
+            };
+            // The sensors on both cores: the fits that wait for the Gram are blocked, and
+            // plain threads (not the fits' pool) cannot be handed a fit that waits for it.
+            std::thread::scope(|s| {
+                let gyro = s.spawn(|| (3..6).map(one).collect::<Vec<_>>());
+                let mut all: Vec<DMatrix<f64>> = (0..3).map(one).collect();
+                all.extend(gyro.join().expect("the Gram does not panic"));
+                all
+            })
+        })
     }
 }
 
@@ -236,7 +249,7 @@ pub(crate) fn solve(req: &FitRequest) -> Fit {
         if nz.q > 0.0 && req.wander != WanderRule::WhiteOnly {
             let m = match req.merged {
                 Some(pool) => {
-                    let full = pool.walk(req.segs(c), c, local.len());
+                    let full = &pool.walks(req)[c];
                     noise::scatter_lower(full, &noise::used_columns(&local), p)
                 }
                 None => noise::random_walk_gram(req.segs(c), c, &local, p),
