@@ -199,6 +199,12 @@ impl<'l> Accumulator<'l> {
             }
             v
         };
+        let moving: [Vec<usize>; 6] = std::array::from_fn(|c| positions(c, true));
+        // The regressors among them (the observation, last, is not fetched).
+        let fetch = std::array::from_fn(|c| {
+            let k = &moving[c][..moving[c].len() - 1];
+            k.iter().map(|&k| (k, layout.by_channel[c][k])).collect()
+        });
         Accumulator {
             seg,
             layout,
@@ -211,14 +217,8 @@ impl<'l> Accumulator<'l> {
             cur: Self::new_block(layout),
             block_end: t_start + BLOCK_S,
             filled: None,
-            fetch: std::array::from_fn(|c| {
-                let k = positions(c, true);
-                k[..k.len() - 1]
-                    .iter()
-                    .map(|&k| (k, layout.by_channel[c][k]))
-                    .collect()
-            }),
-            moving: std::array::from_fn(|c| positions(c, true)),
+            fetch,
+            moving,
             resting: std::array::from_fn(|c| positions(c, false)),
             varying: (varying.iter())
                 .map(|&e| (layout.effects[e], layout.columns_of(e)))
