@@ -29,6 +29,9 @@ pub struct End<'a> {
     pub key: Option<&'a SigningKey>,
     /// The lab's archive (`--archive`), whose history of the unit the report uses.
     pub archive: Option<&'a str>,
+    /// The streams hashed as they were written (`RecordingWriter::written`): the seal reads
+    /// them again only if their length changed.
+    pub written: &'a [ratecal_recording::WrittenFile],
 }
 
 impl End<'_> {
@@ -124,7 +127,7 @@ impl End<'_> {
                 outln!("  warning: {w}");
             }
         }
-        if let Err(e) = ratecal_folder::sealing::write(dir, self.key) {
+        if let Err(e) = ratecal_folder::sealing::write_known(dir, self.key, self.written) {
             errln!("cannot seal {}: {e}", dir.display());
             self.warn_not_at_rest();
             return 1;

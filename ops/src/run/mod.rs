@@ -229,6 +229,13 @@ fn execute_prepared(
             .await,
         )
     });
+    // The streams' hashes as written: the seal takes them instead of reading the files again
+    // (a staged resume's files are committed first, so those are read).
+    let written = if staged {
+        Vec::new()
+    } else {
+        writer.written().to_vec()
+    };
     // The recording is closed before anything reads it back (or records a failure).
     drop(writer);
     let outcome = outcome?;
@@ -257,6 +264,7 @@ fn execute_prepared(
         simulated,
         key,
         archive,
+        written: &written,
     };
     Ok(end.finish())
 }
