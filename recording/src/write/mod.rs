@@ -8,6 +8,7 @@
 
 mod fixed;
 mod streams;
+mod writeback;
 
 pub use fixed::push_fixed;
 pub use streams::Columns;

@@ -3,6 +3,7 @@
 //! sample batches over.
 
 use super::fixed::Line;
+use super::writeback::{WRITEBACK, Writeback};
 use crate::chain::{BlockRecord, CHAIN_START, Chain, check_stream};
 use crate::{ImuSample, TableSample, WriteFailure};
 use sha2::{Digest, Sha256};
@@ -95,6 +96,9 @@ pub(crate) struct Stream {
     /// no journal (an import), where it would be hashing for nothing.
     pub(crate) chained: bool,
     written: u64,
+    /// The early syncs of the file (`None` if its thread could not start) and the length
+    /// at the last one asked for.
+    writeback: Option<(Writeback, u64)>,
     pub(crate) last_t: Option<f64>,
     /// The stamp of the last row on disk (what a failed write leaves).
     written_t: Option<f64>,
@@ -112,6 +116,7 @@ impl Stream {
             chain,
             chained: true,
             written,
+            writeback: Writeback::start(path).map(|w| (w, written)),
             last_t: None,
             written_t: None,
             failure: None,
@@ -221,6 +226,12 @@ impl Stream {
         }
         self.buf.clear();
         let Some(e) = failed else {
+            if let Some((w, asked)) = &mut self.writeback
+                && self.written - *asked >= WRITEBACK
+            {
+                w.ask();
+                *asked = self.written;
+            }
             return Ok(());
         };
         let cut = (done - keep) as u64;
