@@ -92,25 +92,11 @@ impl TemperatureSeries {
         series
     }
 
-    /// The same from a recording read a window at a time (every row's `temp` is seen
-    /// once; the kept ones are every n-th of the whole stream, as in memory).
+    /// The same from a recording read a window at a time, or only its `t` and `temp` cells
+    /// (the kept rows are every n-th of the whole stream, as in memory).
     pub fn from_source<S: Source>(src: &S) -> Result<Self, S::Error> {
         let step = |n: usize| n.div_ceil(TEMPERATURE_POINTS).max(1);
-        let every = step(src.imu_rows());
-        let mut imu = Vec::new();
-        let mut row = 0usize;
-        if src.has_temp() {
-            src.windows(ratecal_analysis::fit::WINDOW_ROWS, |v| {
-                if let Some(temp) = v.temp {
-                    for (t, c) in v.t.iter().zip(temp) {
-                        if row.is_multiple_of(every) {
-                            imu.push((*t, *c));
-                        }
-                        row += 1;
-                    }
-                }
-            })?;
-        }
+        let imu = src.temp_every(step(src.imu_rows()))?;
         let tab = src.table();
         let ambient = tab
             .ambient

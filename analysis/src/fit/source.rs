@@ -70,6 +70,29 @@ pub trait Source: Sync {
     /// size effect's cycles, from the static blocks before them).
     fn recording(&self) -> Result<Cow<'_, Recording>, Self::Error>;
 
+    /// Every `every`-th IMU row's `(t, temp)`, counting from the first row: empty without
+    /// the column. As [`Source::windows`] sees them; a source may read the two cells alone.
+    fn temp_every(&self, every: usize) -> Result<Vec<(f64, f64)>, Self::Error>
+    where
+        Self: Sized,
+    {
+        let every = every.max(1);
+        let (mut kept, mut row) = (Vec::new(), 0usize);
+        if self.has_temp() {
+            self.windows(super::WINDOW_ROWS, |v| {
+                if let Some(temp) = v.temp {
+                    for (t, c) in v.t.iter().zip(temp) {
+                        if row.is_multiple_of(every) {
+                            kept.push((*t, *c));
+                        }
+                        row += 1;
+                    }
+                }
+            })?;
+        }
+        Ok(kept)
+    }
+
     /// Hands `f` every IMU row once, in order, a window of about `rows` rows at a time.
     fn windows(&self, rows: usize, mut f: impl FnMut(ImuView<'_>)) -> Result<(), Self::Error>
     where
@@ -205,6 +228,10 @@ impl Source for Streamed {
         }
         let t = self.open.imu_mean_temp()?.unwrap_or(0.0);
         Ok(*self.mean_temp.get_or_init(|| t))
+    }
+
+    fn temp_every(&self, every: usize) -> Result<Vec<(f64, f64)>, RecordingError> {
+        Ok(self.open.imu_temp_every(every)?.unwrap_or_default())
     }
 
     fn rows<R>(

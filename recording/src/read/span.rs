@@ -175,6 +175,66 @@ impl OpenRecording {
         }
         Ok(sum.mean())
     }
+
+    /// Every `every`-th IMU row's `(t, temp)`, counting from the first row (`None` without
+    /// the column): one pass that parses those two cells of each line alone, for a plot of
+    /// the temperature over the run (the rows a window-by-window pass would keep).
+    pub fn imu_temp_every(&self, every: usize) -> Result<Option<Vec<(f64, f64)>>, RecordingError> {
+        if !self.imu.optional {
+            return Ok(None);
+        }
+        let every = every.max(1);
+        let slot = ImuStream::REQUIRED.len();
+        if let Some(full) = &self.imu.fast {
+            let want = full.want.iter();
+            let layout = Layout {
+                want: want
+                    .map(|&w| if w == 0 || w == slot { w } else { SKIP })
+                    .collect(),
+                data_start: full.data_start,
+                lazy_tail: true,
+            };
+            let (from, to) = (self.imu.head_end, self.imu.len);
+            let mut kept = TempEvery::new(slot, every);
+            if scan::scan_range(&self.imu.path, &layout, from, to, &mut kept).is_ok() {
+                return Ok(Some(kept.kept));
+            }
+        }
+        // The exact reader, whole (it locates a bad cell).
+        let all = self.read_imu_span(f64::NEG_INFINITY, f64::INFINITY)?;
+        let temp = all.temp.unwrap_or_default();
+        let rows = all.t.iter().zip(&temp).step_by(every);
+        Ok(Some(rows.map(|(t, c)| (*t, *c)).collect()))
+    }
+}
+
+/// Keeps every n-th row's time and temperature the range parser hands over.
+struct TempEvery {
+    slot: usize,
+    every: usize,
+    row: usize,
+    kept: Vec<(f64, f64)>,
+}
+
+impl TempEvery {
+    fn new(slot: usize, every: usize) -> Self {
+        TempEvery {
+            slot,
+            every,
+            row: 0,
+            kept: Vec::new(),
+        }
+    }
+}
+
+impl RowSink for TempEvery {
+    #[inline]
+    fn push(&mut self, r: &[f64; MAX_SLOTS]) {
+        if self.row.is_multiple_of(self.every) {
+            self.kept.push((r[0], r[self.slot]));
+        }
+        self.row += 1;
+    }
 }
 
 /// Sums the finite temperatures the range parser hands over.

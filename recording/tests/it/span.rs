@@ -297,3 +297,39 @@ fn the_mean_temperature_from_its_cells_alone() {
     let open = Recording::open(tmp.path()).unwrap();
     assert_eq!(render(&open.imu_mean_temp().unwrap_err()), whole);
 }
+
+/// Every n-th row's time and temperature read from those two cells alone: the whole read's
+/// rows (every line ending), `None` without the column, and a bad `temp` cell refused as a
+/// whole read refuses it (the exact reader takes over and names it).
+#[test]
+fn every_nth_temperature_from_its_cells_alone() {
+    let [m, imu, table] = synthetic(40_000);
+    let mut warm = String::from("t,ax,ay,az,gx,gy,gz,temp\n");
+    for (i, line) in imu.lines().skip(1).enumerate() {
+        let cut = line.rfind(',').unwrap();
+        warm += &format!("{},{:.2}\n", &line[..cut], 20.0 + (i % 1000) as f64 / 100.0);
+    }
+    for ends in ["\n", "\r\n"] {
+        let tmp = variant(&[m.clone(), warm.clone(), table.clone()], ends);
+        let whole = recording::read(tmp.path()).unwrap();
+        let temps = whole.imu.temp.as_ref().unwrap();
+        let open = Recording::open(tmp.path()).unwrap();
+        for every in [1, 7, 20, 39_999, 40_000, 100_000] {
+            let want: Vec<(f64, f64)> = (0..temps.len())
+                .step_by(every)
+                .map(|i| (whole.imu.t[i], temps[i]))
+                .collect();
+            let got = open.imu_temp_every(every).unwrap().unwrap();
+            assert_eq!(got, want, "{ends:?}, every {every}");
+        }
+    }
+    let no_temp = imu.replace(",temp\n", "\n").replace(",22.5\n", "\n");
+    let tmp = variant(&[m.clone(), no_temp, table.clone()], "\n");
+    let open = Recording::open(tmp.path()).unwrap();
+    assert_eq!(open.imu_temp_every(10).unwrap(), None);
+    let bad = warm.replacen(",20.50\n", ",2O.50\n", 1);
+    let tmp = variant(&[m, bad, table], "\n");
+    let whole = render(&recording::read(tmp.path()).unwrap_err());
+    let open = Recording::open(tmp.path()).unwrap();
+    assert_eq!(render(&open.imu_temp_every(10).unwrap_err()), whole);
+}
