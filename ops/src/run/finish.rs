@@ -248,10 +248,17 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
         stated: ratecal_certificate::stated_of_folder(dir),
         ..Options::default()
     };
-    let mut results = analyze_source(&rec, Some(plan), &opts)
-        .map_err(unreadable)
-        .ok()?;
-    let temperature = ratecal_render::TemperatureSeries::from_source(&rec)
+    // The report's temperature plot is read beside the analysis: its one pass over two
+    // cells of each line fills the analysis's single-threaded stretches.
+    let (results, temperature) = std::thread::scope(|s| {
+        let temperature = s.spawn(|| ratecal_render::TemperatureSeries::from_source(&rec));
+        let results = analyze_source(&rec, Some(plan), &opts);
+        (results, temperature.join())
+    });
+    let mut results = results.map_err(unreadable).ok()?;
+    let temperature = temperature
+        .map_err(|_| errln!("no analysis: the temperature plot's reader stopped"))
+        .ok()?
         .map_err(unreadable)
         .ok()?;
     let run_warnings = journal_warnings(dir);
