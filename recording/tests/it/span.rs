@@ -261,18 +261,25 @@ fn opening_refuses_what_a_whole_read_refuses() {
     ));
 }
 
-/// The mean IMU temperature read from the `temp` cells alone: the whole read's mean (over
-/// a large enough file that the two halves it is read in both hold rows), `None` without
-/// the column, and a bad `temp` cell refused as a whole read refuses it.
-#[test]
-fn the_mean_temperature_from_its_cells_alone() {
-    let [m, imu, table] = synthetic(40_000);
-    // A temperature that varies: row i reads 20 + (i mod 1000) / 100.
+/// `imu` (a synthetic stream) with a temperature that varies: row i reads
+/// 20 + (i mod 1000) / 100.
+fn warming(imu: &str) -> String {
     let mut warm = String::from("t,ax,ay,az,gx,gy,gz,temp\n");
     for (i, line) in imu.lines().skip(1).enumerate() {
         let cut = line.rfind(',').unwrap();
         warm += &format!("{},{:.2}\n", &line[..cut], 20.0 + (i % 1000) as f64 / 100.0);
     }
+    warm
+}
+
+/// The temperature read from the `t` and `temp` cells alone: the mean is the whole read's
+/// (over a large enough file that the two halves it is read in both hold rows), every n-th
+/// row is the whole read's rows (every line ending); `None` without the column; a bad
+/// `temp` cell refused as a whole read refuses it (the exact reader takes over and names it).
+#[test]
+fn the_temperature_from_its_cells_alone() {
+    let [m, imu, table] = synthetic(40_000);
+    let warm = warming(&imu);
     for ends in ["\n", "\r\n"] {
         let tmp = variant(&[m.clone(), warm.clone(), table.clone()], ends);
         let whole = recording::read(tmp.path()).unwrap();
@@ -281,39 +288,6 @@ fn the_mean_temperature_from_its_cells_alone() {
         let open = Recording::open(tmp.path()).unwrap();
         let got = open.imu_mean_temp().unwrap().unwrap();
         assert!((got - want).abs() < 1e-9, "{ends:?}: {got} vs {want}");
-    }
-    let no_temp = imu.replace(",temp\n", "\n").replace(",22.5\n", "\n");
-    let tmp = variant(&[m.clone(), no_temp, table.clone()], "\n");
-    assert_eq!(
-        Recording::open(tmp.path())
-            .unwrap()
-            .imu_mean_temp()
-            .unwrap(),
-        None
-    );
-    let bad = warm.replacen(",20.50\n", ",2O.50\n", 1);
-    let tmp = variant(&[m, bad, table], "\n");
-    let whole = render(&recording::read(tmp.path()).unwrap_err());
-    let open = Recording::open(tmp.path()).unwrap();
-    assert_eq!(render(&open.imu_mean_temp().unwrap_err()), whole);
-}
-
-/// Every n-th row's time and temperature read from those two cells alone: the whole read's
-/// rows (every line ending), `None` without the column, and a bad `temp` cell refused as a
-/// whole read refuses it (the exact reader takes over and names it).
-#[test]
-fn every_nth_temperature_from_its_cells_alone() {
-    let [m, imu, table] = synthetic(40_000);
-    let mut warm = String::from("t,ax,ay,az,gx,gy,gz,temp\n");
-    for (i, line) in imu.lines().skip(1).enumerate() {
-        let cut = line.rfind(',').unwrap();
-        warm += &format!("{},{:.2}\n", &line[..cut], 20.0 + (i % 1000) as f64 / 100.0);
-    }
-    for ends in ["\n", "\r\n"] {
-        let tmp = variant(&[m.clone(), warm.clone(), table.clone()], ends);
-        let whole = recording::read(tmp.path()).unwrap();
-        let temps = whole.imu.temp.as_ref().unwrap();
-        let open = Recording::open(tmp.path()).unwrap();
         for every in [1, 7, 20, 39_999, 40_000, 100_000] {
             let want: Vec<(f64, f64)> = (0..temps.len())
                 .step_by(every)
@@ -326,10 +300,12 @@ fn every_nth_temperature_from_its_cells_alone() {
     let no_temp = imu.replace(",temp\n", "\n").replace(",22.5\n", "\n");
     let tmp = variant(&[m.clone(), no_temp, table.clone()], "\n");
     let open = Recording::open(tmp.path()).unwrap();
+    assert_eq!(open.imu_mean_temp().unwrap(), None);
     assert_eq!(open.imu_temp_every(10).unwrap(), None);
     let bad = warm.replacen(",20.50\n", ",2O.50\n", 1);
     let tmp = variant(&[m, bad, table], "\n");
     let whole = render(&recording::read(tmp.path()).unwrap_err());
     let open = Recording::open(tmp.path()).unwrap();
+    assert_eq!(render(&open.imu_mean_temp().unwrap_err()), whole);
     assert_eq!(render(&open.imu_temp_every(10).unwrap_err()), whole);
 }
