@@ -251,7 +251,8 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
     // The report's temperature plot is read beside the analysis: its one pass over two
     // cells of each line fills the analysis's single-threaded stretches.
     let (results, temperature) = std::thread::scope(|s| {
-        let temperature = s.spawn(|| ratecal_render::TemperatureSeries::from_source(&rec));
+        let temperature =
+            s.spawn(|| ratecal_render::TemperatureSeries::from_source(&rec).map_err(Box::new));
         let results = analyze_source(&rec, Some(plan), &opts);
         (results, temperature.join())
     });
@@ -259,7 +260,7 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
     let temperature = temperature
         .map_err(|_| errln!("no analysis: the temperature plot's reader stopped"))
         .ok()?
-        .map_err(unreadable)
+        .map_err(|e| unreadable(*e))
         .ok()?;
     let run_warnings = journal_warnings(dir);
     results.warnings.splice(0..0, run_warnings);
