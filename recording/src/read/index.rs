@@ -11,7 +11,7 @@ use super::check::Extent;
 use super::csvread::read_rows;
 use super::fast::{head, layout};
 use super::io_error;
-use super::scan::{self, Layout, MAX_SLOTS, RowSink, SKIP};
+use super::scan::{self, Layout, MAX_SLOTS, RowSink};
 use super::stream::Stream;
 use crate::error::RecordingError;
 use std::path::{Path, PathBuf};
@@ -111,12 +111,7 @@ impl StreamIndex {
         let (names, data_start, len) = head(&path)?;
         if let Some((full, optional)) = layout::<S>(&names, data_start) {
             // The time column alone (slot 0); the other cells wait for their span.
-            let want = full.want.iter().map(|&w| if w == 0 { 0 } else { SKIP });
-            let only_t = Layout {
-                want: want.collect(),
-                data_start,
-                lazy_tail: true,
-            };
+            let only_t = full.only(&[0]);
             let mut fast = Times::new(times.starts);
             if let Some(entries) = fast_entries(&path, &only_t, len, &mut fast) {
                 *times = fast;

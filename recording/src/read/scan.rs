@@ -42,6 +42,19 @@ impl Layout {
             lazy_tail: false,
         }
     }
+
+    /// This layout reading only the cells of `slots` (the others skipped, the cells after
+    /// the last one read left unread): a pass over a few columns of every line.
+    pub(crate) fn only(&self, slots: &[usize]) -> Layout {
+        let want = self.want.iter();
+        Layout {
+            want: want
+                .map(|&w| if slots.contains(&w) { w } else { SKIP })
+                .collect(),
+            data_start: self.data_start,
+            lazy_tail: true,
+        }
+    }
 }
 
 pub(crate) const SKIP: usize = usize::MAX;

@@ -10,7 +10,7 @@ use super::check;
 use super::check::Extent;
 use super::csvread::read_rows;
 use super::index::{StreamIndex, Times};
-use super::scan::{self, Layout, MAX_SLOTS, RowSink, SKIP};
+use super::scan::{self, MAX_SLOTS, RowSink};
 use super::stream::Stream;
 use super::{io_error, read_manifest, read_stream};
 use crate::error::RecordingError;
@@ -145,12 +145,7 @@ impl OpenRecording {
         let slot = ImuStream::REQUIRED.len();
         let mut sum = TempSum { slot, s: 0.0, n: 0 };
         if let Some(full) = &self.imu.fast {
-            let want = full.want.iter();
-            let layout = Layout {
-                want: want.map(|&w| if w == slot { slot } else { SKIP }).collect(),
-                data_start: full.data_start,
-                lazy_tail: true,
-            };
+            let layout = full.only(&[slot]);
             // Two halves side by side (a range owns the lines that start in it).
             let (from, to) = (self.imu.head_end, self.imu.len);
             let mid = from + (to - from) / 2;
@@ -186,14 +181,7 @@ impl OpenRecording {
         let every = every.max(1);
         let slot = ImuStream::REQUIRED.len();
         if let Some(full) = &self.imu.fast {
-            let want = full.want.iter();
-            let layout = Layout {
-                want: want
-                    .map(|&w| if w == 0 || w == slot { w } else { SKIP })
-                    .collect(),
-                data_start: full.data_start,
-                lazy_tail: true,
-            };
+            let layout = full.only(&[0, slot]);
             let (from, to) = (self.imu.head_end, self.imu.len);
             let mut kept = TempEvery::new(slot, every);
             if scan::scan_range(&self.imu.path, &layout, from, to, &mut kept).is_ok() {
