@@ -191,15 +191,12 @@ pub trait Effect: Send + Sync + std::fmt::Debug {
     /// What this term adds to the ideal outputs for these parameter values. The default is
     /// linear in the parameters; effects that are not override it.
     fn forward(&self, values: &[f64], s: &Signals) -> Partials {
-        let mut parts = [Partials::default(); 16];
-        let n = self.params().len();
-        self.regressors(s, &mut parts[..n]);
-        let mut out = Partials::default();
-        for (v, p) in values.iter().zip(&parts[..n]) {
-            out.accel += p.accel * *v;
-            out.gyro += p.gyro * *v;
+        // Most effects have three parameters or four: their scratch is that short (the
+        // simulator calls this for every term at every sample that moves).
+        match self.params().len() {
+            n @ 0..=4 => linear::<4>(self, n, values, s),
+            n => linear::<16>(self, n, values, s),
         }
-        out
     }
     /// [`Descriptor::sensed`] (no for an effect made at run time).
     fn sensed(&self) -> bool {
@@ -306,5 +303,22 @@ macro_rules! per_axis {
 }
 pub(crate) use per_axis;
 
+
+/// The default [`Effect::forward`]: the `n` regressors (at most `N`) times the values.
+fn linear<const N: usize>(
+    fx: &(impl Effect + ?Sized),
+    n: usize,
+    values: &[f64],
+    s: &Signals,
+) -> Partials {
+    let mut parts = [Partials::default(); N];
+    fx.regressors(s, &mut parts[..n]);
+    let mut out = Partials::default();
+    for (v, p) in values.iter().zip(&parts[..n]) {
+        out.accel += p.accel * *v;
+        out.gyro += p.gyro * *v;
+    }
+    out
+}
 #[cfg(test)]
 mod tests;

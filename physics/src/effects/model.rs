@@ -1,7 +1,7 @@
 //! A measurement model as a list of registry terms with values: what the simulator
 //! applies to the ideal outputs.
 
-use super::{Effect, Signals};
+use super::{Effect, Sensor, Signals};
 use crate::Vec3;
 
 /// One effect with its parameter values (in the catalogue's units).
@@ -49,10 +49,14 @@ impl ImuModel {
         let mut a = sensed.f_b;
         let mut g = s.w_b_dps();
         for t in &self.terms {
-            if !t.effect.sensed() {
+            // A term adds nothing to a sensor it does not touch: it is not evaluated for it.
+            let on = t.effect.sensors();
+            if !t.effect.sensed() && on.contains(&Sensor::Accel) {
                 a += t.effect.forward(&t.values, &sensed).accel;
             }
-            g += t.effect.forward(&t.values, s).gyro;
+            if on.contains(&Sensor::Gyro) {
+                g += t.effect.forward(&t.values, s).gyro;
+            }
         }
         (a, g)
     }
