@@ -93,9 +93,19 @@ pub struct Checked {
     pub plan: Plan,
     /// Warnings (the procedure is accepted).
     pub warnings: Vec<Diagnostic>,
-    /// What the procedure's motion lets explain determine of each registry effect that
-    /// is not part of the nominal model.
-    pub observability: Vec<EffectObservability>,
+    /// The signals at the procedure's sampled instants, from which
+    /// [`Checked::observability`] is worked out when it is asked for.
+    signals: Vec<ratecal_physics::Signals>,
+    observability: std::sync::OnceLock<Vec<EffectObservability>>,
+}
+
+impl Checked {
+    /// What the procedure's motion lets explain determine of each registry effect that is
+    /// not part of the nominal model (worked out on the first call: a run does not ask).
+    pub fn observability(&self) -> &[EffectObservability] {
+        self.observability
+            .get_or_init(|| registry::observe(&self.signals))
+    }
 }
 
 /// Parses and checks a procedure text; `name` is how diagnostics name the file.
@@ -120,14 +130,15 @@ pub fn check(
 ) -> Result<Checked, Vec<Diagnostic>> {
     let mut ck = Ck::new(src.clone(), sources, opts);
     let plan = ck.file(file);
-    let observability = ck.registry_observability(&ck.walk.segments);
+    let signals = ck.sample_signals(&ck.walk.segments);
     let mut diags = std::mem::take(&mut ck.diags);
     dedup(&mut diags);
     match plan {
         Some(plan) if !diags.iter().any(Diagnostic::is_error) => Ok(Checked {
             plan,
             warnings: diags,
-            observability,
+            signals,
+            observability: Default::default(),
         }),
         _ => {
             if !diags.iter().any(Diagnostic::is_error) {

@@ -33,24 +33,23 @@ pub struct EffectObservability {
     pub not: Vec<(&'static str, &'static str)>,
 }
 
-impl Ck<'_> {
-    /// Every registry effect that is not part of the nominal model, over the recorded
-    /// segments.
-    pub(crate) fn registry_observability(&self, segs: &[SegInfo]) -> Vec<EffectObservability> {
-        let signals = self.sample_signals(segs);
-        if signals.is_empty() {
-            return Vec::new();
-        }
-        let nominal = nominal_columns(&signals);
-        REGISTRY
-            .iter()
-            .filter(|e| !e.nominal())
-            .map(|e| observe_effect(*e, &signals, &nominal))
-            .collect()
+/// Every registry effect that is not part of the nominal model, over the signals sampled
+/// from the recorded segments ([`Ck::sample_signals`]).
+pub(crate) fn observe(signals: &[Signals]) -> Vec<EffectObservability> {
+    if signals.is_empty() {
+        return Vec::new();
     }
+    let nominal = nominal_columns(signals);
+    REGISTRY
+        .iter()
+        .filter(|e| !e.nominal())
+        .map(|e| observe_effect(*e, signals, &nominal))
+        .collect()
+}
 
+impl Ck<'_> {
     /// The signals at the sampled instants of every segment.
-    fn sample_signals(&self, segs: &[SegInfo]) -> Vec<Signals> {
+    pub(crate) fn sample_signals(&self, segs: &[SegInfo]) -> Vec<Signals> {
         let site = Site {
             latitude_deg: 45.0,
             gravity_mps2: 9.80665,

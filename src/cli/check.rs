@@ -124,7 +124,7 @@ pub fn main(args: Args) -> ExitCode {
                     p.version,
                     human_duration(p.estimated_duration_s)
                 );
-                let observes = observability_lines(&checked.observability);
+                let observes = observability_lines(checked.observability());
                 if args.format == "json" {
                     errln!("{line}");
                     observes.iter().for_each(|l| errln!("{l}"));

@@ -30,7 +30,8 @@ const SIX_FACES: &str = r#"procedure six-faces version 0.1.0 {
 fn observability(text: &str) -> Vec<EffectObservability> {
     check_text("p", text, &NoImports, &CheckOptions::default())
         .unwrap_or_else(|d| panic!("{d:?}"))
-        .observability
+        .observability()
+        .to_vec()
 }
 
 fn of<'a>(obs: &'a [EffectObservability], id: &str) -> &'a EffectObservability {
