@@ -62,6 +62,12 @@ pub(crate) const SKIP: usize = usize::MAX;
 /// Receives parsed rows (the wanted cells in slot order).
 pub(crate) trait RowSink: Send {
     fn push(&mut self, row: &[f64; MAX_SLOTS]);
+    /// Whether the next row (a line that is not blank) is wanted: one that is not is
+    /// passed over unread, only its end found, and not pushed.
+    #[inline]
+    fn wants(&mut self) -> bool {
+        true
+    }
 }
 
 /// Reads the header line of `path`: field names, and the offset after it.
@@ -227,6 +233,10 @@ fn parse_lines<S: RowSink>(
                 pos = e + 1;
                 continue;
             }
+        }
+        if !sink.wants() {
+            pos = memchr(b'\n', &buf[pos..]).map_or(buf.len(), |p| pos + p + 1);
+            continue;
         }
         let mut field = 0;
         loop {

@@ -172,8 +172,10 @@ impl OpenRecording {
     }
 
     /// Every `every`-th IMU row's `(t, temp)`, counting from the first row (`None` without
-    /// the column): one pass that parses those two cells of each line alone, for a plot of
-    /// the temperature over the run (the rows a window-by-window pass would keep).
+    /// the column): one pass that parses those two cells of the kept lines alone and only
+    /// finds the end of the others, for a plot of the temperature over the run (the rows a
+    /// window-by-window pass would keep). The lines passed over are not checked: whatever
+    /// reads the recording's samples does that.
     pub fn imu_temp_every(&self, every: usize) -> Result<Option<Vec<(f64, f64)>>, RecordingError> {
         if !self.imu.optional {
             return Ok(None);
@@ -216,12 +218,17 @@ impl TempEvery {
 }
 
 impl RowSink for TempEvery {
+    /// The rows between two kept ones are passed over: only their line ends are found.
+    #[inline]
+    fn wants(&mut self) -> bool {
+        let kept = self.row.is_multiple_of(self.every);
+        self.row += 1;
+        kept
+    }
+
     #[inline]
     fn push(&mut self, r: &[f64; MAX_SLOTS]) {
-        if self.row.is_multiple_of(self.every) {
-            self.kept.push((r[0], r[self.slot]));
-        }
-        self.row += 1;
+        self.kept.push((r[0], r[self.slot]));
     }
 }
 

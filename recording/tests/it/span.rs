@@ -307,5 +307,7 @@ fn the_temperature_from_its_cells_alone() {
     let whole = render(&recording::read(tmp.path()).unwrap_err());
     let open = Recording::open(tmp.path()).unwrap();
     assert_eq!(render(&open.imu_mean_temp().unwrap_err()), whole);
-    assert_eq!(render(&open.imu_temp_every(10).unwrap_err()), whole);
+    // Every row kept: the bad cell is read, and named as the whole read names it (the
+    // rows between kept ones are passed over unread: the analysis reads them).
+    assert_eq!(render(&open.imu_temp_every(1).unwrap_err()), whole);
 }
