@@ -27,7 +27,7 @@ mod stats;
 pub use allan::overlapping_adev;
 pub use repeat::analyze_runs;
 pub use segment::{Retime, WINDOW_ROWS};
-pub use source::{ImuView, Source, Streamed};
+pub use source::{ImuView, ImuWork, Source, Streamed};
 
 use crate::plan::{Outliers, Plan};
 use crate::recording::Recording;

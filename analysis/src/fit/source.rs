@@ -45,6 +45,32 @@ impl<'a> ImuView<'a> {
     }
 }
 
+/// The IMU rows of one span to work on: the stamps and temperatures borrowed, the six
+/// outputs (`ax ay az gx gy gz`) the span's own when the source read them for it (a filter
+/// then writes them in place), else borrowed (copied on the first write).
+#[derive(Debug)]
+pub struct ImuWork<'a> {
+    /// Stamps, s.
+    pub t: &'a [f64],
+    /// IMU internal temperature, degC.
+    pub temp: Option<&'a [f64]>,
+    /// The outputs, accelerometers (m/s^2) then gyros (deg/s).
+    pub outputs: [Cow<'a, [f64]>; 6],
+}
+
+impl<'a> ImuWork<'a> {
+    /// The rows of a view, borrowed.
+    fn borrowed(v: ImuView<'a>) -> Self {
+        ImuWork {
+            t: v.t,
+            temp: v.temp,
+            outputs: std::array::from_fn(|c| {
+                Cow::Borrowed(if c < 3 { v.accel[c] } else { v.gyro[c - 3] })
+            }),
+        }
+    }
+}
+
 /// A recording as the analysis reads it.
 pub trait Source: Sync {
     /// Why a span could not be read.
@@ -69,6 +95,20 @@ pub trait Source: Sync {
     /// The whole recording in memory: for the analyses that navigate the raw stream (the
     /// size effect's cycles, from the static blocks before them).
     fn recording(&self) -> Result<Cow<'_, Recording>, Self::Error>;
+
+    /// Hands `f` the IMU rows with `t0 <= t <= t1` to work on ([`ImuWork`]); by default
+    /// borrowed from [`Source::rows`].
+    fn rows_to_work<R>(
+        &self,
+        t0: f64,
+        t1: f64,
+        f: impl FnOnce(ImuWork<'_>) -> R,
+    ) -> Result<R, Self::Error>
+    where
+        Self: Sized,
+    {
+        self.rows(t0, t1, |v| f(ImuWork::borrowed(v)))
+    }
 
     /// Every `every`-th IMU row's `(t, temp)`, counting from the first row: empty without
     /// the column. As [`Source::windows`] sees them; a source may read the two cells alone.
@@ -242,6 +282,23 @@ impl Source for Streamed {
     ) -> Result<R, RecordingError> {
         let s = self.open.read_imu_span(t0, t1)?;
         Ok(f(ImuView::of(&s, 0, s.t.len())))
+    }
+
+    /// The span read is the work's: its outputs are handed over, not copied.
+    fn rows_to_work<R>(
+        &self,
+        t0: f64,
+        t1: f64,
+        f: impl FnOnce(ImuWork<'_>) -> R,
+    ) -> Result<R, RecordingError> {
+        let s = self.open.read_imu_span(t0, t1)?;
+        let [ax, ay, az] = s.accel;
+        let [gx, gy, gz] = s.gyro;
+        Ok(f(ImuWork {
+            t: &s.t,
+            temp: s.temp.as_deref(),
+            outputs: [ax, ay, az, gx, gy, gz].map(Cow::Owned),
+        }))
     }
 
     fn recording(&self) -> Result<Cow<'_, Recording>, RecordingError> {

@@ -17,7 +17,7 @@ pub(crate) use stats::{ChannelStats, RawSums};
 
 use super::joint::{Accumulator, Layout, SegAcc};
 use super::prep::{self, PrepOptions};
-use super::source::{ImuView, Source};
+use super::source::{ImuWork, Source};
 use super::stats::median_step;
 use crate::recording::{Segment, SegmentKind, TableStream};
 use crate::results::SyncReport;
@@ -180,7 +180,7 @@ pub(crate) fn pass<S: Source>(src: &S, job: &Job) -> Result<(Summary, SegAcc), S
         );
         // Only the segment's own end is inclusive: a piece ends where the next begins.
         let last = i + 1 == cut.k && cut.s1 >= seg.t_end;
-        src.rows(r0, r1, |v| w.window(&mut kin, v, c0, c1, last))?;
+        src.rows_to_work(r0, r1, |v| w.window(&mut kin, v, c0, c1, last))?;
     }
     let Window { acc, sum, .. } = w;
     Ok((sum, acc.finish()))
@@ -273,7 +273,7 @@ struct Step {
 impl Window<'_> {
     /// One window: rows `v`, of which those in `[c0, c1)` (`[c0, c1]` for the last) are
     /// its own; the others are the low-pass's margins.
-    fn window(&mut self, kin: &mut Kin, v: ImuView, c0: f64, c1: f64, last: bool) {
+    fn window(&mut self, kin: &mut Kin, v: ImuWork, c0: f64, c1: f64, last: bool) {
         let n = v.t.len();
         let ca = v.t.partition_point(|&t| t < c0);
         let cb = if last {
@@ -319,10 +319,19 @@ impl Window<'_> {
             }
             None => Refs::Constant([0.0; 6]),
         };
+        // The raw rows against their references, for the sanity checks (before the
+        // outputs are filtered, in place when the window's rows are its own).
+        // At rest the references are the window's one set (they do not read the time).
+        let raw_ref = |i: usize| match (&refs, constant) {
+            (Refs::PerRow(_), _) | (_, Some(_)) => [0, 1, 2, 3, 4, 5].map(|c| refs.at(c, i)),
+            _ => reference(&sig_at(i)),
+        };
+        let mut outputs = v.outputs;
+        for i in ca..cb {
+            self.sum.raw.add(outputs.each_ref().map(|o| o[i]), raw_ref(i));
+        }
         let mut keep_a = vec![true; n];
         let mut keep_g = vec![true; n];
-        let mut outputs: [Cow<[f64]>; 6] =
-            std::array::from_fn(|c| Cow::Borrowed(if c < 3 { v.accel[c] } else { v.gyro[c - 3] }));
         if let Some(po) = self.job.prep {
             if let Some(rule) = po.outliers {
                 let core = ca..cb;
@@ -353,22 +362,6 @@ impl Window<'_> {
                 }
                 shift(&mut outputs, &refs, 1.0);
             }
-        }
-        // The raw rows against their references, for the sanity checks.
-        // At rest the references are the window's one set (they do not read the time).
-        let raw_ref = |i: usize| match (&refs, constant) {
-            (Refs::PerRow(_), _) | (_, Some(_)) => [0, 1, 2, 3, 4, 5].map(|c| refs.at(c, i)),
-            _ => reference(&sig_at(i)),
-        };
-        for i in ca..cb {
-            let out = [0, 1, 2, 3, 4, 5].map(|c| {
-                if c < 3 {
-                    v.accel[c][i]
-                } else {
-                    v.gyro[c - 3][i]
-                }
-            });
-            self.sum.raw.add(out, raw_ref(i));
         }
         // The window's own rows, into the fit and the sums.
         let temp_at = |i: usize| v.temp.map_or(f64::NAN, |x| x[i]);
