@@ -134,8 +134,9 @@ impl StreamIndex {
 /// Blocks parsed at once by [`fast_entries`]: 16 MB of CSV, whose stamps are 2 MB.
 const BATCH: usize = 64;
 
-/// Block by block through the range parser, the blocks of a batch parsed side by side
-/// (two threads) and their stamps then seen in order; `None` when it gives up somewhere.
+/// Block by block through the range parser, a batch of blocks at a time: a second thread
+/// parses every other batch while this one parses the others and sees every stamp in
+/// order (neither waits for the other but at the end); `None` when it gives up somewhere.
 fn fast_entries(
     path: &Path,
     only_t: &Layout,
@@ -148,26 +149,41 @@ fn fast_entries(
         scan::scan_range(path, only_t, a, (a + BLOCK).min(len), &mut s).ok()?;
         Some(s.0)
     };
+    let batch = |b: &[u64]| b.iter().map(|&a| stamps(a)).collect::<Option<Vec<_>>>();
+    let batches: Vec<&[u64]> = starts.chunks(BATCH).collect();
     let mut entries = Vec::new();
-    for batch in starts.chunks(BATCH) {
-        let (one, two) = batch.split_at(batch.len() / 2);
-        let (one, two) = std::thread::scope(|sc| {
-            let h = sc.spawn(|| two.iter().map(|&a| stamps(a)).collect::<Option<Vec<_>>>());
-            let one = one.iter().map(|&a| stamps(a)).collect::<Option<Vec<_>>>();
-            (one, h.join().expect("index thread"))
-        });
-        for (&a, block) in batch.iter().zip(one?.into_iter().chain(two?)) {
-            if let Some(&t) = block.first() {
-                let at = if entries.is_empty() {
-                    only_t.data_start
-                } else {
-                    a
-                };
-                entries.push((at, t));
+    std::thread::scope(|sc| {
+        // Two batches ahead at most: the stamps waiting stay a few MB.
+        let (tx, rx) = std::sync::mpsc::sync_channel(2);
+        let odd = batches.iter().skip(1).step_by(2);
+        sc.spawn(move || {
+            for b in odd {
+                let parsed = batch(b);
+                let gave_up = parsed.is_none();
+                if tx.send(parsed).is_err() || gave_up {
+                    return;
+                }
             }
-            block.into_iter().for_each(|t| times.see(t));
+        });
+        for (i, b) in batches.iter().enumerate() {
+            let parsed = match i % 2 {
+                0 => batch(b),
+                _ => rx.recv().ok().flatten(),
+            }?;
+            for (&a, block) in b.iter().zip(parsed) {
+                if let Some(&t) = block.first() {
+                    let at = if entries.is_empty() {
+                        only_t.data_start
+                    } else {
+                        a
+                    };
+                    entries.push((at, t));
+                }
+                block.into_iter().for_each(|t| times.see(t));
+            }
         }
-    }
+        Some(())
+    })?;
     Some(entries)
 }
 
