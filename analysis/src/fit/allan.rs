@@ -33,13 +33,20 @@ impl Series {
 /// The curve of a rate series held in chunks, integrated in their own memory: sample `i`
 /// becomes the angle `theta[i + 1]` (`theta[0] = 0` is left implicit, so nothing grows).
 fn adev_of_rates(mut chunks: Vec<Vec<f64>>, dt: f64) -> Vec<(f64, f64, usize)> {
+    integrate(&mut chunks, dt);
+    let c = Chunked::new(&chunks);
+    let sums: Vec<f64> = groups(c.len).flat_map(|g| group_sums(&c, g)).collect();
+    curve(c.len, &sums, dt)
+}
+
+/// The rates of `chunks` (the empty ones left out) to angles, in place.
+fn integrate(chunks: &mut Vec<Vec<f64>>, dt: f64) {
     chunks.retain(|c| !c.is_empty());
     let mut acc = 0.0;
     for v in chunks.iter_mut().flatten() {
         acc += *v * dt;
         *v = acc;
     }
-    adev_of_angle(&Chunked::new(&chunks), dt)
 }
 
 /// One series read across its chunks.
@@ -80,42 +87,63 @@ impl<'a> Chunked<'a> {
 /// waits on the one before, so four independent ones keep the adder busy.
 const SWEPT: usize = 4;
 
-/// The curve from the integrated angle `theta[k] = c[k - 1]`, `theta[0] = 0`.
-fn adev_of_angle(c: &Chunked, dt: f64) -> Vec<(f64, f64, usize)> {
-    let n = c.len;
-    let ms: Vec<usize> = std::iter::successors(Some(1usize), |m| Some(m * 2))
+/// The octave cluster sizes `m = 1, 2, 4, ...` up to a quarter of `n` samples.
+fn sizes(n: usize) -> Vec<usize> {
+    std::iter::successors(Some(1usize), |m| Some(m * 2))
         .take_while(|m| 4 * m <= n)
-        .collect();
-    let terms = |m: usize| n + 1 - 2 * m;
-    let mut sums = vec![0.0; ms.len()];
-    for (group, s) in ms.chunks(SWEPT).zip(sums.chunks_mut(SWEPT)) {
-        // k = 0, where theta[k] is the implicit zero, then the rest in order: every sum
-        // adds its terms in the order of k, whichever sizes are swept beside it.
-        for (s, &m) in s.iter_mut().zip(group) {
-            let d0 = c.at(2 * m - 1) - 2.0 * c.at(m - 1);
-            *s = d0 * d0;
+        .collect()
+}
+
+/// The cluster sizes of a series of `n` samples in the groups swept together: each group's
+/// sums are independent of the others' (a task of their own).
+fn groups(n: usize) -> impl Iterator<Item = Vec<usize>> {
+    let ms = sizes(n);
+    let g: Vec<Vec<usize>> = ms.chunks(SWEPT).map(<[usize]>::to_vec).collect();
+    g.into_iter()
+}
+
+/// Terms of the sum at cluster size `m` over `n` samples.
+fn terms(n: usize, m: usize) -> usize {
+    n + 1 - 2 * m
+}
+
+/// The sums of squared second differences of the integrated angle `theta[k] = c[k - 1]`
+/// (`theta[0] = 0`) at the cluster sizes of `group`.
+fn group_sums(c: &Chunked, group: Vec<usize>) -> Vec<f64> {
+    let n = c.len;
+    let mut s = vec![0.0; group.len()];
+    // k = 0, where theta[k] is the implicit zero, then the rest in order: every sum adds
+    // its terms in the order of k, whichever sizes are swept beside it.
+    for (s, &m) in s.iter_mut().zip(&group) {
+        let d0 = c.at(2 * m - 1) - 2.0 * c.at(m - 1);
+        *s = d0 * d0;
+    }
+    let common = terms(n, group[group.len() - 1]);
+    match <[usize; SWEPT]>::try_from(group.as_slice()) {
+        Ok(g) => {
+            let mut four = [0.0; SWEPT];
+            four.copy_from_slice(&s);
+            sweep(c, g, &mut four, 1, common);
+            s.copy_from_slice(&four);
         }
-        let common = terms(group[group.len() - 1]);
-        match <[usize; SWEPT]>::try_from(group) {
-            Ok(g) => {
-                let mut four = [0.0; SWEPT];
-                four.copy_from_slice(s);
-                sweep(c, g, &mut four, 1, common);
-                s.copy_from_slice(&four);
+        Err(_) => {
+            for (s, &m) in s.iter_mut().zip(&group) {
+                sweep(c, [m], std::array::from_mut(s), 1, common);
             }
-            Err(_) => {
-                for (s, &m) in s.iter_mut().zip(group) {
-                    sweep(c, [m], std::array::from_mut(s), 1, common);
-                }
-            }
-        }
-        for (s, &m) in s.iter_mut().zip(group) {
-            sweep(c, [m], std::array::from_mut(s), common, terms(m));
         }
     }
-    let curve = ms.iter().zip(&sums).map(|(&m, &s)| {
+    for (s, &m) in s.iter_mut().zip(&group) {
+        sweep(c, [m], std::array::from_mut(s), common, terms(n, m));
+    }
+    s
+}
+
+/// The curve of a series of `n` samples from its sums (in the order of [`sizes`]).
+fn curve(n: usize, sums: &[f64], dt: f64) -> Vec<(f64, f64, usize)> {
+    let ms = sizes(n);
+    let curve = ms.iter().zip(sums).map(|(&m, &s)| {
         let tau = m as f64 * dt;
-        let adev = (s / (2.0 * tau * tau * terms(m) as f64)).sqrt();
+        let adev = (s / (2.0 * tau * tau * terms(n, m) as f64)).sqrt();
         (tau, adev, n / m)
     });
     curve.collect()
@@ -157,8 +185,24 @@ pub(crate) fn curves(series: Series, dt: f64) -> Curves {
             ax.push(c);
         }
     }
-    axes.into_par_iter()
-        .map(|chunks| adev_of_rates(chunks, dt))
+    axes.par_iter_mut().for_each(|chunks| integrate(chunks, dt));
+    let series: Vec<Chunked> = axes.iter().map(|a| Chunked::new(a)).collect();
+    // Every axis's groups of cluster sizes as tasks of their own: three axes on two cores
+    // would leave one core idle for the last axis.
+    let tasks: Vec<(usize, Vec<usize>)> = (series.iter().enumerate())
+        .flat_map(|(ax, c)| groups(c.len).map(move |g| (ax, g)))
+        .collect();
+    let sums: Vec<(usize, Vec<f64>)> = tasks
+        .into_par_iter()
+        .map(|(ax, g)| (ax, group_sums(&series[ax], g)))
+        .collect();
+    (series.iter().enumerate())
+        .map(|(ax, c)| {
+            let s: Vec<f64> = (sums.iter().filter(|(a, _)| *a == ax))
+                .flat_map(|(_, s)| s.iter().copied())
+                .collect();
+            curve(c.len, &s, dt)
+        })
         .collect()
 }
 
