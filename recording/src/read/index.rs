@@ -131,7 +131,7 @@ impl StreamIndex {
     }
 }
 
-/// Blocks parsed at once by [`fast_entries`]: 16 MB of CSV, whose stamps are 2 MB.
+/// Blocks parsed at once by [`fast_entries`] (at most): 16 MB of CSV, whose stamps are 2 MB.
 const BATCH: usize = 64;
 
 /// Block by block through the range parser, a batch of blocks at a time: a second thread
@@ -150,7 +150,9 @@ fn fast_entries(
         Some(s.0)
     };
     let batch = |b: &[u64]| b.iter().map(|&a| stamps(a)).collect::<Option<Vec<_>>>();
-    let batches: Vec<&[u64]> = starts.chunks(BATCH).collect();
+    // A file of one batch or less is still cut in two, one half for each thread.
+    let size = starts.len().div_ceil(2).clamp(1, BATCH);
+    let batches: Vec<&[u64]> = starts.chunks(size).collect();
     let mut entries = Vec::new();
     std::thread::scope(|sc| {
         // Two batches ahead at most: the stamps waiting stay a few MB.
