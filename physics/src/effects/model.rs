@@ -77,3 +77,69 @@ impl ImuModel {
             .sum()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::effects::REGISTRY;
+    use crate::{Geometry, Site, TableState};
+
+    /// What `outputs` computed before a term was evaluated only for the sensors it touches:
+    /// every term for both sensors.
+    fn every_term_for_both(m: &ImuModel, s: &Signals) -> (Vec3, Vec3) {
+        let mut sensed = *s;
+        for t in m.terms.iter().filter(|t| t.effect.sensed()) {
+            sensed.f_b += t.effect.forward(&t.values, s).accel;
+        }
+        let (mut a, mut g) = (sensed.f_b, s.w_b_dps());
+        for t in &m.terms {
+            if !t.effect.sensed() {
+                a += t.effect.forward(&t.values, &sensed).accel;
+            }
+            g += t.effect.forward(&t.values, s).gyro;
+        }
+        (a, g)
+    }
+
+    /// Every registry effect at once, at rest and turning, warm and cold: the outputs are
+    /// those of every term evaluated for both sensors, to the bit (a term adds exact zeros
+    /// to the sensor it does not touch).
+    #[test]
+    fn a_term_left_out_of_a_sensor_it_does_not_touch_changes_no_bit() {
+        let terms = (REGISTRY.iter())
+            .map(|e| Term {
+                effect: *e,
+                values: (0..e.params().len())
+                    .map(|k| 1e-3 * (k as f64 + 1.0) * if k % 2 == 0 { 1.0 } else { -0.7 })
+                    .collect(),
+            })
+            .collect();
+        let model = ImuModel {
+            terms,
+            t_ref_c: 20.0,
+        };
+        let site = Site {
+            latitude_deg: 48.0,
+            gravity_mps2: 9.8085,
+        };
+        let geo = Geometry::seed();
+        for (o, i, rate, dtemp) in [
+            (0.0, 0.0, 0.0, 0.0),
+            (90.0, 30.0, 0.0, 2.5),
+            (-45.0, 180.0, 1.3, -1.0),
+            (10.0, -60.0, -0.4, 0.3),
+        ] {
+            let mut st = TableState::at_rest_deg(o, i);
+            st.outer.rate = rate;
+            st.inner.rate = -0.5 * rate;
+            st.inner.accel = 0.2 * rate;
+            let s = Signals::new(&st.snapshot(&geo, &site), &site, dtemp).at(123.4);
+            let (a, g) = model.outputs(&s);
+            let (wa, wg) = every_term_for_both(&model, &s);
+            for k in 0..3 {
+                assert_eq!(a[k].to_bits(), wa[k].to_bits(), "accel {k} at {o} {i} {rate}");
+                assert_eq!(g[k].to_bits(), wg[k].to_bits(), "gyro {k} at {o} {i} {rate}");
+            }
+        }
+    }
+}
