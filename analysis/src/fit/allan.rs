@@ -35,7 +35,9 @@ impl Series {
 fn adev_of_rates(mut chunks: Vec<Vec<f64>>, dt: f64) -> Vec<(f64, f64, usize)> {
     integrate(&mut chunks, dt);
     let c = Chunked::new(&chunks);
-    let sums: Vec<f64> = groups(c.len).flat_map(|g| group_sums(&c, g)).collect();
+    let sums: Vec<f64> = (groups(c.len).into_iter())
+        .flat_map(|g| group_sums(&c, g))
+        .collect();
     curve(c.len, &sums, dt)
 }
 
@@ -96,10 +98,8 @@ fn sizes(n: usize) -> Vec<usize> {
 
 /// The cluster sizes of a series of `n` samples in the groups swept together: each group's
 /// sums are independent of the others' (a task of their own).
-fn groups(n: usize) -> impl Iterator<Item = Vec<usize>> {
-    let ms = sizes(n);
-    let g: Vec<Vec<usize>> = ms.chunks(SWEPT).map(<[usize]>::to_vec).collect();
-    g.into_iter()
+fn groups(n: usize) -> Vec<Vec<usize>> {
+    sizes(n).chunks(SWEPT).map(<[usize]>::to_vec).collect()
 }
 
 /// Terms of the sum at cluster size `m` over `n` samples.
@@ -190,7 +190,7 @@ pub(crate) fn curves(series: Series, dt: f64) -> Curves {
     // Every axis's groups of cluster sizes as tasks of their own: three axes on two cores
     // would leave one core idle for the last axis.
     let tasks: Vec<(usize, Vec<usize>)> = (series.iter().enumerate())
-        .flat_map(|(ax, c)| groups(c.len).map(move |g| (ax, g)))
+        .flat_map(|(ax, c)| groups(c.len).into_iter().map(move |g| (ax, g)))
         .collect();
     let sums: Vec<(usize, Vec<f64>)> = tasks
         .into_par_iter()

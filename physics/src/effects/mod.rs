@@ -303,7 +303,6 @@ macro_rules! per_axis {
 }
 pub(crate) use per_axis;
 
-
 /// The default [`Effect::forward`]: the `n` regressors (at most `N`) times the values.
 fn linear<const N: usize>(
     fx: &(impl Effect + ?Sized),

@@ -137,8 +137,16 @@ mod tests {
             let (a, g) = model.outputs(&s);
             let (wa, wg) = every_term_for_both(&model, &s);
             for k in 0..3 {
-                assert_eq!(a[k].to_bits(), wa[k].to_bits(), "accel {k} at {o} {i} {rate}");
-                assert_eq!(g[k].to_bits(), wg[k].to_bits(), "gyro {k} at {o} {i} {rate}");
+                assert_eq!(
+                    a[k].to_bits(),
+                    wa[k].to_bits(),
+                    "accel {k} at {o} {i} {rate}"
+                );
+                assert_eq!(
+                    g[k].to_bits(),
+                    wg[k].to_bits(),
+                    "gyro {k} at {o} {i} {rate}"
+                );
             }
         }
     }

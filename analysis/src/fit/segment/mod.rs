@@ -328,7 +328,9 @@ impl Window<'_> {
         };
         let mut outputs = v.outputs;
         for i in ca..cb {
-            self.sum.raw.add(outputs.each_ref().map(|o| o[i]), raw_ref(i));
+            self.sum
+                .raw
+                .add(outputs.each_ref().map(|o| o[i]), raw_ref(i));
         }
         let mut keep_a = vec![true; n];
         let mut keep_g = vec![true; n];
