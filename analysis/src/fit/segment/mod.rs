@@ -393,9 +393,15 @@ impl Window<'_> {
             }
         }
         if let Some(series) = &mut self.sum.allan {
-            let kept: Vec<usize> = (ca..cb).filter(|&i| keep_g[i]).collect();
+            // The window's own gyro columns become the series' chunk, cut to its rows and
+            // its kept samples in place (a span read for the window is not copied).
             series.push(std::array::from_fn(|ax| {
-                kept.iter().map(|&i| outputs[3 + ax][i]).collect()
+                let mut col = std::mem::take(outputs[3 + ax].to_mut());
+                col.truncate(cb);
+                col.drain(..ca);
+                let mut kept = keep_g[ca..cb].iter();
+                col.retain(|_| *kept.next().expect("a flag a row"));
+                col
             }));
         }
     }
