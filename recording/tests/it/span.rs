@@ -261,6 +261,33 @@ fn opening_refuses_what_a_whole_read_refuses() {
     ));
 }
 
+/// A file of several blocks is indexed by two threads, each parsing every other batch of
+/// blocks: a bad or backward stamp in either thread's part (rows 100, 30,000 and 39,990 of
+/// 40,000; the second thread's begins near row 23,000) is refused as a whole read refuses
+/// it, and a sound file opens with every row.
+#[test]
+fn a_refusal_in_either_thread_of_the_index_is_a_whole_reads() {
+    let [m, imu, table] = synthetic(40_000);
+    let open = |imu: String| {
+        let tmp = tempfile::tempdir().unwrap();
+        write(tmp.path(), &[m.clone(), imu, table.clone()]);
+        let whole = recording::read(tmp.path()).map_err(|e| render(&e));
+        let open = Recording::open(tmp.path()).map_err(|e| render(&e));
+        (whole, open)
+    };
+    let (whole, opened) = open(imu.clone());
+    assert_eq!(whole.unwrap().imu.t.len(), 40_000);
+    assert_eq!(opened.unwrap().imu_rows(), 40_000);
+    for row in ["1.00", "300.00", "399.90"] {
+        let before = format!("{:.2}", row.parse::<f64>().unwrap() - 1.0);
+        for bad in ["x", before.as_str()] {
+            let (whole, opened) = open(imu.replacen(&format!("\n{row},"), &format!("\n{bad},"), 1));
+            let (whole, opened) = (whole.unwrap_err(), opened.unwrap_err());
+            assert_eq!(opened, whole, "row {row} as {bad}");
+        }
+    }
+}
+
 /// `imu` (a synthetic stream) with a temperature that varies: row i reads
 /// 20 + (i mod 1000) / 100.
 fn warming(imu: &str) -> String {
