@@ -51,6 +51,11 @@ pub trait RunSink {
     fn flush(&mut self) -> io::Result<()> {
         Ok(())
     }
+    /// Waits until every segment handed to [`RunSink::segment`] is persisted: the error of
+    /// one that could not be (called before the run is said to be completed).
+    fn settle(&mut self) -> io::Result<()> {
+        Ok(())
+    }
     /// How the hardware links delivered their samples (called before `end`).
     fn links(&mut self, _sync: &SyncRecord) {}
 }
@@ -171,17 +176,19 @@ impl RunSink for RecordingWriter {
     }
 
     fn segment(&mut self, segment: Segment) -> io::Result<()> {
+        // The writer thread syncs and rewrites the manifest while the run goes on; a
+        // checkpoint that fails takes its segment out again (its data may not all be
+        // written) and fails the next call here, `flush` or `settle`.
         self.manifest_mut().segments.push(segment);
-        let r = self.checkpoint();
-        if r.is_err() {
-            // Its data may not all be written: the segment is not the recording's.
-            self.manifest_mut().segments.pop();
-        }
-        r
+        self.checkpoint_begin()
     }
 
     fn flush(&mut self) -> io::Result<()> {
         self.sync()
+    }
+
+    fn settle(&mut self) -> io::Result<()> {
+        RecordingWriter::settle(self)
     }
 
     fn links(&mut self, sync: &SyncRecord) {

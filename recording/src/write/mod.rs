@@ -34,6 +34,9 @@ enum Msg {
     /// Flush to the disk and reply with the files' SHA-256 (imu, table) and the failed
     /// write, if one failed (the streams are then cut after their last full line).
     Hashes(mpsc::Sender<io::Result<Hashes>>),
+    /// A checkpoint: both streams to the disk with every block recorded, then this manifest
+    /// (`manifest.yaml`'s text) replaced atomically; reply with the first error.
+    Checkpoint(String, mpsc::Sender<io::Result<()>>),
 }
 
 /// The streams as written (imu, table: SHA-256 and length), and the write that failed, if
@@ -46,7 +49,7 @@ const QUEUE: usize = 64;
 /// Rows gathered before they go to the writer thread (fewer wake-ups than one message per
 /// control tick); every checkpoint, `finish` and drop sends what is gathered.
 const BATCH_IMU: usize = 512;
-const BATCH_TABLE: usize = 64;
+const BATCH_TABLE: usize = 512;
 
 /// Writes a recording folder incrementally. Sample times handed in are already on the
 /// recording's clock (0 at the start of the run). Samples the format cannot hold are
@@ -69,13 +72,18 @@ pub struct RecordingWriter {
     /// The streams as [`RecordingWriter::finish`] left them.
     written: Vec<WrittenFile>,
     failure: Option<WriteFailure>,
+    /// The checkpoint the writer thread is doing ([`RecordingWriter::checkpoint_begin`]):
+    /// its reply, and the segments its manifest lists.
+    in_flight: Option<(mpsc::Receiver<io::Result<()>>, usize)>,
+    /// Segments the manifest on the disk lists (the last checkpoint's that succeeded).
+    durable: usize,
 }
 
 fn copy_err(e: &io::Error) -> io::Error {
     io::Error::new(e.kind(), e.to_string())
 }
 
-fn writer_thread(mut st: Streams, rx: mpsc::Receiver<Msg>) -> u64 {
+fn writer_thread(mut st: Streams, dir: PathBuf, rx: mpsc::Receiver<Msg>) -> u64 {
     let mut failed: Option<io::Error> = None;
     let keep = |r: io::Result<()>, failed: &mut Option<io::Error>| {
         if let Err(e) = r {
@@ -99,19 +107,23 @@ fn writer_thread(mut st: Streams, rx: mpsc::Receiver<Msg>) -> u64 {
                 keep(r, &mut failed);
             }
             Msg::Sync(durable, reply) => {
-                if failed.is_none() {
-                    keep(st.sync(durable), &mut failed);
-                } else {
-                    let _ = st.record_blocks(true).and_then(|()| st.journal.sync_data());
-                }
+                sync_or_record(&mut st, durable, &mut failed);
                 let _ = reply.send(failed.as_ref().map_or(Ok(()), |e| Err(copy_err(e))));
             }
-            Msg::Hashes(reply) => {
-                if failed.is_none() {
-                    keep(st.sync(true), &mut failed);
-                } else {
-                    let _ = st.record_blocks(true).and_then(|()| st.journal.sync_data());
+            Msg::Checkpoint(yaml, reply) => {
+                sync_or_record(&mut st, true, &mut failed);
+                let r = match &failed {
+                    Some(e) => Err(copy_err(e)),
+                    // A manifest that could not be replaced fails this checkpoint only.
+                    None => write_manifest_text(&dir, &yaml),
+                };
+                if r.is_ok() {
+                    crash_point("after-checkpoint");
                 }
+                let _ = reply.send(r);
+            }
+            Msg::Hashes(reply) => {
+                sync_or_record(&mut st, true, &mut failed);
                 // A failed stream write is recorded and sealed as cut; any other failure
                 // (the journal, an fsync) leaves the recording unfinished.
                 let r = match (&failed, st.failure()) {
@@ -128,6 +140,24 @@ fn writer_thread(mut st: Streams, rx: mpsc::Receiver<Msg>) -> u64 {
     st.dropped
 }
 
+/// Flushes both streams (`durable`: to the disk), or after a failure records the blocks
+/// written before it and syncs the journal.
+fn sync_or_record(st: &mut Streams, durable: bool, failed: &mut Option<io::Error>) {
+    if failed.is_none() {
+        if let Err(e) = st.sync(durable) {
+            *failed = Some(e);
+        }
+    } else {
+        let _ = st.record_blocks(true).and_then(|()| st.journal.sync_data());
+    }
+}
+
+/// Replaces `manifest.yaml` in `dir` atomically with `yaml`.
+fn write_manifest_text(dir: &Path, yaml: &str) -> io::Result<()> {
+    crate::commit::write_atomic(dir, "manifest.yaml", yaml.as_bytes())
+        .map_err(|e| io::Error::new(e.kind(), format!("manifest.yaml: {e}")))
+}
+
 fn gone() -> io::Error {
     io::Error::other("the recording writer thread stopped")
 }
@@ -136,9 +166,10 @@ impl RecordingWriter {
     fn start(dir: &Path, streams: Streams, manifest: Manifest) -> io::Result<Self> {
         let columns = streams.columns;
         let (tx, rx) = mpsc::sync_channel(QUEUE);
+        let at = dir.to_path_buf();
         let thread = std::thread::Builder::new()
             .name("recording-writer".into())
-            .spawn(move || writer_thread(streams, rx))?;
+            .spawn(move || writer_thread(streams, at, rx))?;
         Ok(RecordingWriter {
             dir: dir.to_path_buf(),
             tx: Some(tx),
@@ -150,6 +181,8 @@ impl RecordingWriter {
             cut: BTreeMap::new(),
             written: Vec::new(),
             failure: None,
+            in_flight: None,
+            durable: 0,
         })
     }
 
@@ -239,6 +272,7 @@ impl RecordingWriter {
             journal,
         };
         let mut w = Self::start(dir, streams, manifest)?;
+        w.durable = w.manifest.segments.len();
         for (name, n) in [("imu.csv", imu_cut), ("table.csv", table_cut)] {
             if n > 0 {
                 w.cut.insert(name.into(), n);
@@ -340,6 +374,7 @@ impl RecordingWriter {
     }
 
     fn sync_streams(&mut self, durable: bool) -> io::Result<()> {
+        self.settle()?;
         self.send_pending()?;
         let (tx, rx) = mpsc::channel();
         self.send(Msg::Sync(durable, tx))?;
@@ -354,22 +389,53 @@ impl RecordingWriter {
     /// Flushes both streams to the disk, records their blocks in the journal, and replaces
     /// the manifest atomically (written whole and fsynced, then renamed).
     pub fn checkpoint(&mut self) -> io::Result<()> {
-        self.sync_streams(true)?;
-        self.write_manifest()?;
-        crash_point("after-checkpoint");
+        self.checkpoint_begin()?;
+        self.settle()
+    }
+
+    /// Begins a checkpoint ([`RecordingWriter::checkpoint`]) of the manifest as it stands
+    /// and returns at once: the writer thread does it after the rows already handed over,
+    /// while the caller goes on. Its error surfaces at the next checkpoint, sync or
+    /// [`RecordingWriter::settle`] ([`RecordingWriter::finish`] settles first); then the
+    /// segments it added are taken out of the manifest again, since their data may not all
+    /// be on the disk. An error of the checkpoint before this one is returned here, and
+    /// this one is not begun.
+    pub fn checkpoint_begin(&mut self) -> io::Result<()> {
+        self.settle()?;
+        self.send_pending()?;
+        let yaml = manifest_yaml(&self.manifest)?;
+        let (tx, rx) = mpsc::channel();
+        self.send(Msg::Checkpoint(yaml, tx))?;
+        self.in_flight = Some((rx, self.manifest.segments.len()));
         Ok(())
+    }
+
+    /// Waits for the checkpoint begun, if any ([`RecordingWriter::checkpoint_begin`]): its
+    /// error, with the segments listed since the last checkpoint that succeeded taken out
+    /// of the manifest.
+    pub fn settle(&mut self) -> io::Result<()> {
+        let Some((rx, listed)) = self.in_flight.take() else {
+            return Ok(());
+        };
+        let r = rx.recv().map_err(|_| gone()).and_then(|r| r);
+        match r {
+            Ok(()) => self.durable = listed,
+            Err(_) => self.manifest.segments.truncate(self.durable),
+        }
+        r
     }
 
     fn write_manifest(&self) -> io::Result<()> {
         let yaml = manifest_yaml(&self.manifest)?;
-        crate::commit::write_atomic(&self.dir, "manifest.yaml", yaml.as_bytes())
-            .map_err(|e| io::Error::new(e.kind(), format!("manifest.yaml: {e}")))
+        write_manifest_text(&self.dir, &yaml)
     }
 
     /// Ends the recording: records the SHA-256 of each data file in `run.files_sha256`,
     /// sets `run.ended`, and writes the final manifest. After a failed write the streams
     /// end cut after their last full line and the manifest says so (`run.write_failure`).
     pub fn finish(&mut self) -> io::Result<()> {
+        // A failed checkpoint's error is the writer thread's too: `Hashes` reports it.
+        let _ = self.settle();
         self.send_pending()?;
         let (tx, rx) = mpsc::channel();
         self.send(Msg::Hashes(tx))?;

@@ -20,6 +20,12 @@ use tokio::time::{Instant, sleep_until};
 /// data is ever only in memory; half of it leaves room for a slow tick).
 const FLUSH_EVERY_S: f64 = 0.5;
 
+/// Run-clock time between looks at the wall clock for [`FLUSH_EVERY_S`], s: a real run's
+/// clock is the wall's, so a flush is at most this late; a simulated run looks a few times
+/// per simulated second, not at every tick (a clock read each is a tenth of a dry run's
+/// interpreter).
+const FLUSH_LOOK_S: f64 = 0.1;
+
 /// Why the walk stops early.
 pub(super) enum Stop {
     Abort(AbortRecord),
@@ -78,6 +84,7 @@ pub async fn execute(
         fires: Vec::new(),
         last_progress: f64::NEG_INFINITY,
         last_flush: std::time::Instant::now(),
+        flush_look: f64::NEG_INFINITY,
         stall_s: opts.stall_timeout_s.max(3.0 / info.sample_hz.max(1e-3)),
         imu_hz: info.sample_hz,
         table_hz: table_info.feedback_hz,
@@ -100,6 +107,8 @@ pub async fn execute(
         Ok(()) => ex.walk().await,
         Err(e) => Err(e),
     };
+    // The last segment's checkpoint may still be under way: its failure aborts the run.
+    let result = result.and_then(|()| ex.settled());
     let status = match result {
         Ok(()) => {
             if matches!(ex.cmd.outer, AxisCmd::Rate(_) | AxisCmd::Osc { .. })
@@ -196,6 +205,8 @@ struct Exec<'a> {
     fires: Vec<Fire>,
     last_progress: f64,
     last_flush: std::time::Instant,
+    /// Run-clock time of the last look at the wall clock for a flush.
+    flush_look: f64,
     stall_s: f64,
     imu_hz: f64,
     table_hz: f64,
@@ -239,6 +250,14 @@ impl Exec<'_> {
         })
     }
 
+    /// Waits until every segment recorded so far is persisted (the sink's checkpoints run
+    /// beside the interpreter); one that could not be aborts the run.
+    fn settled(&mut self) -> Res {
+        self.sink
+            .settle()
+            .map_err(|e| self.abort("recording error".into(), e.to_string()))
+    }
+
     async fn walk(&mut self) -> Res {
         let plan = self.plan;
         for (i, step) in plan.steps.iter().enumerate().skip(self.opts.start_step) {
@@ -252,6 +271,8 @@ impl Exec<'_> {
             let mut vars = Vec::new();
             self.nodes(&step.body, &mut vars).await?;
             self.monitor.leave_step();
+            // A resume trusts `step_end`: its segments are on the disk before it is written.
+            self.settled()?;
             self.journal(JournalEvent::StepEnd {
                 index: i,
                 segments: self.total_segments(),
@@ -778,6 +799,10 @@ impl Exec<'_> {
         }
         // Wall-clock time: a simulated run on the paused clock flushes as rarely as a real
         // one, not every half second of simulated time.
+        if now - self.flush_look < FLUSH_LOOK_S {
+            return Ok(());
+        }
+        self.flush_look = now;
         if self.last_flush.elapsed().as_secs_f64() >= FLUSH_EVERY_S {
             self.last_flush = std::time::Instant::now();
             if let Err(e) = self.sink.flush() {
