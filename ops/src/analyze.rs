@@ -88,6 +88,9 @@ pub fn analyze(args: &Request) -> u8 {
             .runs
             .first()
             .and_then(|d| ratecal_certificate::stated_of_folder(d)),
+        // The Allan series of a long block waits in an unlinked file of the temp dir, not
+        // in memory.
+        scratch: Some(fit::Scratch::new(tempfile::tempfile)),
         ..Options::default()
     };
     // The IMU stream is read a window at a time: a cell found bad there is refused as a

@@ -36,6 +36,7 @@ use joint::{Layout, SegAcc};
 use ratecal_physics::{Mat3, Vec3};
 use segment::Summary;
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 pub(crate) const AXES: [&str; 3] = ["x", "y", "z"];
 
@@ -62,6 +63,32 @@ pub struct Options {
     /// GUM budget (results.json `budgets`) and the checks on parameters are judged with
     /// its `U` and `k`; without, with the fit's Type A uncertainty at k = 2.
     pub stated: Option<crate::budget::terms::Stated>,
+    /// Where the Allan block's gyro series may be kept instead of memory (87 MB at 1 kHz
+    /// for an hour at rest): with it the series is written to a scratch file as it comes
+    /// and read back a block at a time, and the analysis holds a few MB of it whatever
+    /// the recording's length; without, it stays in memory. The curves are the same to
+    /// the bit either way. A scratch file that cannot be opened or written leaves the
+    /// series in memory; one that cannot be read back leaves the Allan parameters
+    /// unobservable, with a warning.
+    pub scratch: Option<Scratch>,
+}
+
+/// Opens a fresh scratch file, read and written, empty, removed when closed (as
+/// `tempfile::tempfile`): the analysis opens no file of its own.
+#[derive(Clone)]
+pub struct Scratch(pub Arc<dyn Fn() -> std::io::Result<std::fs::File> + Send + Sync>);
+
+impl Scratch {
+    /// Scratch files opened by `open`.
+    pub fn new(open: impl Fn() -> std::io::Result<std::fs::File> + Send + Sync + 'static) -> Self {
+        Scratch(Arc::new(open))
+    }
+}
+
+impl std::fmt::Debug for Scratch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Scratch")
+    }
 }
 
 impl Default for Options {
@@ -74,6 +101,7 @@ impl Default for Options {
             window_rows: segment::WINDOW_ROWS,
             parallel_windows: true,
             stated: None,
+            scratch: None,
         }
     }
 }
@@ -185,10 +213,14 @@ pub fn analyze_source<S: Source>(
     if let Some(ix) = &sel.size_effect {
         size_effect::fit(&*src.recording()?, ix, &mut out);
     }
-    let allan = sel
-        .allan
-        .zip(curves.as_ref())
-        .and_then(|(i, c)| allan::analyse(&m.segments[i].id, c, &mut out));
+    let allan = match (sel.allan, curves) {
+        (Some(i), Some(Ok(c))) => allan::analyse(&m.segments[i].id, &c, &mut out),
+        (Some(i), Some(Err(e))) => {
+            allan::unreadable(&m.segments[i].id, &e, &mut out);
+            None
+        }
+        _ => None,
+    };
     // results.json always lists bias and scale of both sensors on every axis.
     for s in ["accel", "gyro"] {
         for what in ["bias", "scale"] {
@@ -300,6 +332,7 @@ pub(crate) fn accumulate_all<S: Source>(
                 t_ref_c,
                 prep: None,
                 allan: false,
+                spill: None,
                 verify: false,
                 rate_hz,
                 window_rows: segment::WINDOW_ROWS,
@@ -379,6 +412,12 @@ fn pass_segments<S: Source>(
         rate_hz,
         t_ref_c,
     } = Context::of(src, layout)?;
+    // The Allan series goes to a scratch file when one is handed in and opens; else it
+    // stays in memory.
+    let spill = (opts.scratch.as_ref())
+        .filter(|_| (0..m.segments.len()).any(|i| what(i).1))
+        .and_then(|open| open.0().ok())
+        .map(|file| Arc::new(allan::Spill::new(file)));
     let mut jobs = Vec::new();
     for i in 0..m.segments.len() {
         let (prep, allan, verify) = what(i);
@@ -389,6 +428,7 @@ fn pass_segments<S: Source>(
             t_ref_c,
             prep,
             allan,
+            spill: spill.as_ref(),
             verify,
             rate_hz,
             window_rows: opts.window_rows,

@@ -235,7 +235,7 @@ pub fn journal_warnings(dir: &Path) -> Vec<String> {
 /// Analyses the recording kept (complete or not), writes results.json, plan.json and the
 /// reports; the verdict, or `None` when the recording could not be analysed.
 fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict> {
-    use ratecal_analysis::fit::{Options, Source, Streamed, analyze_source};
+    use ratecal_analysis::fit::{Options, Scratch, Source, Streamed, analyze_source};
     // The recording is read back a window at a time, as `ratecal analyze` reads it.
     let unreadable = |e| {
         errln!("{:?}", Report::new(e));
@@ -246,6 +246,9 @@ fn analyze(dir: &Path, plan: &Plan, archive: Option<&str>) -> Option<RunVerdict>
     // parameters judged with its U and k (the certificate states the same).
     let opts = Options {
         stated: ratecal_certificate::stated_of_folder(dir),
+        // The Allan series of a long block waits in an unlinked file of the temp dir, not
+        // in memory.
+        scratch: Some(Scratch::new(tempfile::tempfile)),
         ..Options::default()
     };
     // The report's temperature plot is read beside the analysis: its one pass over two

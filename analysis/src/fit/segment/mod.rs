@@ -49,6 +49,8 @@ pub(crate) struct Job<'a> {
     pub prep: Option<PrepOptions>,
     /// Whether to keep the kept gyro series for the Allan analysis.
     pub allan: bool,
+    /// Where that series goes as it comes (in memory without).
+    pub spill: Option<&'a std::sync::Arc<super::allan::Spill>>,
     /// Whether to keep the outputs against their references (a verification segment).
     pub verify: bool,
     /// Mean IMU rate of the recording, Hz (sizes the windows).
@@ -167,7 +169,8 @@ pub(crate) fn pass<S: Source>(src: &S, job: &Job) -> Result<(Summary, SegAcc), S
             angle_sums: (0.0, 0.0),
             step_s: f64::NAN,
             channels: Default::default(),
-            allan: (job.allan && job.prep.is_some()).then(Default::default),
+            allan: (job.allan && job.prep.is_some())
+                .then(|| super::allan::Series::new(job.spill.cloned())),
             raw: RawSums::default(),
         },
         step: None,

@@ -1,0 +1,250 @@
+//! The Allan series out of core: a 1 kHz hour at rest is 87 MB of gyro samples (174 MB at
+//! 2 kHz), so with a scratch file handed in ([`super::super::Scratch`]) the series lives
+//! there and the analysis holds a few MB of it at a time, whatever the recording's length.
+//!
+//! - Each window's kept samples are written as soon as the window has passed, at the next
+//!   free stretch of the file (the windows pass side by side and finish in any order); the
+//!   series keeps where each of its chunks went, in series order.
+//! - The curves first integrate every axis's chunks, read back in series order, to angles
+//!   written contiguously after them (the same running sum as in memory).
+//! - Each cluster-size group then sweeps `k` in blocks of [`BLOCK`] samples: a block reads
+//!   the angles at `k - 1` and at `k - 1 + m`, `k - 1 + 2m` for each size `m` with
+//!   positioned reads (one `File` shared by the tasks), the ranges that overlap read as
+//!   one (small sizes: one range a block; large sizes: a range per distinct offset).
+//!
+//! Every sum adds the same terms in the same order as in memory, so the curves are the
+//! same to the bit. A failed write leaves the rest of the series in memory; a failed read
+//! is returned.
+
+use super::{Part, Theta, add_run};
+use std::fs::File;
+use std::io;
+use std::os::unix::fs::FileExt;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+
+/// Samples of `k` a sweep reads at once (1 MB a range).
+pub(super) const BLOCK: usize = 1 << 17;
+/// Values moved between the file and memory per read or write (512 KB).
+const STEP: usize = 1 << 16;
+
+/// A scratch file the series is written to, shared by the windows that pass side by side
+/// and by the curves' tasks.
+#[derive(Debug)]
+pub(crate) struct Spill {
+    file: File,
+    /// The first byte no stretch has taken.
+    end: AtomicU64,
+    /// Whether a write has failed: nothing more is written.
+    failed: AtomicBool,
+}
+
+impl Spill {
+    /// A spill into `file` (empty: it is written from its start).
+    pub(crate) fn new(file: File) -> Spill {
+        Spill {
+            file,
+            end: AtomicU64::new(0),
+            failed: AtomicBool::new(false),
+        }
+    }
+
+    /// Writes `v` at a stretch of its own and says where, or `None` when a write has
+    /// failed (this one or one before: the rest of the series stays in memory).
+    pub(super) fn write(&self, v: &[f64]) -> Option<u64> {
+        if self.failed.load(Ordering::Relaxed) {
+            return None;
+        }
+        let at = self.reserve(v.len());
+        match self.write_at(v, at, &mut Vec::new()) {
+            Ok(()) => Some(at),
+            Err(_) => {
+                self.failed.store(true, Ordering::Relaxed);
+                None
+            }
+        }
+    }
+
+    /// Takes a stretch of `n` values: its first byte.
+    fn reserve(&self, n: usize) -> u64 {
+        self.end.fetch_add(8 * n as u64, Ordering::Relaxed)
+    }
+
+    /// Writes `v` from byte `at`, through `bytes`.
+    fn write_at(&self, v: &[f64], at: u64, bytes: &mut Vec<u8>) -> io::Result<()> {
+        for (i, piece) in v.chunks(STEP).enumerate() {
+            bytes.resize(8 * piece.len(), 0);
+            for (b, x) in bytes.chunks_exact_mut(8).zip(piece) {
+                b.copy_from_slice(&x.to_le_bytes());
+            }
+            self.file.write_all_at(bytes, at + (8 * i * STEP) as u64)?;
+        }
+        Ok(())
+    }
+
+    /// Reads `out.len()` values from byte `at`, through `bytes`.
+    pub(super) fn read_at(&self, out: &mut [f64], at: u64, bytes: &mut Vec<u8>) -> io::Result<()> {
+        for (i, piece) in out.chunks_mut(STEP).enumerate() {
+            bytes.resize(8 * piece.len(), 0);
+            self.file.read_exact_at(bytes, at + (8 * i * STEP) as u64)?;
+            for (x, b) in piece.iter_mut().zip(bytes.chunks_exact(8)) {
+                *x = f64::from_le_bytes(b.try_into().expect("8 bytes"));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One axis's angles in the scratch file: `len` values from byte `at`, value `i` the angle
+/// `theta[i + 1]`.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Angles {
+    at: u64,
+    len: usize,
+}
+
+/// Integrates an axis's rates (`parts`, in series order) sampled every `dt` to angles
+/// written after everything else in the file, `step` values at a time.
+pub(super) fn integrate(spill: &Spill, parts: &[Part], dt: f64, step: usize) -> io::Result<Angles> {
+    let len = parts.iter().map(Part::len).sum();
+    let mut w = AngleWriter {
+        spill,
+        angles: Angles {
+            at: spill.reserve(len),
+            len,
+        },
+        written: 0,
+        acc: 0.0,
+        dt,
+        out: Vec::with_capacity(step.min(len)),
+        step,
+        bytes: Vec::new(),
+    };
+    let mut rates = Vec::new();
+    let mut bytes = Vec::new();
+    for p in parts {
+        match p {
+            Part::Held(v) => w.add(v)?,
+            &Part::Spilled { at, len } => {
+                for i in (0..len).step_by(step) {
+                    rates.resize(step.min(len - i), 0.0);
+                    spill.read_at(&mut rates, at + 8 * i as u64, &mut bytes)?;
+                    w.add(&rates)?;
+                }
+            }
+        }
+    }
+    w.flush()?;
+    Ok(w.angles)
+}
+
+/// The running sum of the rates, written as it grows.
+struct AngleWriter<'a> {
+    spill: &'a Spill,
+    angles: Angles,
+    /// Angles written so far.
+    written: usize,
+    acc: f64,
+    dt: f64,
+    /// Angles not yet written (at most `step`).
+    out: Vec<f64>,
+    step: usize,
+    bytes: Vec<u8>,
+}
+
+impl AngleWriter<'_> {
+    /// The angles after these rates, in order.
+    fn add(&mut self, mut rates: &[f64]) -> io::Result<()> {
+        while !rates.is_empty() {
+            let (now, rest) = rates.split_at((self.step - self.out.len()).min(rates.len()));
+            for v in now {
+                self.acc += v * self.dt;
+                self.out.push(self.acc);
+            }
+            if self.out.len() == self.step {
+                self.flush()?;
+            }
+            rates = rest;
+        }
+        Ok(())
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        let at = self.angles.at + 8 * self.written as u64;
+        self.spill.write_at(&self.out, at, &mut self.bytes)?;
+        self.written += self.out.len();
+        self.out.clear();
+        Ok(())
+    }
+}
+
+/// An axis's angles read from the scratch file in blocks of `block` samples of `k`.
+pub(super) struct OnFile<'a> {
+    pub spill: &'a Spill,
+    pub angles: Angles,
+    pub block: usize,
+}
+
+impl Theta for OnFile<'_> {
+    type Error = io::Error;
+
+    fn len(&self) -> usize {
+        self.angles.len
+    }
+
+    fn at(&self, i: usize) -> io::Result<f64> {
+        let mut v = [0.0];
+        let at = self.angles.at + 8 * i as u64;
+        self.spill.read_at(&mut v, at, &mut Vec::new())?;
+        Ok(v[0])
+    }
+
+    fn sweep<const N: usize>(
+        &self,
+        ms: [usize; N],
+        s: &mut [f64; N],
+        mut k: usize,
+        end: usize,
+    ) -> io::Result<()> {
+        // The offsets from `k - 1` each block reads at; ranges that overlap are read once.
+        let mut offsets: Vec<usize> = std::iter::once(0)
+            .chain(ms)
+            .chain(ms.map(|m| 2 * m))
+            .collect();
+        offsets.sort_unstable();
+        offsets.dedup();
+        let (mut buf, mut bytes) = (Vec::new(), Vec::new());
+        // (first offset, end offset, where the range starts in `buf`)
+        let mut ranges: Vec<(usize, usize, usize)> = Vec::new();
+        while k < end {
+            let run = (end - k).min(self.block);
+            ranges.clear();
+            for &o in &offsets {
+                match ranges.last_mut() {
+                    Some(r) if o <= r.1 => r.1 = o + run,
+                    last => {
+                        let place = last.map_or(0, |r| r.2 + r.1 - r.0);
+                        ranges.push((o, o + run, place));
+                    }
+                }
+            }
+            let &(o0, o1, place) = ranges.last().expect("offset 0 at least");
+            buf.resize(place + o1 - o0, 0.0);
+            for &(o0, o1, place) in &ranges {
+                let at = self.angles.at + 8 * (k - 1 + o0) as u64;
+                self.spill
+                    .read_at(&mut buf[place..place + o1 - o0], at, &mut bytes)?;
+            }
+            let from = |o: usize| -> &[f64] {
+                let r = ranges
+                    .iter()
+                    .rev()
+                    .find(|r| r.0 <= o)
+                    .expect("offset 0 first");
+                &buf[r.2 + o - r.0..][..run]
+            };
+            add_run(from(0), ms.map(from), ms.map(|m| from(2 * m)), s);
+            k += run;
+        }
+        Ok(())
+    }
+}
