@@ -484,15 +484,15 @@ mod tests {
     }
 
     /// Spilled to a scratch file as it comes and read back in blocks from 5 samples (the
-    /// small sizes' ranges read as one, the large sizes' each on its own, blocks and
-    /// integration pieces ending everywhere) to the whole series at once, the curve is the
-    /// textbook one to the bit; so it is with some chunks left in memory among the
-    /// spilled ones.
+    /// large sizes' offsets read each on its own, the small sizes' through the sliding
+    /// window, blocks and integration pieces ending everywhere) to the whole series at
+    /// once, the curve is the textbook one to the bit; so it is with some chunks left in
+    /// memory among the spilled ones.
     #[test]
     fn spilled_curve_is_the_textbook_one_to_the_bit() {
         let y = rates(CUTS[CUTS.len() - 1]);
         let want = textbooks(&y, 0.01);
-        for block in [5, 64, 1_000, 1 << 17] {
+        for block in [5, 64, 1_000, super::spill::BLOCK] {
             let spill = Arc::new(Spill::new(tempfile::tempfile().unwrap()));
             let mut series = chunked(&y, Some(spill));
             let spilled = series.chunks.iter().flatten();

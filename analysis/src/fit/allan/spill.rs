@@ -7,10 +7,12 @@
 //!   series keeps where each of its chunks went, in series order.
 //! - The curves first integrate every axis's chunks, read back in series order, to angles
 //!   written contiguously after them (the same running sum as in memory).
-//! - Each cluster-size group then sweeps `k` in blocks of [`BLOCK`] samples: a block reads
-//!   the angles at `k - 1` and at `k - 1 + m`, `k - 1 + 2m` for each size `m` with
-//!   positioned reads (one `File` shared by the tasks), the ranges that overlap read as
-//!   one (small sizes: one range a block; large sizes: a range per distinct offset).
+//! - Each cluster-size group then sweeps `k` in blocks of [`BLOCK`] samples or more,
+//!   reading the angles at `k - 1` and at `k - 1 + m`, `k - 1 + 2m` for each size `m`
+//!   with positioned reads (one `File` shared by the tasks). While the farthest offset
+//!   is within [`SLIDE`] blocks, a window of the angles slides along the series and each
+//!   is read once (at most 2 x 16 x [`BLOCK`] values held, 16 MB); beyond, each block
+//!   reads the range at each distinct offset, so that nothing held grows with the series.
 //!
 //! Every sum adds the same terms in the same order as in memory, so the curves are the
 //! same to the bit. A failed write leaves the rest of the series in memory; a failed read
@@ -22,8 +24,8 @@ use std::io;
 use std::os::unix::fs::FileExt;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
-/// Samples of `k` a sweep reads at once (1 MB a range).
-pub(super) const BLOCK: usize = 1 << 17;
+/// Samples of `k` a sweep reads at once, at least (512 KB a range).
+pub(super) const BLOCK: usize = 1 << 16;
 /// Values moved between the file and memory per read or write (512 KB).
 const STEP: usize = 1 << 16;
 
@@ -73,8 +75,8 @@ impl Spill {
     fn write_at(&self, v: &[f64], at: u64, bytes: &mut Vec<u8>) -> io::Result<()> {
         for (i, piece) in v.chunks(STEP).enumerate() {
             bytes.resize(8 * piece.len(), 0);
-            for (b, x) in bytes.chunks_exact_mut(8).zip(piece) {
-                b.copy_from_slice(&x.to_le_bytes());
+            for (b, x) in bytes.as_chunks_mut::<8>().0.iter_mut().zip(piece) {
+                *b = x.to_le_bytes();
             }
             self.file.write_all_at(bytes, at + (8 * i * STEP) as u64)?;
         }
@@ -86,8 +88,8 @@ impl Spill {
         for (i, piece) in out.chunks_mut(STEP).enumerate() {
             bytes.resize(8 * piece.len(), 0);
             self.file.read_exact_at(bytes, at + (8 * i * STEP) as u64)?;
-            for (x, b) in piece.iter_mut().zip(bytes.chunks_exact(8)) {
-                *x = f64::from_le_bytes(b.try_into().expect("8 bytes"));
+            for (x, b) in piece.iter_mut().zip(bytes.as_chunks::<8>().0) {
+                *x = f64::from_le_bytes(*b);
             }
         }
         Ok(())
@@ -156,10 +158,14 @@ impl AngleWriter<'_> {
     fn add(&mut self, mut rates: &[f64]) -> io::Result<()> {
         while !rates.is_empty() {
             let (now, rest) = rates.split_at((self.step - self.out.len()).min(rates.len()));
-            for v in now {
-                self.acc += v * self.dt;
-                self.out.push(self.acc);
-            }
+            // The running sum in a register, not through `self`: each addition waits on
+            // the one before.
+            let (mut acc, dt) = (self.acc, self.dt);
+            self.out.extend(now.iter().map(|v| {
+                acc += v * dt;
+                acc
+            }));
+            self.acc = acc;
             if self.out.len() == self.step {
                 self.flush()?;
             }
@@ -177,11 +183,49 @@ impl AngleWriter<'_> {
     }
 }
 
+/// How far past a block (in blocks) a sweep may read and still keep what the next block
+/// reads again in memory: beyond, each offset's range is read on its own.
+const SLIDE: usize = 16;
+
 /// An axis's angles read from the scratch file in blocks of `block` samples of `k`.
 pub(super) struct OnFile<'a> {
     pub spill: &'a Spill,
     pub angles: Angles,
     pub block: usize,
+}
+
+impl OnFile<'_> {
+    /// [`Theta::sweep`] with a window of the angles `c[k - 1 ..]` as long as a block and
+    /// the farthest offset read (`reach`) that slides along the series: each angle is read
+    /// once, and what the next block reads again is moved, not read (the blocks are at
+    /// least `reach` long, so no more is moved than read).
+    fn slide<const N: usize>(
+        &self,
+        ms: [usize; N],
+        s: &mut [f64; N],
+        mut k: usize,
+        end: usize,
+        reach: usize,
+    ) -> io::Result<()> {
+        let block = self.block.max(reach);
+        let (mut buf, mut bytes) = (Vec::new(), Vec::new());
+        // The values at the start of `buf` that are already `c[k - 1 ..]`.
+        let mut held = 0;
+        while k < end {
+            let run = (end - k).min(block);
+            buf.resize(reach + run, 0.0);
+            let at = self.angles.at + 8 * (k - 1 + held) as u64;
+            self.spill.read_at(&mut buf[held..], at, &mut bytes)?;
+            let from = |o: usize| &buf[o..o + run];
+            add_run(from(0), ms.map(from), ms.map(|m| from(2 * m)), s);
+            k += run;
+            if k < end {
+                buf.copy_within(run.., 0);
+                held = reach;
+            }
+        }
+        Ok(())
+    }
 }
 
 impl Theta for OnFile<'_> {
@@ -205,42 +249,29 @@ impl Theta for OnFile<'_> {
         mut k: usize,
         end: usize,
     ) -> io::Result<()> {
-        // The offsets from `k - 1` each block reads at; ranges that overlap are read once.
+        // The offsets from `k - 1` each block reads at.
         let mut offsets: Vec<usize> = std::iter::once(0)
             .chain(ms)
             .chain(ms.map(|m| 2 * m))
             .collect();
         offsets.sort_unstable();
         offsets.dedup();
+        let reach = offsets[offsets.len() - 1];
+        if reach <= SLIDE * self.block {
+            return self.slide(ms, s, k, end, reach);
+        }
+        // Offsets this far apart are more than a block apart: a range each.
         let (mut buf, mut bytes) = (Vec::new(), Vec::new());
-        // (first offset, end offset, where the range starts in `buf`)
-        let mut ranges: Vec<(usize, usize, usize)> = Vec::new();
         while k < end {
             let run = (end - k).min(self.block);
-            ranges.clear();
-            for &o in &offsets {
-                match ranges.last_mut() {
-                    Some(r) if o <= r.1 => r.1 = o + run,
-                    last => {
-                        let place = last.map_or(0, |r| r.2 + r.1 - r.0);
-                        ranges.push((o, o + run, place));
-                    }
-                }
+            buf.resize(offsets.len() * run, 0.0);
+            for (range, &o) in buf.chunks_exact_mut(run).zip(&offsets) {
+                let at = self.angles.at + 8 * (k - 1 + o) as u64;
+                self.spill.read_at(range, at, &mut bytes)?;
             }
-            let &(o0, o1, place) = ranges.last().expect("offset 0 at least");
-            buf.resize(place + o1 - o0, 0.0);
-            for &(o0, o1, place) in &ranges {
-                let at = self.angles.at + 8 * (k - 1 + o0) as u64;
-                self.spill
-                    .read_at(&mut buf[place..place + o1 - o0], at, &mut bytes)?;
-            }
-            let from = |o: usize| -> &[f64] {
-                let r = ranges
-                    .iter()
-                    .rev()
-                    .find(|r| r.0 <= o)
-                    .expect("offset 0 first");
-                &buf[r.2 + o - r.0..][..run]
+            let from = |o: usize| {
+                let i = offsets.binary_search(&o).expect("an offset read");
+                &buf[i * run..][..run]
             };
             add_run(from(0), ms.map(from), ms.map(|m| from(2 * m)), s);
             k += run;
