@@ -2,6 +2,7 @@
 //! tau = 1 s and bias instability (minimum of the curve / 0.664).
 
 mod spill;
+mod stream;
 
 pub(crate) use spill::Spill;
 
@@ -299,19 +300,43 @@ fn curves_in_blocks(series: Series, dt: f64, block: usize) -> io::Result<Curves>
             return Ok(curves);
         }
     };
-    let angles = (axes.par_iter())
-        .map(|parts| spill::integrate(&spill, parts, dt, block))
-        .collect::<io::Result<Vec<_>>>()?;
-    // What a failed write left in memory is in the file now.
-    drop(axes);
-    let series: Vec<OnFile> = (angles.into_iter())
-        .map(|angles| OnFile {
-            spill: &spill,
-            angles,
-            block,
+    // The groups whose offsets fit in a stream's ring are summed as each axis is read
+    // back; the farther ones (a long recording's largest sizes) from the angles it writes.
+    let lens = axes
+        .each_ref()
+        .map(|parts| parts.iter().map(Part::len).sum::<usize>());
+    let split = |n: usize| -> (Vec<Vec<usize>>, Vec<Vec<usize>>) {
+        (groups(n).into_iter()).partition(|g| 2 * g[g.len() - 1] <= spill::SLIDE * block)
+    };
+    let streamed = (axes.par_iter().zip(&lens))
+        .map(|(parts, &n)| {
+            let (near, far) = split(n);
+            stream::stream(&spill, parts, dt, &near, !far.is_empty(), block)
         })
+        .collect::<io::Result<Vec<_>>>()?;
+    // What a failed write left in memory has been read.
+    drop(axes);
+    let tasks: Vec<(usize, Vec<usize>, spill::Angles)> = (streamed.iter().enumerate())
+        .filter_map(|(ax, (_, angles))| Some((ax, (*angles)?)))
+        .flat_map(|(ax, angles)| split(lens[ax]).1.into_iter().map(move |g| (ax, g, angles)))
         .collect();
-    curves_of(&series, dt)
+    let far: Vec<(usize, Vec<f64>)> = tasks
+        .into_par_iter()
+        .map(|(ax, g, angles)| {
+            let on_file = OnFile {
+                spill: &spill,
+                angles,
+                block,
+            };
+            Ok((ax, group_sums(&on_file, g)?))
+        })
+        .collect::<io::Result<_>>()?;
+    let curves = (streamed.into_iter().enumerate()).map(|(ax, (near, _))| {
+        let far = far.iter().filter(|(a, _)| *a == ax).flat_map(|(_, s)| s);
+        let s: Vec<f64> = near.into_iter().flatten().chain(far.copied()).collect();
+        curve(lens[ax], &s, dt)
+    });
+    Ok(curves.collect())
 }
 
 /// The curves of integrated series, one per axis.

@@ -18,7 +18,7 @@
 //! same to the bit. A failed write leaves the rest of the series in memory; a failed read
 //! is returned.
 
-use super::{Part, Theta, add_run};
+use super::{Theta, add_run};
 use std::fs::File;
 use std::io;
 use std::os::unix::fs::FileExt;
@@ -104,88 +104,30 @@ pub(super) struct Angles {
     len: usize,
 }
 
-/// Integrates an axis's rates (`parts`, in series order) sampled every `dt` to angles
-/// written after everything else in the file, `step` values at a time.
-pub(super) fn integrate(spill: &Spill, parts: &[Part], dt: f64, step: usize) -> io::Result<Angles> {
-    let len = parts.iter().map(Part::len).sum();
-    let mut w = AngleWriter {
-        spill,
-        angles: Angles {
+impl Angles {
+    /// A stretch of the file for `len` angles.
+    pub(super) fn reserve(spill: &Spill, len: usize) -> Angles {
+        Angles {
             at: spill.reserve(len),
             len,
-        },
-        written: 0,
-        acc: 0.0,
-        dt,
-        out: Vec::with_capacity(step.min(len)),
-        step,
-        bytes: Vec::new(),
-    };
-    let mut rates = Vec::new();
-    let mut bytes = Vec::new();
-    for p in parts {
-        match p {
-            Part::Held(v) => w.add(v)?,
-            &Part::Spilled { at, len } => {
-                for i in (0..len).step_by(step) {
-                    rates.resize(step.min(len - i), 0.0);
-                    spill.read_at(&mut rates, at + 8 * i as u64, &mut bytes)?;
-                    w.add(&rates)?;
-                }
-            }
         }
     }
-    w.flush()?;
-    Ok(w.angles)
-}
 
-/// The running sum of the rates, written as it grows.
-struct AngleWriter<'a> {
-    spill: &'a Spill,
-    angles: Angles,
-    /// Angles written so far.
-    written: usize,
-    acc: f64,
-    dt: f64,
-    /// Angles not yet written (at most `step`).
-    out: Vec<f64>,
-    step: usize,
-    bytes: Vec<u8>,
-}
-
-impl AngleWriter<'_> {
-    /// The angles after these rates, in order.
-    fn add(&mut self, mut rates: &[f64]) -> io::Result<()> {
-        while !rates.is_empty() {
-            let (now, rest) = rates.split_at((self.step - self.out.len()).min(rates.len()));
-            // The running sum in a register, not through `self`: each addition waits on
-            // the one before.
-            let (mut acc, dt) = (self.acc, self.dt);
-            self.out.extend(now.iter().map(|v| {
-                acc += v * dt;
-                acc
-            }));
-            self.acc = acc;
-            if self.out.len() == self.step {
-                self.flush()?;
-            }
-            rates = rest;
-        }
-        Ok(())
-    }
-
-    fn flush(&mut self) -> io::Result<()> {
-        let at = self.angles.at + 8 * self.written as u64;
-        self.spill.write_at(&self.out, at, &mut self.bytes)?;
-        self.written += self.out.len();
-        self.out.clear();
-        Ok(())
+    /// Writes the angles from value `i` on, through `bytes`.
+    pub(super) fn write(
+        &self,
+        spill: &Spill,
+        i: usize,
+        v: &[f64],
+        bytes: &mut Vec<u8>,
+    ) -> io::Result<()> {
+        spill.write_at(v, self.at + 8 * i as u64, bytes)
     }
 }
 
 /// How far past a block (in blocks) a sweep may read and still keep what the next block
 /// reads again in memory: beyond, each offset's range is read on its own.
-const SLIDE: usize = 16;
+pub(super) const SLIDE: usize = 16;
 
 /// An axis's angles read from the scratch file in blocks of `block` samples of `k`.
 pub(super) struct OnFile<'a> {
