@@ -5,14 +5,14 @@
 //! - Each window's kept samples are written as soon as the window has passed, at the next
 //!   free stretch of the file (the windows pass side by side and finish in any order); the
 //!   series keeps where each of its chunks went, in series order.
-//! - The curves first integrate every axis's chunks, read back in series order, to angles
-//!   written contiguously after them (the same running sum as in memory).
-//! - Each cluster-size group then sweeps `k` in blocks of [`BLOCK`] samples or more,
-//!   reading the angles at `k - 1` and at `k - 1 + m`, `k - 1 + 2m` for each size `m`
-//!   with positioned reads (one `File` shared by the tasks). While the farthest offset
-//!   is within [`SLIDE`] blocks, a window of the angles slides along the series and each
-//!   is read once (at most 2 x 16 x [`BLOCK`] values held, 16 MB); beyond, each block
-//!   reads the range at each distinct offset, so that nothing held grows with the series.
+//! - The curves read each axis back once, in series order, and integrate it (the same
+//!   running sum as in memory) into a ring as long as two blocks and the farthest offset
+//!   `2m` of the sizes up to [`SLIDE`] blocks: their sums are taken as the angles come
+//!   (`stream.rs`). At most 2^20 + 2^17 values an axis are held (9 MB).
+//! - Larger sizes (only beyond a 1 kHz hour: a 2 kHz hour's largest) need angles further
+//!   apart than that: the angles are then also written to the file, and those sizes
+//!   sweep `k` in blocks of [`BLOCK`], reading `theta` at `k`, `k + m` and `k + 2m` with
+//!   positioned reads ([`OnFile`]; one `File` shared by the tasks).
 //!
 //! Every sum adds the same terms in the same order as in memory, so the curves are the
 //! same to the bit. A failed write leaves the rest of the series in memory; a failed read
@@ -125,8 +125,9 @@ impl Angles {
     }
 }
 
-/// How far past a block (in blocks) a sweep may read and still keep what the next block
-/// reads again in memory: beyond, each offset's range is read on its own.
+/// How far (in blocks) the offsets of the sizes whose angles are kept in memory while
+/// they are needed may reach (the stream's ring, a sweep's sliding window): farther
+/// offsets are read on their own.
 pub(super) const SLIDE: usize = 16;
 
 /// An axis's angles read from the scratch file in blocks of `block` samples of `k`.
