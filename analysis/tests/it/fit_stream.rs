@@ -184,3 +184,28 @@ fn windows_side_by_side_give_the_numbers_of_one_pass() {
         assert!((x.std - y.std).abs() <= 1e-9 * x.std, "{x:?} vs {y:?}");
     }
 }
+
+/// The Allan series written to a scratch file as its windows pass (side by side, so out of
+/// order) and read back gives the results of the series held in memory, to the byte; so
+/// does a scratch file that cannot be opened (the series stays in memory).
+#[test]
+fn an_allan_series_spilled_to_a_scratch_file_gives_the_results_held_in_memory() {
+    let tmp = sim(&SimSpec::tactical(24));
+    let streamed = fit::Streamed::open(tmp.path()).unwrap();
+    let opts = |scratch: Option<fit::Scratch>| fit::Options {
+        // 12,000 rows of gyro block in 1,500-row windows.
+        window_rows: 1_500,
+        scratch,
+        ..Default::default()
+    };
+    let json = |o: &fit::Options| {
+        let r = fit::analyze_source(&streamed, None, o).unwrap();
+        assert!(r.allan.as_ref().is_some_and(|a| a.tau_s.len() > 5));
+        serde_json::to_string(&r).unwrap()
+    };
+    let held = json(&opts(None));
+    let spilled = json(&opts(Some(fit::Scratch::new(tempfile::tempfile))));
+    assert_eq!(held, spilled);
+    let refused = fit::Scratch::new(|| Err(std::io::Error::other("no scratch space")));
+    assert_eq!(held, json(&opts(Some(refused))));
+}
