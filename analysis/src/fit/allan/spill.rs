@@ -21,7 +21,6 @@
 use super::{Theta, add_run};
 use std::fs::File;
 use std::io;
-use std::os::unix::fs::FileExt;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 /// Samples of `k` a sweep reads at once, at least (512 KB a range).
@@ -78,7 +77,7 @@ impl Spill {
             for (b, x) in bytes.as_chunks_mut::<8>().0.iter_mut().zip(piece) {
                 *b = x.to_le_bytes();
             }
-            self.file.write_all_at(bytes, at + (8 * i * STEP) as u64)?;
+            write_all_at(&self.file, bytes, at + (8 * i * STEP) as u64)?;
         }
         Ok(())
     }
@@ -87,7 +86,7 @@ impl Spill {
     pub(super) fn read_at(&self, out: &mut [f64], at: u64, bytes: &mut Vec<u8>) -> io::Result<()> {
         for (i, piece) in out.chunks_mut(STEP).enumerate() {
             bytes.resize(8 * piece.len(), 0);
-            self.file.read_exact_at(bytes, at + (8 * i * STEP) as u64)?;
+            read_exact_at(&self.file, bytes, at + (8 * i * STEP) as u64)?;
             for (x, b) in piece.iter_mut().zip(bytes.as_chunks::<8>().0) {
                 *x = f64::from_le_bytes(*b);
             }
@@ -221,4 +220,42 @@ impl Theta for OnFile<'_> {
         }
         Ok(())
     }
+}
+
+/// `buf` written at byte `at` of `f`, without moving a shared cursor (the tasks share `f`).
+#[cfg(unix)]
+fn write_all_at(f: &File, buf: &[u8], at: u64) -> io::Result<()> {
+    std::os::unix::fs::FileExt::write_all_at(f, buf, at)
+}
+
+/// `buf` filled from byte `at` of `f`, without moving a shared cursor.
+#[cfg(unix)]
+fn read_exact_at(f: &File, buf: &mut [u8], at: u64) -> io::Result<()> {
+    std::os::unix::fs::FileExt::read_exact_at(f, buf, at)
+}
+
+/// As on unix: Windows' positioned IO moves the cursor, which no read here relies on.
+#[cfg(windows)]
+fn write_all_at(f: &File, mut buf: &[u8], mut at: u64) -> io::Result<()> {
+    use std::os::windows::fs::FileExt;
+    while !buf.is_empty() {
+        match f.seek_write(buf, at)? {
+            0 => return Err(io::ErrorKind::WriteZero.into()),
+            n => (buf, at) = (&buf[n..], at + n as u64),
+        }
+    }
+    Ok(())
+}
+
+/// As on unix: Windows' positioned IO moves the cursor, which no read here relies on.
+#[cfg(windows)]
+fn read_exact_at(f: &File, mut buf: &mut [u8], mut at: u64) -> io::Result<()> {
+    use std::os::windows::fs::FileExt;
+    while !buf.is_empty() {
+        match f.seek_read(buf, at)? {
+            0 => return Err(io::ErrorKind::UnexpectedEof.into()),
+            n => (buf, at) = (&mut std::mem::take(&mut buf)[n..], at + n as u64),
+        }
+    }
+    Ok(())
 }
