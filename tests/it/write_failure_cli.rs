@@ -30,6 +30,8 @@ fn a_file_size_limit_aborts_the_run_and_what_is_sealed_reads_back() {
     assert!(out.contains("imu.csv: File too large (os error"), "{out}");
     assert!(out.contains("a write failed (imu.csv"), "{out}");
     assert!(out.contains("ratecal run --resume r"), "{out}");
+    // The summary counts the segments the recording kept, not those handed to the writer.
+    assert!(out.contains("segments: 1\n"), "{out}");
 
     let dir = tmp.path().join("r");
     let m = ratecal_recording::read(&dir)

@@ -236,13 +236,17 @@ fn execute_prepared(
     } else {
         writer.written().to_vec()
     };
+    // The segments the manifest kept: a segment whose checkpoint failed after the
+    // interpreter handed it over is not the recording's.
+    let kept = (writer.manifest().segments.len()).saturating_sub(opts.resume_segments);
     // The recording is closed before anything reads it back (or records a failure).
     drop(writer);
     let outcome = outcome?;
     bar.finish();
     let wall = wall.elapsed().as_secs_f64();
-    let outcome = outcome
+    let mut outcome = outcome
         .map_err(|e| miette::miette!("cannot close the recording in {}: {e}", dir.display()))?;
+    outcome.segments = outcome.segments.min(kept);
     if staged {
         // The rest is recorded and closed: it replaces the sealed files in one change.
         resume::commit_staged(&dir).map_err(|e| {
