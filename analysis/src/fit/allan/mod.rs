@@ -218,32 +218,55 @@ fn terms(n: usize, m: usize) -> usize {
 /// The sums of squared second differences of the integrated angle `theta[k] = c[k - 1]`
 /// (`theta[0] = 0`) at the cluster sizes of `group`.
 fn group_sums<T: Theta>(c: &T, group: Vec<usize>) -> Result<Vec<f64>, T::Error> {
-    let n = c.len();
-    let mut s = vec![0.0; group.len()];
-    // k = 0, where theta[k] is the implicit zero, then the rest in order: every sum adds
-    // its terms in the order of k, whichever sizes are swept beside it.
-    for (s, &m) in s.iter_mut().zip(&group) {
+    let mut s = first_terms(c, &group)?;
+    add_terms(c, &group, &mut s, 1, terms(c.len(), group[0]))?;
+    Ok(s)
+}
+
+/// The terms at `k = 0` of the sums of `group`'s sizes, where `theta[k]` is the implicit zero.
+fn first_terms<T: Theta>(c: &T, group: &[usize]) -> Result<Vec<f64>, T::Error> {
+    let term = |m: usize| -> Result<f64, T::Error> {
         let d0 = c.at(2 * m - 1)? - 2.0 * c.at(m - 1)?;
-        *s = d0 * d0;
-    }
+        Ok(d0 * d0)
+    };
+    group.iter().map(|&m| term(m)).collect()
+}
+
+/// Adds to `s` (the sums of `group`'s sizes) their terms of `k` in `[a, b)`: the sizes swept
+/// together up to the largest size's last term, then each size's own tail. Every sum adds
+/// its terms in the order of `k`, whichever sizes are swept beside it, and whether `[1,
+/// end)` is added at once or block by block in order (a block's swept part comes before its
+/// tails, which start after the swept part ends).
+fn add_terms<T: Theta>(
+    c: &T,
+    group: &[usize],
+    s: &mut [f64],
+    a: usize,
+    b: usize,
+) -> Result<(), T::Error> {
+    let n = c.len();
     let common = terms(n, group[group.len() - 1]);
-    match <[usize; SWEPT]>::try_from(group.as_slice()) {
-        Ok(g) => {
-            let mut four = [0.0; SWEPT];
-            four.copy_from_slice(&s);
-            c.sweep(g, &mut four, 1, common)?;
-            s.copy_from_slice(&four);
-        }
-        Err(_) => {
-            for (s, &m) in s.iter_mut().zip(&group) {
-                c.sweep([m], std::array::from_mut(s), 1, common)?;
+    let swept = (a, b.min(common));
+    if swept.0 < swept.1 {
+        match <[usize; SWEPT]>::try_from(group) {
+            Ok(g) => {
+                let four = <&mut [f64; SWEPT]>::try_from(&mut s[..]).expect("four sums");
+                c.sweep(g, four, swept.0, swept.1)?;
+            }
+            Err(_) => {
+                for (s, &m) in s.iter_mut().zip(group) {
+                    c.sweep([m], std::array::from_mut(s), swept.0, swept.1)?;
+                }
             }
         }
     }
-    for (s, &m) in s.iter_mut().zip(&group) {
-        c.sweep([m], std::array::from_mut(s), common, terms(n, m))?;
+    for (s, &m) in s.iter_mut().zip(group) {
+        let (a, b) = (a.max(common), b.min(terms(n, m)));
+        if a < b {
+            c.sweep([m], std::array::from_mut(s), a, b)?;
+        }
     }
-    Ok(s)
+    Ok(())
 }
 
 /// The curve of a series of `n` samples from its sums (in the order of [`sizes`]).

@@ -10,7 +10,7 @@
 //! tail.
 
 use super::spill::{Angles, Spill};
-use super::{Part, SWEPT, add_run, terms};
+use super::{Part, Theta, add_run, add_terms, first_terms, terms};
 use std::io;
 
 /// The sums of `near` (groups of cluster sizes, in order) over one axis's rates `parts`
@@ -130,42 +130,48 @@ impl Window<'_> {
     /// Sums the block of `k` from `base + 1` (up to `block` long) and moves past it.
     fn take_block(&mut self) {
         let k0 = self.base + 1;
-        let ring = &self.ring[..];
-        if k0 == 1 {
-            // k = 0, where theta[k] is the implicit zero.
-            for (s, g) in self.sums.iter_mut().zip(self.near) {
-                for (s, &m) in s.iter_mut().zip(g) {
-                    let d0 = ring[2 * m - 1] - 2.0 * ring[m - 1];
-                    *s = d0 * d0;
-                }
-            }
-        }
         let run = self.block.min(self.end - k0);
-        let (k1, n) = (k0 + run, self.n);
+        let ring = Ring {
+            ring: &self.ring,
+            n: self.n,
+        };
         for (s, g) in self.sums.iter_mut().zip(self.near) {
-            let common = terms(n, g[g.len() - 1]);
-            let (a, b) = (k0, k1.min(common));
-            if a < b {
-                match <[usize; SWEPT]>::try_from(g.as_slice()) {
-                    Ok(ms) => {
-                        let four = <&mut [f64; SWEPT]>::try_from(&mut s[..]).expect("four sums");
-                        sweep(ring, ms, four, a, b);
-                    }
-                    Err(_) => {
-                        for (s, &m) in s.iter_mut().zip(g) {
-                            sweep(ring, [m], std::array::from_mut(s), a, b);
-                        }
-                    }
-                }
+            if k0 == 1 {
+                let Ok(first) = first_terms(&ring, g);
+                *s = first;
             }
-            for (s, &m) in s.iter_mut().zip(g) {
-                let (a, b) = (k0.max(common), k1.min(terms(n, m)));
-                if a < b {
-                    sweep(ring, [m], std::array::from_mut(s), a, b);
-                }
-            }
+            let Ok(()) = add_terms(&ring, g, s, k0, k0 + run);
         }
         self.base += run;
+    }
+}
+
+/// The angles in the ring, read as the whole series (`n` values) where they are held.
+struct Ring<'a> {
+    ring: &'a [f64],
+    n: usize,
+}
+
+impl Theta for Ring<'_> {
+    type Error = std::convert::Infallible;
+
+    fn len(&self) -> usize {
+        self.n
+    }
+
+    fn at(&self, i: usize) -> Result<f64, Self::Error> {
+        Ok(self.ring[i % self.ring.len()])
+    }
+
+    fn sweep<const N: usize>(
+        &self,
+        ms: [usize; N],
+        s: &mut [f64; N],
+        k: usize,
+        end: usize,
+    ) -> Result<(), Self::Error> {
+        sweep(self.ring, ms, s, k, end);
+        Ok(())
     }
 }
 
